@@ -1,0 +1,3 @@
+//! One module per subcommand. Each has an `Args` (clap derive) and a `run`.
+
+pub mod calc;

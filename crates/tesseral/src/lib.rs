@@ -1,0 +1,16 @@
+//! # tesseral
+//!
+//! Octrees of 3-D solids and surfaces. See `ARCHITECTURE.md` at the repository root
+//! for how the parts fit together, and `../shared/DESIGN.md` for the conventions
+//! every module shares (axes, child labels, depth, voxel centres).
+//!
+//! Conventions in one breath: x east, y north, z up; a child label is
+//! `d = x + 2y + 4z`; a tesseral (Morton) code holds the octal digits of the path from
+//! the root, most significant first; voxel `(i, j, k)` is the half-open unit cube at
+//! that corner, sampled at its centre.
+#![deny(missing_docs)]
+
+pub mod code;
+
+/// A voxel (or any lattice point) in world coordinates.
+pub type Voxel = [i64; 3];
