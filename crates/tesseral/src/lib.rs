@@ -11,6 +11,8 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod io;
+pub mod linear;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
