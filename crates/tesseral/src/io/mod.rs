@@ -18,8 +18,12 @@
 //! | `.stl`, `.obj`, `.ply` | meshes, voxelized on read, meshed on write | [`crate::mesh`] |
 //! | `.glb` | glTF binary mesh (write only) | [`crate::mesh`] |
 
+pub mod binvox;
 pub mod native;
+mod reframe;
 pub mod xyz;
+
+pub use reframe::reframe;
 
 use std::collections::BTreeMap;
 use std::fs;
@@ -202,10 +206,10 @@ pub struct ReadOptions {}
 pub struct WriteOptions {}
 
 /// The extensions [`read_octree`] understands.
-pub const KNOWN_EXTENSIONS: &str = "tess, xyz";
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox";
 
 /// The extensions [`write_octree`] understands.
-pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz";
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox";
 
 /// Reads an octree from `path`, choosing the format by its extension. Meshes are
 /// voxelized with [`ReadOptions::default`].
@@ -232,6 +236,7 @@ pub fn read_model_with(path: &Path, _options: &ReadOptions) -> Result<VoxelModel
     match extension(path).as_str() {
         "tess" => native::read(path),
         "xyz" => xyz::read(path).map(VoxelModel::new),
+        "binvox" => binvox::read(path),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -269,6 +274,7 @@ pub fn write_model_with(
     match extension(path).as_str() {
         "tess" => write_atomic(path, |w| native::write(w, model)),
         "xyz" => write_atomic(path, |w| xyz::write(w, &model.tree)),
+        "binvox" => binvox::write_file(path, model),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,
