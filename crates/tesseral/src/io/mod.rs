@@ -21,6 +21,7 @@
 pub mod binvox;
 pub mod native;
 mod reframe;
+pub mod vox;
 pub mod xyz;
 
 pub use reframe::reframe;
@@ -206,10 +207,10 @@ pub struct ReadOptions {}
 pub struct WriteOptions {}
 
 /// The extensions [`read_octree`] understands.
-pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox";
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox";
 
 /// The extensions [`write_octree`] understands.
-pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox";
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox";
 
 /// Reads an octree from `path`, choosing the format by its extension. Meshes are
 /// voxelized with [`ReadOptions::default`].
@@ -237,6 +238,7 @@ pub fn read_model_with(path: &Path, _options: &ReadOptions) -> Result<VoxelModel
         "tess" => native::read(path),
         "xyz" => xyz::read(path).map(VoxelModel::new),
         "binvox" => binvox::read(path),
+        "vox" => vox::read(path),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -275,6 +277,7 @@ pub fn write_model_with(
         "tess" => write_atomic(path, |w| native::write(w, model)),
         "xyz" => write_atomic(path, |w| xyz::write(w, &model.tree)),
         "binvox" => binvox::write_file(path, model),
+        "vox" => vox::write_file(path, model),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,
