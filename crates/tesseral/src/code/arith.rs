@@ -466,8 +466,11 @@ impl<W: CodeWord> Space<W> {
     ///
     /// ```
     /// use tesseral::code::Space;
-    /// let s = Space::<u64>::new(3).unwrap();
-    /// assert_eq!(s.decode_signed(0o022), [0, -5, 0]);
+    /// let s = Space::<u64>::new(4).unwrap();
+    /// // -5 along y is binary 1011, spread onto the y bits: 2022.
+    /// assert_eq!(s.decode_signed(0o2022), [0, -5, 0]);
+    /// // In 3 digits the same bits 011 read +3: -5 does not fit [-4, 4).
+    /// assert_eq!(Space::<u64>::new(3).unwrap().decode_signed(0o022), [0, 3, 0]);
     /// ```
     #[must_use]
     pub fn decode_signed(&self, code: W) -> [i64; 3] {
