@@ -19,12 +19,15 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// The papers' digit tables, computed; misprints marked and footnoted.
+    Tables(cmd::tables::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Tables(args) => cmd::tables::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
