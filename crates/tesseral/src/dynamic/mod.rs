@@ -68,10 +68,13 @@ pub const NEIGHBOUR_BIT: [u32; 6] = [12, 14, 10, 16, 4, 22];
 /// Bit of the 27-bit neighbourhood for the centre voxel.
 pub const CENTRE_BIT: u32 = 13;
 
+/// Eight child slots, 32 bytes aligned to 32, so a node never straddles two cache
+/// lines; its parent link lives in a separate array (`node_parent`), which searches
+/// from the root never touch.
 #[derive(Clone, Copy)]
+#[repr(C, align(32))]
 struct Node {
     child: [u32; 8],
-    parent: u32,
 }
 
 /// 8×8×8 voxels: word `z`, bit `x + 8y`.
@@ -93,6 +96,7 @@ pub struct DynamicOctree {
     /// log2 of the root's side, 0..=64. Below 3 the root is the low corner of a block.
     size_log2: u32,
     nodes: Vec<Node>,
+    node_parent: Vec<u32>,
     node_free: Vec<u32>,
     leaves: Vec<Leaf>,
     leaf_parent: Vec<u32>,
@@ -155,6 +159,17 @@ impl fmt::Debug for DynamicOctree {
             .field("nodes", &self.node_count())
             .field("faces", &self.faces.as_ref().map(|f| f.list.len()))
             .finish()
+    }
+}
+
+/// Grows a pool by 1/8 (at least 64 entries) when it is full, instead of doubling:
+/// the pools are most of the memory, and doubling would leave up to half of it
+/// unused. Large reallocations are cheap (glibc moves them with `mremap`), so the
+/// amortised cost per push stays O(1).
+#[inline]
+fn grow<T>(v: &mut Vec<T>) {
+    if v.len() == v.capacity() {
+        v.reserve_exact((v.len() / 8).max(64));
     }
 }
 
@@ -260,10 +275,8 @@ impl DynamicOctree {
             root: EMPTY,
             root_min: [0; 3],
             size_log2: 0,
-            nodes: vec![Node {
-                child: [EMPTY; 8],
-                parent: FREED,
-            }],
+            nodes: vec![Node { child: [EMPTY; 8] }],
+            node_parent: vec![FREED],
             node_free: Vec::new(),
             leaves: vec![Leaf([0; 8])],
             leaf_parent: vec![FREED],
@@ -313,25 +326,26 @@ impl DynamicOctree {
     // ----- pools -------------------------------------------------------------------
 
     fn alloc_node(&mut self, parent: u32, fill: u32) -> u32 {
-        let n = Node {
-            child: [fill; 8],
-            parent,
-        };
+        let n = Node { child: [fill; 8] };
         if let Some(i) = self.node_free.pop() {
             self.nodes[i as usize] = n;
+            self.node_parent[i as usize] = parent;
             i
         } else {
             let i = u32::try_from(self.nodes.len())
                 .ok()
                 .filter(|&i| i < FULL)
                 .expect("DynamicOctree: more than 2^32 - 2 nodes");
+            grow(&mut self.nodes);
             self.nodes.push(n);
+            grow(&mut self.node_parent);
+            self.node_parent.push(parent);
             i
         }
     }
 
     fn free_node(&mut self, i: u32) {
-        self.nodes[i as usize].parent = FREED;
+        self.node_parent[i as usize] = FREED;
         self.node_free.push(i);
     }
 
@@ -345,7 +359,9 @@ impl DynamicOctree {
                 .ok()
                 .filter(|&i| i < FULL)
                 .expect("DynamicOctree: more than 2^32 - 2 blocks");
+            grow(&mut self.leaves);
             self.leaves.push(Leaf([fill; 8]));
+            grow(&mut self.leaf_parent);
             self.leaf_parent.push(parent);
             i
         }
@@ -369,7 +385,7 @@ impl DynamicOctree {
     fn set_parent(&mut self, slot: u32, level: u32, parent: u32) {
         if is_index(slot) {
             if level > LEAF_LOG2 {
-                self.nodes[slot as usize].parent = parent;
+                self.node_parent[slot as usize] = parent;
             } else {
                 self.leaf_parent[slot as usize] = parent;
             }
@@ -574,7 +590,7 @@ impl DynamicOctree {
         self.set_slot(parent, child_index(u, level), FULL);
         let mut node = parent;
         while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == FULL) {
-            let p = self.nodes[node as usize].parent;
+            let p = self.node_parent[node as usize];
             self.free_node(node);
             level += 1;
             let ci = if p != NONE { child_index(u, level) } else { 0 };
@@ -660,7 +676,7 @@ impl DynamicOctree {
             self.set_slot(parent, child_index(u, level), EMPTY);
             let mut node = parent;
             while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == EMPTY) {
-                let p = self.nodes[node as usize].parent;
+                let p = self.node_parent[node as usize];
                 self.free_node(node);
                 level += 1;
                 let ci = if p != NONE { child_index(u, level) } else { 0 };
@@ -731,7 +747,7 @@ impl DynamicOctree {
         while level < 64
             && ((t[0] ^ probe[0]) | (t[1] ^ probe[1]) | (t[2] ^ probe[2])) >> level != 0
         {
-            node = self.nodes[node as usize].parent;
+            node = self.node_parent[node as usize];
             level += 1;
             debug_assert!(node != NONE, "climbed past the root");
         }
@@ -1066,6 +1082,7 @@ impl DynamicOctree {
     pub fn bytes(&self) -> usize {
         std::mem::size_of::<Self>()
             + self.nodes.capacity() * std::mem::size_of::<Node>()
+            + self.node_parent.capacity() * 4
             + self.node_free.capacity() * 4
             + self.leaves.capacity() * std::mem::size_of::<Leaf>()
             + self.leaf_parent.capacity() * 4
@@ -1077,6 +1094,7 @@ impl DynamicOctree {
     /// pools may hold up to twice what they need). O(size).
     pub fn shrink_to_fit(&mut self) {
         self.nodes.shrink_to_fit();
+        self.node_parent.shrink_to_fit();
         self.node_free.shrink_to_fit();
         self.leaves.shrink_to_fit();
         self.leaf_parent.shrink_to_fit();
@@ -1179,7 +1197,7 @@ impl DynamicOctree {
         );
         for &i in &self.node_free {
             assert_eq!(
-                self.nodes[i as usize].parent, FREED,
+                self.node_parent[i as usize], FREED,
                 "free node {i} not marked"
             );
         }
@@ -1193,6 +1211,11 @@ impl DynamicOctree {
             self.leaves.len(),
             self.leaf_parent.len(),
             "block parent array length"
+        );
+        assert_eq!(
+            self.nodes.len(),
+            self.node_parent.len(),
+            "node parent array length"
         );
         if self.root == EMPTY {
             assert_eq!(self.voxels, 0, "empty root with voxels");
@@ -1225,7 +1248,10 @@ impl DynamicOctree {
                 _ if level > LEAF_LOG2 => {
                     let n = &self.nodes[slot as usize];
                     assert!(!nfree.contains(&slot), "node {slot} is live and free");
-                    assert_eq!(n.parent, parent, "parent link of node {slot}");
+                    assert_eq!(
+                        self.node_parent[slot as usize], parent,
+                        "parent link of node {slot}"
+                    );
                     assert!(n.child.iter().any(|&c| c != EMPTY), "node {slot} is empty");
                     assert!(n.child.iter().any(|&c| c != FULL), "node {slot} is full");
                     seen_nodes += 1;
