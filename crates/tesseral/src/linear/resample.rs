@@ -241,7 +241,7 @@ impl LinearOctree {
     }
 
     /// The general top-down resample; `delta` is the new origin minus ours.
-    fn resample_general(&self, depth: u8, delta: [i64; 3]) -> Vec<Leaf> {
+    pub(super) fn resample_general(&self, depth: u8, delta: [i64; 3]) -> Vec<Leaf> {
         let mut index = Index::new(&self.leaves, self.depth);
         // Wrap the input in gray ancestors until it is at least as deep as the
         // output (the input space becomes child 0 of each new root), so windows at
@@ -289,7 +289,7 @@ impl LinearOctree {
     /// leaf moves whole: its code is moved by tesseral addition, the leaves outside
     /// the new space are dropped, and the rest are sorted and merged. Returns `None`
     /// when the fast path does not apply.
-    fn aligned_shift(&self, depth: u8, delta: [i64; 3]) -> Option<Vec<Leaf>> {
+    pub(super) fn aligned_shift(&self, depth: u8, delta: [i64; 3]) -> Option<Vec<Leaf>> {
         let max_k = self.leaves.iter().map(|l| l.size_log2()).max().unwrap_or(0);
         if delta.iter().any(|&v| v.rem_euclid(1 << max_k) != 0) {
             return None;
