@@ -11,6 +11,7 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
