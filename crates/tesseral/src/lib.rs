@@ -11,6 +11,8 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod io;
+pub mod linear;
 pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
