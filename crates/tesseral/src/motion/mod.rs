@@ -8,6 +8,7 @@
 //!   object cannot tunnel through a thin wall between time steps.
 //! - [`World`]: one static environment and moving objects with trajectories, advanced
 //!   in time steps, with interference at each step and a swept test between steps.
+//! - [`read_world`]: the JSON world file of `tesseral simulate`.
 //! - [`plan()`]: configuration-space obstacles as a Minkowski sum of octrees, A* over free
 //!   octree cells of varying sizes with exact adjacency, then smoothing.
 //!
@@ -19,12 +20,16 @@ mod interfere;
 mod orient;
 mod sweep;
 mod traverse;
+mod world;
+mod world_file;
 
 pub use interfere::{
     clearance, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
 pub use orient::{Rotation, RotationError};
+pub use world::{Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World};
+pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
 
 #[cfg(test)]
