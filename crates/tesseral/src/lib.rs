@@ -14,6 +14,7 @@ pub mod code;
 pub mod dynamic;
 pub mod io;
 pub mod linear;
+pub mod mesh;
 pub mod motion;
 pub mod rsmc;
 
