@@ -140,6 +140,9 @@ pub fn voxelize(
                 ));
             }
             let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+            if !ext.is_finite() {
+                return Err(FormatError::too_large(path, "the mesh's extent overflows"));
+            }
             let h = if ext > 0.0 {
                 ext / f64::from(1u32 << d)
             } else {
