@@ -107,6 +107,12 @@ fn bench_add(c: &mut Criterion) {
             black_box(&out);
         })
     });
+    g.bench_function("add_slices", |bench| {
+        bench.iter(|| {
+            tesseral::code::batch::add_slices(&s, black_box(&a), black_box(&b), &mut out).unwrap();
+            black_box(&out);
+        })
+    });
     g.bench_function("translate_in_place", |bench| {
         let by = b[0];
         bench.iter(|| {

@@ -201,6 +201,12 @@ fn check_arith<W: CodeWord>(seed: u64) {
             let ctx = format!("depth {depth} a {a:?} b {b:?} seed {seed:#x}");
 
             let add = model_op(&s, a, b, |x, y| x + y);
+            let mut out = [W::ZERO; 1];
+            batch::add_slices(&s, &[ja], &[jb], &mut out).unwrap();
+            assert_eq!(out[0], add.code, "add_slices {ctx}");
+            let mut moved = [ja];
+            batch::translate_slice(&s, &mut moved, jb);
+            assert_eq!(moved[0], add.code, "translate_slice {ctx}");
             assert_eq!(s.overflowing_add(ja, jb), add, "add {ctx}");
             assert_eq!(s.add(ja, jb), add.code, "add {ctx}");
             assert_eq!(add_by_table(a, b, depth), add, "table add {ctx}");
