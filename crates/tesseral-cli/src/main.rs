@@ -21,6 +21,8 @@ enum Command {
     Calc(cmd::calc::Args),
     /// The papers' digit tables, computed; misprints marked and footnoted.
     Tables(cmd::tables::Args),
+    /// Monte Carlo of self-avoiding random surfaces (Libes §6).
+    Rsmc(cmd::rsmc::Args),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +30,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Tables(args) => cmd::tables::run(args),
+        Command::Rsmc(args) => cmd::rsmc::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
