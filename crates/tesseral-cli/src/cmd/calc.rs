@@ -33,25 +33,25 @@ pub struct Args {
 enum Op {
     /// Tesseral addition A + B: A translated by the vector from 0 to B.
     Add {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         b: String,
     },
     /// Tesseral subtraction A - B, by the P-adic method.
     Sub {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         b: String,
     },
     /// Negation: the two's complement of every axis.
     Neg {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
     },
@@ -69,7 +69,7 @@ enum Op {
     },
     /// Prints the coordinates `X Y Z` of an octal code.
     Decode {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         code: String,
     },
