@@ -19,12 +19,15 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// Applies an operations log (+ x y z, - x y z, ? x y z) to an unbounded octree.
+    Replay(cmd::replay::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Replay(args) => cmd::replay::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -995,6 +995,26 @@ impl DynamicOctree {
         self.faces.as_ref().map_or(0, |f| f.list.len())
     }
 
+    /// The number of exposed faces (the surface area), whether or not the face list
+    /// is kept: `face_count()` with face bookkeeping, otherwise
+    /// `6·voxels − 2·(face-adjacent pairs)` counted now in O(voxels · depth).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[0, 0, 0], [0, 1, 0]]);
+    /// assert_eq!(t.exposed_faces(), 10);
+    /// ```
+    #[must_use]
+    pub fn exposed_faces(&self) -> u64 {
+        if let Some(f) = &self.faces {
+            return f.list.len() as u64;
+        }
+        let mut pairs = 0u64;
+        for v in self.voxels() {
+            pairs += u64::from((self.face_neighbours(v) & 0b10_1010).count_ones());
+        }
+        6 * self.voxels - 2 * pairs
+    }
+
     /// The `i`-th face of the face list. O(1).
     ///
     /// # Panics
