@@ -61,6 +61,8 @@ const FULL: u32 = u32::MAX;
 const NONE: u32 = 0;
 /// The parent field of a node or block on the free list.
 const FREED: u32 = u32::MAX;
+static ZERO_BLOCK: [u64; 8] = [0; 8];
+static FULL_BLOCK: [u64; 8] = [!0; 8];
 /// All 27 bits of a 3×3×3 neighbourhood.
 pub const NEIGHBOURHOOD_ALL: u32 = (1 << 27) - 1;
 /// Bit of the 27-bit neighbourhood for each face direction 0..6 (−x, +x, −y, +y, −z, +z).
@@ -879,10 +881,10 @@ impl DynamicOctree {
     /// The block (8³ voxels) whose minimum corner has offsets `t`, found from node
     /// `start` at `start_level` (which contains offsets `u`), or from the root when
     /// `start` is NONE.
-    fn block_bits(&self, t: [u64; 3], u: [u64; 3], start: u32, start_level: u32) -> [u64; 8] {
+    fn block_bits(&self, t: [u64; 3], u: [u64; 3], start: u32, start_level: u32) -> &[u64; 8] {
         let phys = self.phys_log2();
         if !within(t, phys) {
-            return [0; 8];
+            return &ZERO_BLOCK;
         }
         let (cur, level) = if start == NONE {
             (self.root, phys)
@@ -891,9 +893,9 @@ impl DynamicOctree {
         };
         let (slot, _, _) = self.descend(cur, level, NONE, t);
         match slot {
-            EMPTY => [0; 8],
-            FULL => [!0; 8],
-            _ => self.leaves[slot as usize].0,
+            EMPTY => &ZERO_BLOCK,
+            FULL => &FULL_BLOCK,
+            _ => &self.leaves[slot as usize].0,
         }
     }
 
@@ -909,7 +911,7 @@ impl DynamicOctree {
             u[1].wrapping_add(1) >> 3,
             u[2].wrapping_add(1) >> 3,
         ];
-        let mut blocks = [[0u64; 8]; 8];
+        let mut blocks: [&[u64; 8]; 8] = [&ZERO_BLOCK; 8];
         for i in 0..8usize {
             let sel = [i & 1, i >> 1 & 1, i >> 2 & 1];
             if (0..3).any(|a| sel[a] == 1 && hi[a] == lo[a]) {
@@ -918,20 +920,30 @@ impl DynamicOctree {
             let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
             blocks[i] = self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level);
         }
+        // Row by row: the three cells (x−1, x, x+1) of a row come from one block
+        // word, or from two when the row crosses a block boundary in x.
+        let lx = u[0] & 7;
         let mut r = 0u32;
         for dz in 0..3u64 {
             let cz = u[2].wrapping_add(dz).wrapping_sub(1);
-            let bz = usize::from(cz >> 3 != lo[2]);
+            let bz = usize::from(cz >> 3 != lo[2]) << 2;
+            let lz = (cz & 7) as usize;
             for dy in 0..3u64 {
                 let cy = u[1].wrapping_add(dy).wrapping_sub(1);
-                let by = usize::from(cy >> 3 != lo[1]);
-                for dx in 0..3u64 {
-                    let cx = u[0].wrapping_add(dx).wrapping_sub(1);
-                    let bx = usize::from(cx >> 3 != lo[0]);
-                    let w = blocks[bx | by << 1 | bz << 2][(cz & 7) as usize];
-                    let bit = (w >> ((cx & 7) + 8 * (cy & 7))) & 1;
-                    r |= (bit as u32) << (dx + 3 * dy + 9 * dz);
-                }
+                let b = usize::from(cy >> 3 != lo[1]) << 1 | bz;
+                let sh = 8 * (cy & 7);
+                let row = if lo[0] == hi[0] {
+                    (blocks[b][lz] >> (sh + lx - 1)) & 7
+                } else {
+                    let wl = blocks[b][lz] >> sh;
+                    let wh = blocks[b | 1][lz] >> sh;
+                    if lx == 0 {
+                        (wl >> 7 & 1) | (wh & 3) << 1
+                    } else {
+                        (wl >> 6 & 3) | (wh & 1) << 2
+                    }
+                };
+                r |= (row as u32) << (3 * dy + 9 * dz);
             }
         }
         r
@@ -961,14 +973,15 @@ impl DynamicOctree {
     fn faces_after_insert(&mut self, v: Voxel) {
         let nb = self.face_neighbours(v);
         let f = self.faces.as_mut().expect("face bookkeeping");
+        let mut own = None;
         for dir in 0..6u8 {
             if nb >> dir & 1 == 1 {
-                f.remove(Face {
-                    voxel: step(v, dir),
-                    dir: opposite(dir),
-                });
+                let n = step(v, dir);
+                let r = f.existing_record(n);
+                f.remove(r, n, opposite(dir));
             } else {
-                f.push(Face { voxel: v, dir });
+                let r = *own.get_or_insert_with(|| f.record_of(v));
+                f.push(r, v, dir);
             }
         }
     }
@@ -976,14 +989,20 @@ impl DynamicOctree {
     fn faces_after_remove(&mut self, v: Voxel) {
         let nb = self.face_neighbours(v);
         let f = self.faces.as_mut().expect("face bookkeeping");
+        // A black voxel with a white neighbour has a record; one with six black
+        // neighbours has no face to remove.
+        let own = if nb & 0b11_1111 != 0b11_1111 {
+            f.existing_record(v)
+        } else {
+            0
+        };
         for dir in 0..6u8 {
             if nb >> dir & 1 == 1 {
-                f.push(Face {
-                    voxel: step(v, dir),
-                    dir: opposite(dir),
-                });
+                let n = step(v, dir);
+                let r = f.record_of(n);
+                f.push(r, n, opposite(dir));
             } else {
-                f.remove(Face { voxel: v, dir });
+                f.remove(own, v, dir);
             }
         }
     }
@@ -1027,13 +1046,16 @@ impl DynamicOctree {
             "face index {i} out of range (face_count {})",
             f.len()
         );
-        f[i]
+        f[i].face()
     }
 
     /// The whole face list, in face-list order (empty without face bookkeeping).
+    /// O(faces).
     #[must_use]
-    pub fn faces(&self) -> &[Face] {
-        self.faces.as_ref().map_or(&[][..], |f| &f.list[..])
+    pub fn faces(&self) -> Vec<Face> {
+        self.faces
+            .as_ref()
+            .map_or_else(Vec::new, |f| f.list.iter().map(|e| e.face()).collect())
     }
 
     /// A uniformly random exposed face, or `None` when there is none. O(1).
@@ -1121,7 +1143,9 @@ impl DynamicOctree {
         self.leaf_free.shrink_to_fit();
         if let Some(f) = &mut self.faces {
             f.list.shrink_to_fit();
-            f.index.shrink_to_fit();
+            f.owners.shrink_to_fit();
+            f.records.shrink_to_fit();
+            f.free.shrink_to_fit();
         }
     }
 
@@ -1320,20 +1344,10 @@ impl DynamicOctree {
             assert!(splits, "root block could contract");
         }
         if let Some(f) = &self.faces {
-            assert_eq!(
-                f.list.len(),
-                f.index.len(),
-                "face list and back-pointers differ in size"
-            );
-            for (i, face) in f.list.iter().enumerate() {
-                assert!(face.dir < 6, "face {i} has direction {}", face.dir);
-                assert_eq!(
-                    f.index.get(face).copied(),
-                    Some(i as u32),
-                    "back-pointer of face {i}"
-                );
-                assert!(self.contains(face.voxel), "face {i} on a white voxel");
-                assert!(!self.contains(face.outside()), "face {i} is covered");
+            f.assert_valid();
+            for (i, e) in f.list.iter().enumerate() {
+                assert!(self.contains(e.voxel), "face {i} on a white voxel");
+                assert!(!self.contains(e.face().outside()), "face {i} is covered");
             }
             let all = self.voxels();
             let pairs: u64 = all
