@@ -21,6 +21,10 @@ enum Command {
     Calc(cmd::calc::Args),
     /// Applies an operations log (+ x y z, - x y z, ? x y z) to an unbounded octree.
     Replay(cmd::replay::Args),
+    /// The papers' digit tables, computed; misprints marked and footnoted.
+    Tables(cmd::tables::Args),
+    /// Monte Carlo of self-avoiding random surfaces (Libes §6).
+    Rsmc(cmd::rsmc::Args),
 }
 
 fn main() -> ExitCode {
@@ -28,6 +32,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Replay(args) => cmd::replay::run(args),
+        Command::Tables(args) => cmd::tables::run(args),
+        Command::Rsmc(args) => cmd::rsmc::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

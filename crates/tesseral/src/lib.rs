@@ -12,6 +12,10 @@
 
 pub mod code;
 pub mod dynamic;
+pub mod io;
+pub mod linear;
+pub mod motion;
+pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];

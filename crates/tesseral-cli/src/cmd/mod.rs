@@ -2,3 +2,5 @@
 
 pub mod calc;
 pub mod replay;
+pub mod rsmc;
+pub mod tables;

@@ -1,0 +1,384 @@
+//! Linear (pointerless) octrees: the black leaves of a solid as maximal blocks,
+//! sorted in tesseral order (Harakal & Chmúrny §2; Gargantini's linear octree).
+//!
+//! A [`LinearOctree`] spans a cube of `2^depth` voxels per axis whose lowest corner is
+//! the integer `origin`, so negative world coordinates work. Its leaves are kept in
+//! canonical form: sorted, disjoint, and with no eight black siblings left unmerged.
+//! Two equal solids in the same space therefore have equal leaf lists.
+
+pub(crate) mod arith;
+mod build;
+mod grow;
+mod leaf;
+mod ops;
+mod resample;
+mod sort;
+mod transform;
+
+pub use build::{CellClass, Classifier};
+pub use leaf::{Block, Leaf};
+pub use ops::SetOp;
+pub use transform::{rotation_labels, Axis};
+
+use crate::code;
+use crate::Voxel;
+
+/// The deepest linear octree: its codes fit a `u64` ([`code::MAX_DEPTH_U64`]).
+pub const MAX_DEPTH: u8 = code::MAX_DEPTH_U64 as u8;
+
+/// What can go wrong when building a [`LinearOctree`].
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OctreeError {
+    /// The requested depth exceeds [`MAX_DEPTH`].
+    #[error("depth {0} exceeds the maximum of {MAX_DEPTH}")]
+    DepthTooLarge(u8),
+    /// A voxel lies outside the space `[origin, origin + 2^depth)`.
+    #[error("voxel ({}, {}, {}) lies outside the octree's space", .0[0], .0[1], .0[2])]
+    OutOfBounds(Voxel),
+    /// A coordinate or origin left the range of `i64`.
+    #[error("a coordinate overflows the 64-bit integer range")]
+    Overflow,
+    /// A dense bit array is shorter than its dimensions say.
+    #[error("a dense array of {dims:?} voxels needs {needed} words of 64 bits, got {got}")]
+    DenseTooShort {
+        /// The array's dimensions, x fastest.
+        dims: [u32; 3],
+        /// The number of `u64` words needed.
+        needed: usize,
+        /// The number of words given.
+        got: usize,
+    },
+}
+
+/// A solid as a sorted list of maximal black blocks (a linear octree).
+///
+/// ```
+/// use tesseral::linear::LinearOctree;
+/// let voxels = (0..2).flat_map(|x| (0..2).flat_map(move |y| (0..2).map(move |z| [x, y, z])));
+/// let tree = LinearOctree::from_voxels(3, [0, 0, 0], voxels).unwrap();
+/// assert_eq!(tree.leaf_count(), 1); // the eight voxels merge into one block
+/// assert_eq!(tree.voxel_count(), 8);
+/// assert!(tree.contains([1, 1, 1]) && !tree.contains([2, 0, 0]));
+/// ```
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+pub struct LinearOctree {
+    depth: u8,
+    origin: Voxel,
+    leaves: Vec<Leaf>,
+}
+
+impl LinearOctree {
+    /// An empty (all white) tree spanning `2^depth` voxels per axis from `origin`.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
+    pub fn empty(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
+        check_depth(depth)?;
+        Ok(Self {
+            depth,
+            origin,
+            leaves: Vec::new(),
+        })
+    }
+
+    /// A tree whose whole space is black.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
+    pub fn full(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
+        check_depth(depth)?;
+        Ok(Self {
+            depth,
+            origin,
+            leaves: vec![Leaf::new(0, depth)],
+        })
+    }
+
+    /// Builds a tree from leaves that are already sorted and disjoint (not necessarily
+    /// merged); merges them into canonical form.
+    ///
+    /// # Runtime
+    /// O(n) for n leaves.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
+    ///
+    /// It is a logic error to pass leaves that are unsorted, overlapping, or outside
+    /// the space; [`LinearOctree::assert_valid`] catches it.
+    pub fn from_sorted_leaves(
+        depth: u8,
+        origin: Voxel,
+        leaves: impl IntoIterator<Item = Leaf>,
+    ) -> Result<Self, OctreeError> {
+        check_depth(depth)?;
+        let mut merged = Vec::new();
+        for leaf in leaves {
+            push_merging(&mut merged, leaf);
+        }
+        Ok(Self {
+            depth,
+            origin,
+            leaves: merged,
+        })
+    }
+
+    /// Builds a tree from black voxels in world coordinates, in any order, duplicates
+    /// allowed.
+    ///
+    /// # Runtime
+    /// O(n) for n voxels: the codes are radix-sorted (a few 8-bit passes).
+    ///
+    /// # Errors
+    /// [`OctreeError::OutOfBounds`] for a voxel outside the space;
+    /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
+    pub fn from_voxels(
+        depth: u8,
+        origin: Voxel,
+        voxels: impl IntoIterator<Item = Voxel>,
+    ) -> Result<Self, OctreeError> {
+        check_depth(depth)?;
+        let space = Self {
+            depth,
+            origin,
+            leaves: Vec::new(),
+        };
+        let mut codes = voxels
+            .into_iter()
+            .map(|v| space.code_of(v).ok_or(OctreeError::OutOfBounds(v)))
+            .collect::<Result<Vec<u64>, _>>()?;
+        sort::sort_u64(&mut codes);
+        codes.dedup();
+        Self::from_sorted_leaves(depth, origin, codes.into_iter().map(|c| Leaf::new(c, 0)))
+    }
+
+    /// Builds a tree from black voxels, choosing the smallest space that holds them:
+    /// the origin is their lowest corner and the depth the least that spans them.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when the voxels span more than `2^MAX_DEPTH`.
+    pub fn from_voxels_fitted(voxels: &[Voxel]) -> Result<Self, OctreeError> {
+        let Some(first) = voxels.first() else {
+            return Self::empty(0, [0, 0, 0]);
+        };
+        let (mut lo, mut hi) = (*first, *first);
+        for v in voxels {
+            for a in 0..3 {
+                lo[a] = lo[a].min(v[a]);
+                hi[a] = hi[a].max(v[a]);
+            }
+        }
+        let extent = (0..3).map(|a| hi[a].abs_diff(lo[a]) + 1).max().unwrap_or(1);
+        let depth = extent.next_power_of_two().trailing_zeros();
+        let depth = u8::try_from(depth).unwrap_or(u8::MAX);
+        Self::from_voxels(depth, lo, voxels.iter().copied())
+    }
+
+    /// The tree's depth D: it spans `2^D` voxels per axis.
+    #[must_use]
+    pub fn depth(&self) -> u8 {
+        self.depth
+    }
+
+    /// The world coordinates of the space's lowest corner.
+    #[must_use]
+    pub fn origin(&self) -> Voxel {
+        self.origin
+    }
+
+    /// The side of the space, in voxels: `2^depth`.
+    #[must_use]
+    pub fn side(&self) -> u64 {
+        1 << self.depth
+    }
+
+    /// The black leaves, sorted in tesseral order.
+    #[must_use]
+    pub fn leaves(&self) -> &[Leaf] {
+        &self.leaves
+    }
+
+    /// The number of black leaves (maximal blocks).
+    #[must_use]
+    pub fn leaf_count(&self) -> usize {
+        self.leaves.len()
+    }
+
+    /// Whether no voxel is black.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.leaves.is_empty()
+    }
+
+    /// The number of black voxels.
+    ///
+    /// # Runtime
+    /// O(n) in the number of leaves.
+    #[must_use]
+    pub fn voxel_count(&self) -> u64 {
+        self.leaves.iter().map(|l| l.voxel_count()).sum()
+    }
+
+    /// The number of leaves at each depth, index 0 being the root.
+    #[must_use]
+    pub fn leaves_by_depth(&self) -> Vec<u64> {
+        let mut counts = vec![0; usize::from(self.depth) + 1];
+        for l in &self.leaves {
+            counts[usize::from(self.depth - l.size_log2())] += 1;
+        }
+        counts
+    }
+
+    /// The inclusive bounding box `(min, max)` of the black voxels, or `None` when empty.
+    #[must_use]
+    pub fn bbox(&self) -> Option<(Voxel, Voxel)> {
+        let mut blocks = self.blocks();
+        let first = blocks.next()?;
+        let (mut lo, mut hi) = (first.min, first.max());
+        for b in blocks {
+            let bmax = b.max();
+            for a in 0..3 {
+                lo[a] = lo[a].min(b.min[a]);
+                hi[a] = hi[a].max(bmax[a]);
+            }
+        }
+        Some((lo, hi))
+    }
+
+    /// Whether world voxel `v` is black.
+    ///
+    /// # Runtime
+    /// O(log n): a binary search over the leaves.
+    #[must_use]
+    pub fn contains(&self, v: Voxel) -> bool {
+        let Some(c) = self.code_of(v) else {
+            return false;
+        };
+        let i = self.leaves.partition_point(|l| l.code() <= c);
+        i > 0 && self.leaves[i - 1].contains_code(c)
+    }
+
+    /// The tesseral code of world voxel `v` relative to the origin, or `None` when `v`
+    /// lies outside the space.
+    #[must_use]
+    pub fn code_of(&self, v: Voxel) -> Option<u64> {
+        let side = self.side();
+        let mut rel = [0u32; 3];
+        for a in 0..3 {
+            let d = v[a].checked_sub(self.origin[a])?;
+            if d < 0 || d as u64 >= side {
+                return None;
+            }
+            rel[a] = d as u32;
+        }
+        Some(code::encode(rel[0], rel[1], rel[2]))
+    }
+
+    /// The world voxel whose relative tesseral code is `code`.
+    #[must_use]
+    pub fn voxel_of(&self, code: u64) -> Voxel {
+        let r = code::decode(code);
+        [
+            self.origin[0] + i64::from(r[0]),
+            self.origin[1] + i64::from(r[1]),
+            self.origin[2] + i64::from(r[2]),
+        ]
+    }
+
+    /// The black blocks in tesseral order, in world coordinates.
+    pub fn blocks(&self) -> impl ExactSizeIterator<Item = Block> + '_ {
+        self.leaves.iter().map(|l| Block {
+            min: self.voxel_of(l.code()),
+            size_log2: l.size_log2(),
+        })
+    }
+
+    /// Every black voxel, in tesseral order.
+    pub fn voxels(&self) -> impl Iterator<Item = Voxel> + '_ {
+        self.leaves
+            .iter()
+            .flat_map(|l| (l.code()..l.end()).map(|c| self.voxel_of(c)))
+    }
+
+    /// Panics with a description of the first broken invariant: leaves sorted, disjoint,
+    /// aligned to their size, inside the space, and canonically merged.
+    ///
+    /// # Runtime
+    /// O(n).
+    pub fn assert_valid(&self) {
+        assert!(
+            self.depth <= MAX_DEPTH,
+            "depth {} > {MAX_DEPTH}",
+            self.depth
+        );
+        let space_end = 1u64 << (3 * u32::from(self.depth));
+        for (i, l) in self.leaves.iter().enumerate() {
+            assert!(
+                l.size_log2() <= self.depth,
+                "leaf {i} larger than the space"
+            );
+            assert_eq!(
+                l.code() % l.voxel_count(),
+                0,
+                "leaf {i} not aligned to its size"
+            );
+            assert!(l.end() <= space_end, "leaf {i} outside the space");
+            if i > 0 {
+                let p = self.leaves[i - 1];
+                assert!(
+                    p.end() <= l.code(),
+                    "leaves {} and {i} unsorted or overlapping",
+                    i - 1
+                );
+            }
+            if i >= 7 {
+                let run = &self.leaves[i - 7..=i];
+                assert!(
+                    !completes_parent(run),
+                    "leaves {}..={i} are eight unmerged siblings",
+                    i - 7
+                );
+            }
+        }
+    }
+
+    pub(crate) fn from_parts(depth: u8, origin: Voxel, leaves: Vec<Leaf>) -> Self {
+        Self {
+            depth,
+            origin,
+            leaves,
+        }
+    }
+}
+
+fn check_depth(depth: u8) -> Result<(), OctreeError> {
+    if depth > MAX_DEPTH {
+        return Err(OctreeError::DepthTooLarge(depth));
+    }
+    Ok(())
+}
+
+/// Whether eight leaves (sorted, disjoint) are the eight children of one parent.
+fn completes_parent(run: &[Leaf]) -> bool {
+    let k = run[0].size_log2();
+    let parent_cells = 8 * run[0].voxel_count();
+    run.iter().all(|l| l.size_log2() == k)
+        && run[0].code() % parent_cells == 0
+        && run[7].code() == run[0].code() + 7 * run[0].voxel_count()
+}
+
+/// Appends `leaf` (which follows every leaf in `out`) and merges complete sibling
+/// octets bottom-up, so that `out` stays canonical.
+pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
+    out.push(leaf);
+    while out.len() >= 8 && completes_parent(&out[out.len() - 8..]) {
+        let first = out[out.len() - 8];
+        out.truncate(out.len() - 8);
+        out.push(Leaf::new(first.code(), first.size_log2() + 1));
+    }
+}
+
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod tests_ops;
