@@ -13,7 +13,9 @@
 pub mod code;
 pub mod io;
 pub mod linear;
+pub mod dynamic;
 pub mod rsmc;
+pub mod motion;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
