@@ -10,6 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, Ordering};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{Chain, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -99,7 +100,11 @@ fn bench_rsmc(c: &mut Criterion) {
     for target in [10_000u64, 100_000] {
         let (voxels, area) = grow(target);
         let dense = bench_backend::<DenseLattice>(c, "dense", &voxels, area);
-        let _ = dense;
+        let octree = bench_backend::<DynamicOctree>(c, "octree", &voxels, area);
+        eprintln!(
+            "rsmc area {target}: octree/dense speed ratio {:.2}",
+            octree / dense
+        );
     }
 }
 

@@ -11,11 +11,11 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod dynamic;
 pub mod io;
 pub mod linear;
-pub mod dynamic;
-pub mod rsmc;
 pub mod motion;
+pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];

@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::{Deserialize, Serialize};
+use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -37,7 +38,7 @@ pub struct Args {
     #[arg(long)]
     libes: bool,
     /// Lattice implementation.
-    #[arg(long, value_enum, default_value_t = Backend::Dense)]
+    #[arg(long, value_enum, default_value_t = Backend::Octree)]
     backend: Backend,
     /// Folder for series.csv, area.png, the mesh and checkpoint.json.
     #[arg(long, default_value = "rsmc-out")]
@@ -67,7 +68,9 @@ pub struct Args {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 enum Backend {
-    /// Dense array that follows the surface (baseline).
+    /// The unbounded dynamic octree: O(|S|) memory.
+    Octree,
+    /// Dense array that follows the surface (baseline): O(box volume) memory.
     Dense,
 }
 
@@ -184,6 +187,7 @@ pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
     fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     match args.backend {
+        Backend::Octree => simulate::<DynamicOctree>(args),
         Backend::Dense => simulate::<DenseLattice>(args),
     }
 }
