@@ -310,11 +310,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         write_file(&cp_path, |w| w.write_all(&json))
     };
     let next_multiple = |s: u64, every: u64| {
-        if every == 0 {
-            u64::MAX
-        } else {
-            (s / every + 1) * every
-        }
+        s.checked_div(every)
+            .map_or(u64::MAX, |q| (q + 1).saturating_mul(every))
     };
     let t0 = Instant::now();
     while chain.steps() < args.steps {

@@ -286,9 +286,9 @@ mod tests {
         // corner neighbours: 128 cases, exhaustive.
         for f in 0..64u32 {
             let mut x = 0;
-            for d in 0..6 {
+            for (d, bit) in FACE_BITS.iter().enumerate() {
                 if f & (1 << d) != 0 {
-                    x |= 1 << FACE_BITS[d];
+                    x |= 1 << bit;
                 }
             }
             assert_eq!(legal_join(x), brute_is_disc(x), "faces only {f:06b}");
@@ -309,9 +309,9 @@ mod tests {
         assert_eq!(others.len(), 20);
         for f in 0..64u32 {
             let mut x = 0;
-            for d in 0..6 {
+            for (d, bit) in FACE_BITS.iter().enumerate() {
                 if f & (1 << d) != 0 {
-                    x |= 1 << FACE_BITS[d];
+                    x |= 1 << bit;
                 }
             }
             for i in 0..=others.len() {
