@@ -215,6 +215,21 @@ fn bad_input_is_a_clear_error() {
         "checkpoint.json",
     );
     fails(&tesseral(&["rsmc", "--steps", "abc"], d), "--steps");
+    fails(
+        &tesseral(
+            &[
+                "rsmc",
+                "--steps",
+                "100000000000",
+                "--sample-every",
+                "1",
+                "--out",
+                "o",
+            ],
+            d,
+        ),
+        "--sample-every",
+    );
     // A damaged checkpoint.
     ok(&tesseral(&["rsmc", "--steps", "1000", "--out", "c"], d));
     std::fs::write(d.join("c/checkpoint.json"), "{\"chain\": 3}").unwrap();

@@ -101,6 +101,8 @@ struct Row {
 }
 
 const MAX_BOX_SIDE: u64 = 1000;
+/// The series is kept in memory (it is rewritten at each checkpoint and plotted).
+const MAX_ROWS: u64 = 10_000_000;
 const MAX_START_VOXELS: u64 = 10_000_000;
 
 fn parse_start(s: &str) -> Result<Vec<Voxel>> {
@@ -185,6 +187,12 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
+    ensure!(
+        args.steps / args.sample_every <= MAX_ROWS,
+        "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
+        args.steps,
+        args.sample_every
+    );
     fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     match args.backend {
         Backend::Octree => simulate::<DynamicOctree>(args),

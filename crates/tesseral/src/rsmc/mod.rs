@@ -37,7 +37,7 @@ mod tests;
 pub mod topology;
 
 pub use chain::{Chain, Checkpoint, Counters, Params, CHECKPOINT_FORMAT};
-pub use dense::DenseLattice;
+pub use dense::{DenseLattice, MAX_CELLS};
 
 use crate::Voxel;
 
