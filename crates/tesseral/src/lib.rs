@@ -13,6 +13,7 @@
 pub mod code;
 pub mod io;
 pub mod linear;
+pub mod pointer;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
