@@ -16,6 +16,7 @@ pub mod io;
 pub mod linear;
 pub mod motion;
 pub mod rsmc;
+pub mod pointer;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
