@@ -11,6 +11,7 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod csg;
 pub mod io;
 pub mod linear;
 
