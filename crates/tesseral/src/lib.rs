@@ -14,6 +14,7 @@ pub mod code;
 pub mod csg;
 pub mod io;
 pub mod linear;
+pub mod render;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
