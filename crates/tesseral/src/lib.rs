@@ -14,6 +14,9 @@ pub mod code;
 pub mod csg;
 pub mod io;
 pub mod linear;
+pub mod dynamic;
+pub mod rsmc;
+pub mod motion;
 pub mod render;
 
 /// A voxel (or any lattice point) in world coordinates.
