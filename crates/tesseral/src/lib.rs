@@ -12,11 +12,13 @@
 
 pub mod code;
 pub mod dynamic;
+pub mod csg;
 pub mod io;
 pub mod linear;
 pub mod motion;
 pub mod rsmc;
 pub mod pointer;
+pub mod render;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];
