@@ -25,6 +25,8 @@ enum Command {
     Tables(cmd::tables::Args),
     /// Monte Carlo of self-avoiding random surfaces (Libes §6).
     Rsmc(cmd::rsmc::Args),
+    /// Converts between file formats, chosen by extension.
+    Convert(cmd::convert::Args),
 }
 
 fn main() -> ExitCode {
@@ -34,6 +36,7 @@ fn main() -> ExitCode {
         Command::Replay(args) => cmd::replay::run(args),
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -2,5 +2,6 @@
 
 pub mod calc;
 pub mod replay;
+pub mod convert;
 pub mod rsmc;
 pub mod tables;
