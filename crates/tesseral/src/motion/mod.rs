@@ -18,15 +18,17 @@
 
 mod interfere;
 mod orient;
+mod plan;
 mod sweep;
 mod traverse;
 mod world;
 mod world_file;
 
 pub use interfere::{
-    clearance, clearance_squared, interference, interference_placed, intersects,
+    clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
+pub use plan::{config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions};
 pub use orient::{Rotation, RotationError};
 pub use world::{Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World};
 pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
