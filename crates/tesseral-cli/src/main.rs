@@ -19,12 +19,18 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// The papers' digit tables, computed; misprints marked and footnoted.
+    Tables(cmd::tables::Args),
+    /// Monte Carlo of self-avoiding random surfaces (Libes §6).
+    Rsmc(cmd::rsmc::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Tables(args) => cmd::tables::run(args),
+        Command::Rsmc(args) => cmd::rsmc::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -13,6 +13,8 @@
 pub mod code;
 pub mod io;
 pub mod linear;
+pub mod dynamic;
+pub mod rsmc;
 pub mod motion;
 
 /// A voxel (or any lattice point) in world coordinates.

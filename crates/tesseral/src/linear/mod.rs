@@ -6,11 +6,19 @@
 //! canonical form: sorted, disjoint, and with no eight black siblings left unmerged.
 //! Two equal solids in the same space therefore have equal leaf lists.
 
+pub(crate) mod arith;
 mod build;
+mod grow;
 mod leaf;
+mod ops;
+mod resample;
+mod sort;
+mod transform;
 
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
+pub use ops::SetOp;
+pub use transform::{rotation_labels, Axis};
 
 use crate::code;
 use crate::Voxel;
@@ -28,6 +36,19 @@ pub enum OctreeError {
     /// A voxel lies outside the space `[origin, origin + 2^depth)`.
     #[error("voxel ({}, {}, {}) lies outside the octree's space", .0[0], .0[1], .0[2])]
     OutOfBounds(Voxel),
+    /// A coordinate or origin left the range of `i64`.
+    #[error("a coordinate overflows the 64-bit integer range")]
+    Overflow,
+    /// A dense bit array is shorter than its dimensions say.
+    #[error("a dense array of {dims:?} voxels needs {needed} words of 64 bits, got {got}")]
+    DenseTooShort {
+        /// The array's dimensions, x fastest.
+        dims: [u32; 3],
+        /// The number of `u64` words needed.
+        needed: usize,
+        /// The number of words given.
+        got: usize,
+    },
 }
 
 /// A solid as a sorted list of maximal black blocks (a linear octree).
@@ -106,7 +127,7 @@ impl LinearOctree {
     /// allowed.
     ///
     /// # Runtime
-    /// O(n log n) for n voxels.
+    /// O(n) for n voxels: the codes are radix-sorted (a few 8-bit passes).
     ///
     /// # Errors
     /// [`OctreeError::OutOfBounds`] for a voxel outside the space;
@@ -126,7 +147,7 @@ impl LinearOctree {
             .into_iter()
             .map(|v| space.code_of(v).ok_or(OctreeError::OutOfBounds(v)))
             .collect::<Result<Vec<u64>, _>>()?;
-        codes.sort_unstable();
+        sort::sort_u64(&mut codes);
         codes.dedup();
         Self::from_sorted_leaves(depth, origin, codes.into_iter().map(|c| Leaf::new(c, 0)))
     }
@@ -359,3 +380,5 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_ops;

@@ -1,0 +1,84 @@
+//! Least-significant-digit radix sort of 64-bit keys (voxel codes, packed leaves).
+//!
+//! Passes of 8 bits run only up to the highest key bit in use, and a pass whose
+//! digit is the same for every key is skipped, so sorting the codes of a depth-8
+//! tree takes at most three passes.
+
+use super::Leaf;
+
+/// Below this many keys the standard library's sort is faster.
+const RADIX_MIN_LEN: usize = 256;
+
+/// Sorts `keys` in place, ascending.
+///
+/// # Runtime
+/// O(n · b / 8) for keys of at most b significant bits.
+pub(crate) fn sort_u64(keys: &mut Vec<u64>) {
+    if keys.len() < RADIX_MIN_LEN {
+        keys.sort_unstable();
+        return;
+    }
+    let all = keys.iter().fold(0u64, |acc, &k| acc | k);
+    let bits = 64 - all.leading_zeros();
+    let mut buf = vec![0u64; keys.len()];
+    let mut shift = 0;
+    while shift < bits {
+        let mut count = [0usize; 256];
+        for &k in keys.iter() {
+            count[((k >> shift) & 0xff) as usize] += 1;
+        }
+        if count.iter().any(|&c| c == keys.len()) {
+            shift += 8;
+            continue;
+        }
+        let mut sum = 0;
+        for c in &mut count {
+            let n = *c;
+            *c = sum;
+            sum += n;
+        }
+        for &k in keys.iter() {
+            let d = ((k >> shift) & 0xff) as usize;
+            buf[count[d]] = k;
+            count[d] += 1;
+        }
+        std::mem::swap(keys, &mut buf);
+        shift += 8;
+    }
+}
+
+/// Sorts leaves into tesseral order (packed leaves sort as their codes do).
+pub(crate) fn sort_leaves(leaves: &mut Vec<Leaf>) {
+    let mut keys: Vec<u64> = leaves.iter().map(|l| l.packed()).collect();
+    sort_u64(&mut keys);
+    leaves.clear();
+    leaves.extend(keys.into_iter().map(Leaf::from_packed));
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn radix_sort_matches_std_sort() {
+        for (seed, n, mask) in [
+            (1u64, 10_000, u64::MAX),
+            (7, 5000, 0xffff_ff00),
+            (3, 300, 0x3f),
+        ] {
+            let mut s = seed;
+            let mut v: Vec<u64> = (0..n)
+                .map(|_| {
+                    s ^= s << 13;
+                    s ^= s >> 7;
+                    s ^= s << 17;
+                    s & mask
+                })
+                .collect();
+            let mut want = v.clone();
+            want.sort_unstable();
+            sort_u64(&mut v);
+            assert_eq!(v, want, "seed {seed}");
+        }
+    }
+}
