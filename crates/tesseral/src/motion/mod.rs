@@ -18,6 +18,7 @@
 
 mod interfere;
 mod orient;
+mod picture;
 mod plan;
 mod sweep;
 mod traverse;
@@ -29,6 +30,7 @@ pub use interfere::{
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
 pub use plan::{config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions};
+pub use picture::{Rgb, TopView};
 pub use orient::{Rotation, RotationError};
 pub use world::{Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World};
 pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
