@@ -23,6 +23,12 @@ enum Command {
     Tables(cmd::tables::Args),
     /// Monte Carlo of self-avoiding random surfaces (Libes §6).
     Rsmc(cmd::rsmc::Args),
+    /// Interference of two octrees: overlap, overlap volume, clearance.
+    Collide(cmd::collide::Args),
+    /// Run a world of moving objects; report every contact, with exact times.
+    Simulate(cmd::simulate::Args),
+    /// A collision-free path for an object through an environment.
+    Plan(cmd::plan::Args),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +37,9 @@ fn main() -> ExitCode {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
+        Command::Collide(args) => cmd::collide::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Plan(args) => cmd::plan::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

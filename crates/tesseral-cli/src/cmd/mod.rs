@@ -3,3 +3,6 @@
 pub mod calc;
 pub mod tables;
 pub mod rsmc;
+pub mod collide;
+pub mod simulate;
+pub mod plan;

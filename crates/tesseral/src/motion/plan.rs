@@ -223,9 +223,13 @@ pub fn config_obstacles(
 pub struct PlanOptions {
     /// The object's fixed orientation.
     pub rotation: Rotation,
-    /// The offsets the object may take, inclusive. `None`: every offset that keeps
-    /// the object's voxels inside the environment's space.
-    pub bounds: Option<Aabb>,
+    /// The box of world voxels the object must stay inside. `None`: the bounding box
+    /// of the environment and of the object at the start and at the goal, grown by
+    /// [`PlanOptions::margin`] on every side.
+    pub region: Option<Aabb>,
+    /// How far the default region reaches beyond the bounding box, in voxels (room
+    /// to go around the outside of the obstacles).
+    pub margin: i64,
     /// Join waypoints by straight collision-free segments.
     pub smooth: bool,
     /// Give up after settling this many search states.
@@ -236,7 +240,8 @@ impl Default for PlanOptions {
     fn default() -> Self {
         PlanOptions {
             rotation: Rotation::IDENTITY,
-            bounds: None,
+            region: None,
+            margin: 0,
             smooth: true,
             max_states: 4_000_000,
         }
@@ -250,11 +255,11 @@ pub enum NoPath {
     /// The object has no voxels.
     #[error("no path: the object is empty")]
     EmptyObject,
-    /// The object does not fit inside the bounds at any offset.
-    #[error("no path: the object does not fit in the space of the environment")]
+    /// The object does not fit inside the region at any offset.
+    #[error("no path: the object does not fit in the region")]
     ObjectTooLarge,
     /// The start offset leaves the bounds.
-    #[error("no path: the start ({}, {}, {}) puts the object outside the space ({}..={}, {}..={}, {}..={} allowed)", .start[0], .start[1], .start[2], .bounds.min[0], .bounds.max[0], .bounds.min[1], .bounds.max[1], .bounds.min[2], .bounds.max[2])]
+    #[error("no path: the start ({}, {}, {}) puts the object outside the region (offsets {}..={}, {}..={}, {}..={} allowed)", .start[0], .start[1], .start[2], .bounds.min[0], .bounds.max[0], .bounds.min[1], .bounds.max[1], .bounds.min[2], .bounds.max[2])]
     StartOutOfBounds {
         /// The start.
         start: Voxel,
@@ -262,7 +267,7 @@ pub enum NoPath {
         bounds: Aabb,
     },
     /// The goal offset leaves the bounds.
-    #[error("no path: the goal ({}, {}, {}) puts the object outside the space ({}..={}, {}..={}, {}..={} allowed)", .goal[0], .goal[1], .goal[2], .bounds.min[0], .bounds.max[0], .bounds.min[1], .bounds.max[1], .bounds.min[2], .bounds.max[2])]
+    #[error("no path: the goal ({}, {}, {}) puts the object outside the region (offsets {}..={}, {}..={}, {}..={} allowed)", .goal[0], .goal[1], .goal[2], .bounds.min[0], .bounds.max[0], .bounds.min[1], .bounds.max[1], .bounds.min[2], .bounds.max[2])]
     GoalOutOfBounds {
         /// The goal.
         goal: Voxel,
@@ -451,7 +456,7 @@ fn l1(a: Voxel, b: Voxel) -> u64 {
 /// ```
 /// use tesseral::linear::LinearOctree;
 /// use tesseral::motion::{plan, PlanOptions};
-/// // A wall at x = 4 with a hole at (y, z) = (5, 5), in a 8x8x8 room.
+/// // A wall at x = 4 with a hole at (y, z) = (5, 5); the region is x, y, z in 0..8.
 /// let wall: Vec<[i64; 3]> = (0..64).filter(|i| *i != 5 * 8 + 5).map(|i| [4, i / 8, i % 8]).collect();
 /// let env = LinearOctree::from_voxels(3, [0, 0, 0], wall).unwrap();
 /// let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
@@ -467,16 +472,27 @@ pub fn plan(
 ) -> Result<Plan, NoPath> {
     let rotation = options.rotation;
     let obj_box = rotated(object, rotation).bbox().ok_or(NoPath::EmptyObject)?;
-    let bounds = match options.bounds {
-        Some(b) => b,
+    let region = match options.region {
+        Some(r) => r,
         None => {
-            let lo = environment.origin();
-            let hi = lo.map(|c| c + environment.side() as i64 - 1);
+            let (mut lo, mut hi) = environment.bbox().unwrap_or((from, from));
+            for p in [from, to] {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a].saturating_add(obj_box.0[a]));
+                    hi[a] = hi[a].max(p[a].saturating_add(obj_box.1[a]));
+                }
+            }
+            let m = options.margin.max(0);
             Aabb {
-                min: [0, 1, 2].map(|a| lo[a] - obj_box.0[a]),
-                max: [0, 1, 2].map(|a| hi[a] - obj_box.1[a]),
+                min: lo.map(|c| c.saturating_sub(m)),
+                max: hi.map(|c| c.saturating_add(m)),
             }
         }
+    };
+    // The offsets that keep the object's voxels inside the region.
+    let bounds = Aabb {
+        min: [0, 1, 2].map(|a| region.min[a].saturating_sub(obj_box.0[a])),
+        max: [0, 1, 2].map(|a| region.max[a].saturating_sub(obj_box.1[a])),
     };
     if (0..3).any(|a| bounds.max[a] < bounds.min[a]) {
         return Err(NoPath::ObjectTooLarge);

@@ -601,7 +601,11 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
         };
         let pick = |rng: &mut Pcg64| [0, 1, 2].map(|a| rng.random_range(bounds.0[a]..=bounds.1[a]));
         let (from, to) = (pick(&mut rng), pick(&mut rng));
-        let options = PlanOptions { rotation: r, ..PlanOptions::default() };
+        let options = PlanOptions {
+            rotation: r,
+            region: Some(Aabb { min: [0; 3], max: [side - 1; 3] }),
+            ..PlanOptions::default()
+        };
         let got = plan(&env, &obj, from, to, &options);
         match (free(from), free(to)) {
             (false, _) => {
@@ -649,7 +653,10 @@ fn no_path_says_why() {
     }
     let env = LinearOctree::from_voxels(4, [0, 0, 0], walls).unwrap();
     let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
-    let o = PlanOptions::default();
+    let o = PlanOptions {
+        region: Some(Aabb { min: [0; 3], max: [15; 3] }),
+        ..PlanOptions::default()
+    };
     let e = plan(&env, &dot, [3, 3, 3], [12, 12, 12], &o).unwrap_err();
     assert!(matches!(e, NoPath::Unreachable { cells: _, positions: 216 }), "{e:?}");
     assert!(e.to_string().starts_with("no path"));
@@ -662,6 +669,15 @@ fn no_path_says_why() {
     let empty = LinearOctree::empty(1, [0, 0, 0]).unwrap();
     assert!(matches!(plan(&env, &empty, [0; 3], [0; 3], &o), Err(NoPath::EmptyObject)));
     // Inside the box a path exists, and start = goal is the empty move.
+    // The default region is the bounding box: going around the outside needs a margin.
+    let d = PlanOptions::default();
+    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
+    let around = PlanOptions { margin: 1, ..PlanOptions::default() };
+    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &around), Err(NoPath::Unreachable { .. })));
+    assert!(matches!(plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
+    let p = plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &around).unwrap();
+    assert_eq!(p.steps, 10 + 2 * 4); // around the side: y from 3 to -1 and back
+    assert_eq!(p.clearance, Some(0.0));
     let p = plan(&env, &dot, [1, 1, 1], [6, 6, 6], &o).unwrap();
     assert_eq!(p.steps, 15);
     assert_eq!(p.waypoints, vec![[1, 1, 1], [6, 6, 6]]);
