@@ -27,6 +27,12 @@ enum Command {
     Rsmc(cmd::rsmc::Args),
     /// Converts between file formats, chosen by extension.
     Convert(cmd::convert::Args),
+    /// Interference of two octrees: overlap, overlap volume, clearance.
+    Collide(cmd::collide::Args),
+    /// Run a world of moving objects; report every contact, with exact times.
+    Simulate(cmd::simulate::Args),
+    /// A collision-free path for an object through an environment.
+    Plan(cmd::plan::Args),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +43,9 @@ fn main() -> ExitCode {
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
         Command::Convert(args) => cmd::convert::run(args),
+        Command::Collide(args) => cmd::collide::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Plan(args) => cmd::plan::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

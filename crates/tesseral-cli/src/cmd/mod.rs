@@ -5,3 +5,6 @@ pub mod replay;
 pub mod convert;
 pub mod rsmc;
 pub mod tables;
+pub mod collide;
+pub mod simulate;
+pub mod plan;

@@ -18,6 +18,8 @@
 
 mod interfere;
 mod orient;
+mod picture;
+mod plan;
 mod sweep;
 mod traverse;
 mod world;
@@ -26,7 +28,11 @@ mod world_file;
 pub use interfere::{
     clearance, clearance_squared, interference, interference_placed, intersects, intersects_placed,
     Aabb, Interference, Placed, Placement,
+    clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
+    intersects_placed, Aabb, Interference, Placed, Placement,
 };
+pub use plan::{config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions};
+pub use picture::{Rgb, TopView};
 pub use orient::{Rotation, RotationError};
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
 pub use world::{

@@ -158,9 +158,10 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
     }
     let method = match spec.translation.as_deref() {
         None | Some("offset") => TranslationMethod::Offset,
+        Some("linear") => TranslationMethod::Linear,
         Some(other) => {
             return Err(invalid(format!(
-                "translation {other:?} is not known (known: \"offset\")"
+                "translation {other:?} is not known (known: \"offset\", \"linear\")"
             )))
         }
     };

@@ -1,0 +1,190 @@
+//! `tesseral plan`: a collision-free path for an object through an environment.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use tesseral::motion::{plan, Aabb, Placed, Placement, PlanOptions, Rotation, TopView};
+use tesseral::Voxel;
+
+use super::collide::parse_voxel;
+
+/// Arguments of `tesseral plan`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The environment octree file (the obstacles).
+    env: PathBuf,
+    /// The moving object's octree file.
+    obj: PathBuf,
+    /// The start: the integer offset X,Y,Z of the object.
+    #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true)]
+    from: Voxel,
+    /// The goal offset X,Y,Z.
+    #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true)]
+    to: Voxel,
+    /// The object's fixed rotation, such as `z90` (see `tesseral collide --rotate`).
+    #[arg(long, default_value = "", allow_hyphen_values = true)]
+    rotate: Rotation,
+    /// Let the region reach this many voxels beyond the bounding box of the
+    /// environment and the object at both ends (room to go around the outside).
+    #[arg(long, default_value_t = 0)]
+    margin: u32,
+    /// The box of world voxels X0,Y0,Z0,X1,Y1,Z1 (inclusive) the object must stay
+    /// in; replaces the bounding box and --margin.
+    #[arg(long, value_parser = parse_region, allow_hyphen_values = true)]
+    region: Option<Aabb>,
+    /// Keep the raw A* path (no smoothing).
+    #[arg(long)]
+    no_smooth: bool,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Write a top-down PNG picture of the path through the scene.
+    #[arg(short = 'o', long = "output", value_name = "PATH.png")]
+    output: Option<PathBuf>,
+}
+
+fn parse_region(s: &str) -> Result<Aabb, String> {
+    let v: Vec<i64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<i64>().map_err(|_| format!("{p:?} in {s:?} is not an integer")))
+        .collect::<Result<_, _>>()?;
+    if v.len() != 6 {
+        return Err(format!("expected X0,Y0,Z0,X1,Y1,Z1 (six integers), got {s:?}"));
+    }
+    let (min, max) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+    if (0..3).any(|a| max[a] < min[a]) {
+        return Err(format!("the region {s:?} is empty: each of X1,Y1,Z1 must be at least X0,Y0,Z0"));
+    }
+    Ok(Aabb { min, max })
+}
+
+#[derive(Serialize)]
+struct Found<'a> {
+    found: bool,
+    waypoints: &'a [Voxel],
+    raw: &'a [Voxel],
+    steps: u64,
+    length: f64,
+    clearance: Option<f64>,
+    free_cells: usize,
+    settled: usize,
+}
+
+#[derive(Serialize)]
+struct NotFound {
+    found: bool,
+    reason: String,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let env = tesseral::io::read_octree(&args.env).context("reading the environment")?;
+    let obj = tesseral::io::read_octree(&args.obj).context("reading the object")?;
+    let options = PlanOptions {
+        rotation: args.rotate,
+        smooth: !args.no_smooth,
+        margin: i64::from(args.margin),
+        region: args.region,
+        ..PlanOptions::default()
+    };
+    let result = plan(&env, &obj, args.from, args.to, &options);
+    if let Some(path) = &args.output {
+        picture(path, &env, &obj, &args, result.as_ref().ok().map(|p| p.waypoints.as_slice()))?;
+    }
+    let mut out = std::io::stdout().lock();
+    match result {
+        Ok(p) => {
+            if args.json {
+                let f = Found {
+                    found: true,
+                    waypoints: &p.waypoints,
+                    raw: &p.raw,
+                    steps: p.steps,
+                    length: p.length,
+                    clearance: p.clearance,
+                    free_cells: p.free_cells,
+                    settled: p.settled,
+                };
+                serde_json::to_writer(&mut out, &f)?;
+                writeln!(out)?;
+            } else {
+                writeln!(
+                    out,
+                    "path: {} waypoints, length {:.3} voxels ({} unit moves before smoothing)",
+                    p.waypoints.len(),
+                    p.length,
+                    p.steps
+                )?;
+                match p.clearance {
+                    Some(c) => writeln!(out, "clearance: {c:.3}")?,
+                    None => writeln!(out, "clearance: unbounded (empty environment)")?,
+                }
+                for w in &p.waypoints {
+                    writeln!(out, "{},{},{}", w[0], w[1], w[2])?;
+                }
+            }
+            Ok(())
+        }
+        Err(why) => {
+            if args.json {
+                serde_json::to_writer(
+                    &mut out,
+                    &NotFound {
+                        found: false,
+                        reason: why.to_string(),
+                    },
+                )?;
+                writeln!(out)?;
+            } else {
+                writeln!(out, "{why}")?;
+            }
+            out.flush()?;
+            // No path is an answer, not a failure of the command: exit status 1.
+            std::process::exit(1);
+        }
+    }
+}
+
+fn picture(
+    path: &std::path::Path,
+    env: &tesseral::linear::LinearOctree,
+    obj: &tesseral::linear::LinearOctree,
+    args: &Args,
+    waypoints: Option<&[Voxel]>,
+) -> Result<()> {
+    let turned = tesseral::motion::rotated(obj, args.rotate);
+    let (olo, ohi) = turned.bbox().unwrap_or(([0; 3], [0; 3]));
+    let (mut lo, mut hi) = env.bbox().unwrap_or((args.from, args.from));
+    for p in [args.from, args.to] {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a] + olo[a]);
+            hi[a] = hi[a].max(p[a] + ohi[a]);
+        }
+    }
+    let mut view = TopView::new(Aabb { min: lo, max: hi });
+    view.draw_tree(Placed::fixed(env), [150, 150, 150]);
+    for (p, color) in [(args.from, [30, 170, 80]), (args.to, [40, 110, 230])] {
+        view.draw_tree(
+            Placed::new(
+                obj,
+                Placement {
+                    rotation: args.rotate,
+                    offset: p,
+                },
+            ),
+            color,
+        );
+    }
+    if let Some(w) = waypoints {
+        // Through the centre of the object's box.
+        let c = [0, 1, 2].map(|a| (olo[a] + ohi[a] + 1) as f64 / 2.0);
+        let pts: Vec<[f64; 3]> = w
+            .iter()
+            .map(|p| [0, 1, 2].map(|a| p[a] as f64 + c[a]))
+            .collect();
+        view.draw_polyline(&pts, [240, 200, 0]);
+    }
+    view.write_png(path)
+        .with_context(|| format!("writing {}", path.display()))
+}
