@@ -11,14 +11,14 @@
 #![deny(missing_docs)]
 
 pub mod code;
-pub mod dynamic;
 pub mod csg;
+pub mod dynamic;
 pub mod io;
 pub mod linear;
 pub mod motion;
-pub mod rsmc;
 pub mod pointer;
 pub mod render;
+pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];

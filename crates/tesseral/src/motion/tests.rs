@@ -330,7 +330,16 @@ fn assert_same_run(x: &Simulation, y: &Simulation, seed: u64) {
     let key = |s: &Simulation| -> Vec<_> {
         s.contacts
             .iter()
-            .map(|c| (c.step, c.fraction, c.a.clone(), c.b.clone(), c.between_steps, c.time.to_bits()))
+            .map(|c| {
+                (
+                    c.step,
+                    c.fraction,
+                    c.a.clone(),
+                    c.b.clone(),
+                    c.between_steps,
+                    c.time.to_bits(),
+                )
+            })
             .collect()
     };
     assert_eq!(key(x), key(y), "seed {seed}");
@@ -349,8 +358,16 @@ fn assert_same_run(x: &Simulation, y: &Simulation, seed: u64) {
         out
     };
     for (f, g) in x.frames.iter().zip(&y.frames) {
-        assert_eq!((f.step, &f.offsets, &f.overlaps), (g.step, &g.offsets, &g.overlaps), "seed {seed}");
-        assert_eq!(voxels(&f.contact_boxes), voxels(&g.contact_boxes), "seed {seed}");
+        assert_eq!(
+            (f.step, &f.offsets, &f.overlaps),
+            (g.step, &g.offsets, &g.overlaps),
+            "seed {seed}"
+        );
+        assert_eq!(
+            voxels(&f.contact_boxes),
+            voxels(&g.contact_boxes),
+            "seed {seed}"
+        );
     }
 }
 
@@ -500,7 +517,10 @@ fn minkowski_sum_matches_brute_force() {
         sum.assert_valid();
         let brute: HashSet<Voxel> = va
             .iter()
-            .flat_map(|p| vb.iter().map(move |q| [p[0] + q[0], p[1] + q[1], p[2] + q[2]]))
+            .flat_map(|p| {
+                vb.iter()
+                    .map(move |q| [p[0] + q[0], p[1] + q[1], p[2] + q[2]])
+            })
             .collect();
         let got: HashSet<Voxel> = sum.voxels().collect();
         assert_eq!(got, brute, "seed {seed}");
@@ -511,7 +531,11 @@ fn minkowski_sum_matches_brute_force() {
 fn rotated_and_reflected_trees_match_their_voxels() {
     for seed in 0..100u64 {
         let mut rng = seeded("rotated_and_reflected_trees_match_their_voxels", seed);
-        let o = [rng.random_range(-9..9), rng.random_range(-9..9), rng.random_range(-9..9)];
+        let o = [
+            rng.random_range(-9..9),
+            rng.random_range(-9..9),
+            rng.random_range(-9..9),
+        ];
         let (t, vs) = random_solid(&mut rng, 3, o);
         let r = Rotation::all()[rng.random_range(0..24)];
         let rt = rotated(&t, r);
@@ -539,9 +563,16 @@ fn config_obstacles_match_brute_force_interference() {
         for x in -12..12 {
             for y in -12..12 {
                 for z in -12..12 {
-                    let place = Placement { rotation: r, offset: [x, y, z] };
+                    let place = Placement {
+                        rotation: r,
+                        offset: [x, y, z],
+                    };
                     let brute = vobj.iter().any(|&v| senv.contains(&place.apply_voxel(v)));
-                    assert_eq!(cobs.contains([x, y, z]), brute, "seed {seed} at {x},{y},{z}");
+                    assert_eq!(
+                        cobs.contains([x, y, z]),
+                        brute,
+                        "seed {seed} at {x},{y},{z}"
+                    );
                 }
             }
         }
@@ -550,9 +581,19 @@ fn config_obstacles_match_brute_force_interference() {
 
 /// Every lattice position of the raw path, step by step, is free and in bounds; every
 /// smoothed segment is free by the brute-force swept test and by sampling.
-fn check_path(plan: &Plan, venv: &HashSet<Voxel>, vobj: &[Voxel], r: Rotation, bounds: (Voxel, Voxel), seed: u64) {
+fn check_path(
+    plan: &Plan,
+    venv: &HashSet<Voxel>,
+    vobj: &[Voxel],
+    r: Rotation,
+    bounds: (Voxel, Voxel),
+    seed: u64,
+) {
     let free = |p: Voxel| {
-        let place = Placement { rotation: r, offset: p };
+        let place = Placement {
+            rotation: r,
+            offset: p,
+        };
         (0..3).all(|a| bounds.0[a] <= p[a] && p[a] <= bounds.1[a])
             && vobj.iter().all(|&v| !venv.contains(&place.apply_voxel(v)))
     };
@@ -572,19 +613,27 @@ fn check_path(plan: &Plan, venv: &HashSet<Voxel>, vobj: &[Voxel], r: Rotation, b
     assert_eq!(steps, plan.steps, "seed {seed}: raw length");
     let venv_list: Vec<Voxel> = venv.iter().copied().collect();
     let moved = |p: Voxel| -> Vec<Voxel> {
-        let place = Placement { rotation: r, offset: p };
+        let place = Placement {
+            rotation: r,
+            offset: p,
+        };
         vobj.iter().map(|&v| place.apply_voxel(v)).collect()
     };
     for w in plan.waypoints.windows(2) {
         assert!(free(w[0]) && free(w[1]), "seed {seed}");
         let mv = [0, 1, 2].map(|a| w[1][a] - w[0][a]);
-        assert_eq!(first_contact_brute(&venv_list, &moved(w[0]), mv), None, "seed {seed}: segment {w:?}");
+        assert_eq!(
+            first_contact_brute(&venv_list, &moved(w[0]), mv),
+            None,
+            "seed {seed}: segment {w:?}"
+        );
         let start = moved(w[0]);
         for k in 0..=40 {
             let t = f64::from(k) / 40.0;
             let hit = start.iter().any(|q| {
-                venv.iter()
-                    .any(|e| (0..3).all(|a| (q[a] as f64 + t * mv[a] as f64 - e[a] as f64).abs() < 1.0))
+                venv.iter().any(|e| {
+                    (0..3).all(|a| (q[a] as f64 + t * mv[a] as f64 - e[a] as f64).abs() < 1.0)
+                })
             });
             assert!(!hit, "seed {seed}: segment {w:?} blocked at t = {t}");
         }
@@ -623,7 +672,10 @@ fn dense_shortest(free: &dyn Fn(Voxel) -> bool, from: Voxel, to: Voxel) -> Optio
 fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
     let mut outcomes = [0; 3];
     for seed in 0..120u64 {
-        let mut rng = seeded("plans_are_optimal_against_dense_dijkstra_and_collision_free", seed);
+        let mut rng = seeded(
+            "plans_are_optimal_against_dense_dijkstra_and_collision_free",
+            seed,
+        );
         // Walls with holes make mazes; plus random blocks.
         let side = 16i64;
         let mut env_set: HashSet<Voxel> = HashSet::new();
@@ -634,7 +686,8 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
             let hs = rng.random_range(0..=3);
             for u in 0..side {
                 for w in 0..side {
-                    if (hole[0]..hole[0] + hs).contains(&u) && (hole[1]..hole[1] + hs).contains(&w) {
+                    if (hole[0]..hole[0] + hs).contains(&u) && (hole[1]..hole[1] + hs).contains(&w)
+                    {
                         continue;
                     }
                     let mut v = [0; 3];
@@ -655,27 +708,44 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
         }
         let r = Rotation::all()[rng.random_range(0..24)];
         let obj_box = rotated(&obj, r).bbox().unwrap();
-        let bounds = ([0, 1, 2].map(|a| -obj_box.0[a]), [0, 1, 2].map(|a| side - 1 - obj_box.1[a]));
+        let bounds = (
+            [0, 1, 2].map(|a| -obj_box.0[a]),
+            [0, 1, 2].map(|a| side - 1 - obj_box.1[a]),
+        );
         let free = |p: Voxel| {
-            let place = Placement { rotation: r, offset: p };
+            let place = Placement {
+                rotation: r,
+                offset: p,
+            };
             (0..3).all(|a| bounds.0[a] <= p[a] && p[a] <= bounds.1[a])
-                && vobj.iter().all(|&v| !env_set.contains(&place.apply_voxel(v)))
+                && vobj
+                    .iter()
+                    .all(|&v| !env_set.contains(&place.apply_voxel(v)))
         };
         let pick = |rng: &mut Pcg64| [0, 1, 2].map(|a| rng.random_range(bounds.0[a]..=bounds.1[a]));
         let (from, to) = (pick(&mut rng), pick(&mut rng));
         let options = PlanOptions {
             rotation: r,
-            region: Some(Aabb { min: [0; 3], max: [side - 1; 3] }),
+            region: Some(Aabb {
+                min: [0; 3],
+                max: [side - 1; 3],
+            }),
             ..PlanOptions::default()
         };
         let got = plan(&env, &obj, from, to, &options);
         match (free(from), free(to)) {
             (false, _) => {
-                assert!(matches!(got, Err(NoPath::StartBlocked { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::StartBlocked { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 continue;
             }
             (true, false) => {
-                assert!(matches!(got, Err(NoPath::GoalBlocked { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::GoalBlocked { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 continue;
             }
             _ => {}
@@ -691,13 +761,19 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
                 }
             }
             None => {
-                assert!(matches!(got, Err(NoPath::Unreachable { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::Unreachable { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 outcomes[1] += 1;
             }
         }
     }
     // Found paths, enclosed goals and actual smoothing all occur.
-    assert!(outcomes[0] > 30 && outcomes[1] > 3 && outcomes[2] > 10, "{outcomes:?}");
+    assert!(
+        outcomes[0] > 30 && outcomes[1] > 3 && outcomes[2] > 10,
+        "{outcomes:?}"
+    );
 }
 
 #[test]
@@ -716,27 +792,69 @@ fn no_path_says_why() {
     let env = LinearOctree::from_voxels(4, [0, 0, 0], walls).unwrap();
     let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
     let o = PlanOptions {
-        region: Some(Aabb { min: [0; 3], max: [15; 3] }),
+        region: Some(Aabb {
+            min: [0; 3],
+            max: [15; 3],
+        }),
         ..PlanOptions::default()
     };
     let e = plan(&env, &dot, [3, 3, 3], [12, 12, 12], &o).unwrap_err();
-    assert!(matches!(e, NoPath::Unreachable { cells: _, positions: 216 }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            NoPath::Unreachable {
+                cells: _,
+                positions: 216
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().starts_with("no path"));
-    assert!(matches!(plan(&env, &dot, [0, 3, 3], [4, 4, 4], &o), Err(NoPath::StartBlocked { overlap_voxels: 1 })));
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [7, 4, 4], &o), Err(NoPath::GoalBlocked { .. })));
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [16, 4, 4], &o), Err(NoPath::GoalOutOfBounds { .. })));
-    assert!(matches!(plan(&env, &dot, [-1, 3, 3], [4, 4, 4], &o), Err(NoPath::StartOutOfBounds { .. })));
+    assert!(matches!(
+        plan(&env, &dot, [0, 3, 3], [4, 4, 4], &o),
+        Err(NoPath::StartBlocked { overlap_voxels: 1 })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [7, 4, 4], &o),
+        Err(NoPath::GoalBlocked { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [16, 4, 4], &o),
+        Err(NoPath::GoalOutOfBounds { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [-1, 3, 3], [4, 4, 4], &o),
+        Err(NoPath::StartOutOfBounds { .. })
+    ));
     let big = LinearOctree::full(5, [0, 0, 0]).unwrap();
-    assert!(matches!(plan(&env, &big, [0; 3], [0; 3], &o), Err(NoPath::ObjectTooLarge)));
+    assert!(matches!(
+        plan(&env, &big, [0; 3], [0; 3], &o),
+        Err(NoPath::ObjectTooLarge)
+    ));
     let empty = LinearOctree::empty(1, [0, 0, 0]).unwrap();
-    assert!(matches!(plan(&env, &empty, [0; 3], [0; 3], &o), Err(NoPath::EmptyObject)));
+    assert!(matches!(
+        plan(&env, &empty, [0; 3], [0; 3], &o),
+        Err(NoPath::EmptyObject)
+    ));
     // Inside the box a path exists, and start = goal is the empty move.
     // The default region is the bounding box: going around the outside needs a margin.
     let d = PlanOptions::default();
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
-    let around = PlanOptions { margin: 1, ..PlanOptions::default() };
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &around), Err(NoPath::Unreachable { .. })));
-    assert!(matches!(plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [9, 3, 3], &d),
+        Err(NoPath::Unreachable { .. })
+    ));
+    let around = PlanOptions {
+        margin: 1,
+        ..PlanOptions::default()
+    };
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [9, 3, 3], &around),
+        Err(NoPath::Unreachable { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &d),
+        Err(NoPath::Unreachable { .. })
+    ));
     let p = plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &around).unwrap();
     assert_eq!(p.steps, 10 + 2 * 4); // around the side: y from 3 to -1 and back
     assert_eq!(p.clearance, Some(0.0));
