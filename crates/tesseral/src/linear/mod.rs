@@ -238,11 +238,18 @@ impl LinearOctree {
         let mut lo = [u64::MAX; 3];
         let mut hi = [0u64; 3];
         for l in &self.leaves {
-            let c = l.code();
-            let last = c | ((1u64 << (3 * u32::from(l.size_log2()))) - 1);
+            // First and last code of the leaf, straight off the packed form.
+            let p = l.packed();
+            let m = p ^ p.wrapping_add(1);
+            let (c, last) = ((p & !m) >> 1, (p | m) >> 1);
             for a in 0..3 {
-                lo[a] = lo[a].min((c >> a) & arith::MASK_X);
-                hi[a] = hi[a].max((last >> a) & arith::MASK_X);
+                let (l, h) = ((c >> a) & arith::MASK_X, (last >> a) & arith::MASK_X);
+                if l < lo[a] {
+                    lo[a] = l;
+                }
+                if h > hi[a] {
+                    hi[a] = h;
+                }
             }
         }
         let world = |d: u64, a: usize| self.origin[a] + i64::from(code::undilate3(d));

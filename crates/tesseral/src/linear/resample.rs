@@ -271,7 +271,10 @@ impl Resampler<'_> {
         debug_assert!(k > 0, "a voxel's window is always full or empty");
         if k == 2 {
             // The last two levels at once, on 64-bit occupancy masks.
-            let m = window.map(|s| self.index.mask(s));
+            let mut m = [0u64; 8];
+            for (mask, &slot) in m.iter_mut().zip(window.iter()) {
+                *mask = self.index.mask(slot);
+            }
             let block = extract(m, self.r2);
             if block == u64::MAX {
                 out.push(Leaf::new(code, 2));
@@ -294,12 +297,12 @@ impl Resampler<'_> {
         }
         let table = &self.tables[usize::from(k)];
         let child_cells = 1u64 << (3 * u32::from(k - 1));
-        let windows: [[u32; 8]; 8] = std::array::from_fn(|d| {
-            std::array::from_fn(|e| {
-                let (p, digit) = table[d][e];
-                self.index.child(window[usize::from(p)], usize::from(digit))
-            })
-        });
+        let mut windows = [[EMPTY; 8]; 8];
+        for (row, w) in table.iter().zip(windows.iter_mut()) {
+            for (&(p, digit), slot) in row.iter().zip(w.iter_mut()) {
+                *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+            }
+        }
         if k >= PARALLEL_MIN_SIZE_LOG2 {
             let parts: Vec<Vec<Leaf>> = (0..8usize)
                 .into_par_iter()
