@@ -19,12 +19,36 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// Converts an octree between file formats (chosen by extension).
+    Convert(cmd::convert::Args),
+    /// Prints what an octree file holds (--json for programs).
+    Info(cmd::info::Args),
+    /// Translates an octree by an integer vector.
+    Translate(cmd::transform::TranslateArgs),
+    /// Rotates an octree by quarter turns about an axis.
+    Rotate(cmd::transform::RotateArgs),
+    /// Mirrors an octree in an axis.
+    Mirror(cmd::transform::MirrorArgs),
+    /// Scales an octree by 2^K.
+    Scale(cmd::transform::ScaleArgs),
+    /// Set operations: union, intersection, difference, xor.
+    Op(cmd::op::Args),
+    /// The complement of an octree within its space.
+    Complement(cmd::transform::ComplementArgs),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
+        Command::Info(args) => cmd::info::run(args),
+        Command::Translate(args) => cmd::transform::translate(args),
+        Command::Rotate(args) => cmd::transform::rotate(args),
+        Command::Mirror(args) => cmd::transform::mirror(args),
+        Command::Scale(args) => cmd::transform::scale(args),
+        Command::Op(args) => cmd::op::run(args),
+        Command::Complement(args) => cmd::transform::complement(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
