@@ -8,6 +8,9 @@
 //! maximal run is exactly the canonical leaf list, so the output needs no second
 //! merging pass. Large inputs are split by octant and merged in parallel with rayon.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 
 use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};

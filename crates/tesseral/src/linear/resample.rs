@@ -20,6 +20,9 @@
 //! the displacement is aligned to every leaf the codes are moved directly by tesseral
 //! addition (Ahuja & Nash §3.1, Table 2 carries in parallel over all digits).
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 
 use super::{arith, grow, push_merging, Leaf, LinearOctree, OctreeError};

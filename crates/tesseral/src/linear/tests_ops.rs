@@ -1,5 +1,8 @@
 //! Set operations, translation, resampling and transforms against a `HashSet` model.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::HashSet;
 
 use proptest::prelude::*;
