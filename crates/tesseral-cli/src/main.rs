@@ -23,6 +23,10 @@ enum Command {
     Tables(cmd::tables::Args),
     /// Monte Carlo of self-avoiding random surfaces (Libes §6).
     Rsmc(cmd::rsmc::Args),
+    /// Draws a scene or an octree file as a PNG image.
+    Render(cmd::render::Args),
+    /// Builds a scene's octree and writes it to a file.
+    Build(cmd::build::Args),
 }
 
 fn main() -> ExitCode {
@@ -31,6 +35,8 @@ fn main() -> ExitCode {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Build(args) => cmd::build::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -24,13 +24,15 @@ mod world;
 mod world_file;
 
 pub use interfere::{
-    clearance, clearance_squared, interference, interference_placed, intersects,
-    intersects_placed, Aabb, Interference, Placed, Placement,
+    clearance, clearance_squared, interference, interference_placed, intersects, intersects_placed,
+    Aabb, Interference, Placed, Placement,
 };
 pub use orient::{Rotation, RotationError};
-pub use world::{Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World};
-pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
+pub use world::{
+    Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
+};
+pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 
 #[cfg(test)]
 mod tests;

@@ -10,7 +10,11 @@ use crate::linear::LinearOctree;
 use crate::Voxel;
 
 /// A random solid: a few boxes (so the octree has large blocks) plus loose voxels.
-pub(crate) fn random_solid(rng: &mut Pcg64, depth: u8, origin: Voxel) -> (LinearOctree, Vec<Voxel>) {
+pub(crate) fn random_solid(
+    rng: &mut Pcg64,
+    depth: u8,
+    origin: Voxel,
+) -> (LinearOctree, Vec<Voxel>) {
     let side = 1i64 << depth;
     let mut set = HashSet::new();
     for _ in 0..rng.random_range(0..=4) {
@@ -19,7 +23,11 @@ pub(crate) fn random_solid(rng: &mut Pcg64, depth: u8, origin: Voxel) -> (Linear
         for x in 0..ext[0] {
             for y in 0..ext[1] {
                 for z in 0..ext[2] {
-                    set.insert([origin[0] + lo[0] + x, origin[1] + lo[1] + y, origin[2] + lo[2] + z]);
+                    set.insert([
+                        origin[0] + lo[0] + x,
+                        origin[1] + lo[1] + y,
+                        origin[2] + lo[2] + z,
+                    ]);
                 }
             }
         }
@@ -47,7 +55,13 @@ fn unit_gap2(p: Voxel, q: Voxel) -> u128 {
 }
 
 /// An offset that puts the rotated `b` near `a` (within `jitter` voxels of centring).
-fn offset_near(rng: &mut Pcg64, va: &[Voxel], vb: &[Voxel], rotation: Rotation, jitter: i64) -> Voxel {
+fn offset_near(
+    rng: &mut Pcg64,
+    va: &[Voxel],
+    vb: &[Voxel],
+    rotation: Rotation,
+    jitter: i64,
+) -> Voxel {
     let centre = |vs: &mut dyn Iterator<Item = Voxel>| {
         let (mut sum, mut n) = ([0i64; 3], 0i64);
         for v in vs {
@@ -107,7 +121,9 @@ fn rotated_voxels_of_a_cube_fill_a_cube() {
             .map(|i| r.apply_voxel([i % n, i / n % n, i / n / n]))
             .collect();
         assert_eq!(img.len(), 27);
-        let lo = img.iter().fold([i64::MAX; 3], |m, v| [m[0].min(v[0]), m[1].min(v[1]), m[2].min(v[2])]);
+        let lo = img.iter().fold([i64::MAX; 3], |m, v| {
+            [m[0].min(v[0]), m[1].min(v[1]), m[2].min(v[2])]
+        });
         for v in &img {
             assert!((0..3).all(|a| v[a] - lo[a] < n));
         }
@@ -160,8 +176,16 @@ fn interference_matches_brute_force() {
             .iter()
             .flat_map(|&p| moved.iter().map(move |&q| unit_gap2(p, q)))
             .min();
-        assert_eq!(clearance_squared(Placed::fixed(&a), Placed::new(&b, place)), brute, "seed {seed}");
-        assert_eq!(clearance(&a, &b, place), brute.map(|d| (d as f64).sqrt()), "seed {seed}");
+        assert_eq!(
+            clearance_squared(Placed::fixed(&a), Placed::new(&b, place)),
+            brute,
+            "seed {seed}"
+        );
+        assert_eq!(
+            clearance(&a, &b, place),
+            brute.map(|d| (d as f64).sqrt()),
+            "seed {seed}"
+        );
         hits[usize::from(got.intersects)] += 1;
     }
     // Both outcomes are well represented, so the comparison is not vacuous.
@@ -180,7 +204,11 @@ fn first_contact_matches_brute_force_and_sampling() {
         let rotation = all[rng.random_range(0..24)];
         let near = offset_near(&mut rng, &va, &vb, rotation, 4);
         // Start away from `a` and move back through it (or near it).
-        let v = [rng.random_range(-20..20), rng.random_range(-20..20), rng.random_range(-3..3)];
+        let v = [
+            rng.random_range(-20..20),
+            rng.random_range(-20..20),
+            rng.random_range(-3..3),
+        ];
         let back = rng.random_range(0..=2);
         let offset = [0, 1, 2].map(|ax| near[ax] - v[ax] * back / 4);
         let place = Placement { rotation, offset };
@@ -192,9 +220,9 @@ fn first_contact_matches_brute_force_and_sampling() {
         // just after it.
         let overlap_at = |t: f64| {
             va.iter().any(|p| {
-                moved
-                    .iter()
-                    .any(|q| (0..3).all(|ax| (q[ax] as f64 + t * v[ax] as f64 - p[ax] as f64).abs() < 1.0))
+                moved.iter().any(|q| {
+                    (0..3).all(|ax| (q[ax] as f64 + t * v[ax] as f64 - p[ax] as f64).abs() < 1.0)
+                })
             })
         };
         let end = got.map_or(1.0, |c| c.time.to_f64());
@@ -205,7 +233,11 @@ fn first_contact_matches_brute_force_and_sampling() {
             }
         }
         if let Some(c) = got {
-            assert!(overlap_at(c.time.to_f64() + 1e-7), "seed {seed}: no overlap after {}", c.time);
+            assert!(
+                overlap_at(c.time.to_f64() + 1e-7),
+                "seed {seed}: no overlap after {}",
+                c.time
+            );
             assert!(c.time < Fraction::ONE);
         }
         hits[match got {
@@ -226,15 +258,20 @@ fn thin_wall_tunnelling_is_caught_by_the_swept_test() {
         (0..16).flat_map(|y| (0..16).map(move |z| [20, y, z])),
     )
     .unwrap();
-    let cube =
-        LinearOctree::from_voxels(2, [0, 0, 0], (0..64).map(|i| [i % 4, i / 4 % 4, i / 16])).unwrap();
+    let cube = LinearOctree::from_voxels(2, [0, 0, 0], (0..64).map(|i| [i % 4, i / 4 % 4, i / 16]))
+        .unwrap();
     let start = Placement::at([0, 4, 4]);
     let end = Placement::at([40, 4, 4]);
     // Sampled at the two steps, nothing touches: a per-step test misses the wall.
     assert!(!intersects(&wall, &cube, start));
     assert!(!intersects(&wall, &cube, end));
-    let hit = first_contact(Placed::fixed(&wall), [0; 3], Placed::new(&cube, start), [40, 0, 0])
-        .expect("the swept test catches the wall");
+    let hit = first_contact(
+        Placed::fixed(&wall),
+        [0; 3],
+        Placed::new(&cube, start),
+        [40, 0, 0],
+    )
+    .expect("the swept test catches the wall");
     // The cube's front face x = 4 reaches the wall's face x = 20 after 16 of 40 voxels.
     assert_eq!(hit.time, Fraction::new(2, 5));
     assert_eq!(hit.a_block.min[0], 20);
@@ -242,12 +279,25 @@ fn thin_wall_tunnelling_is_caught_by_the_swept_test() {
 
 #[test]
 fn sliding_along_a_face_is_not_a_collision() {
-    let floor = LinearOctree::from_voxels(3, [0, 0, 0], (0..64).map(|i| [i % 8, i / 8, 0])).unwrap();
+    let floor =
+        LinearOctree::from_voxels(3, [0, 0, 0], (0..64).map(|i| [i % 8, i / 8, 0])).unwrap();
     let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
-    assert!(first_contact(Placed::fixed(&floor), [0; 3], Placed::new(&dot, Placement::at([0, 0, 1])), [7, 7, 0]).is_none());
+    assert!(first_contact(
+        Placed::fixed(&floor),
+        [0; 3],
+        Placed::new(&dot, Placement::at([0, 0, 1])),
+        [7, 7, 0]
+    )
+    .is_none());
     assert_eq!(clearance(&floor, &dot, Placement::at([3, 3, 1])), Some(0.0));
     // Already overlapping at the start: time 0.
-    let hit = first_contact(Placed::fixed(&floor), [0; 3], Placed::new(&dot, Placement::at([0, 0, 0])), [1, 0, 0]).unwrap();
+    let hit = first_contact(
+        Placed::fixed(&floor),
+        [0; 3],
+        Placed::new(&dot, Placement::at([0, 0, 0])),
+        [1, 0, 0],
+    )
+    .unwrap();
     assert_eq!(hit.time, Fraction::ZERO);
 }
 
@@ -258,7 +308,10 @@ fn empty_trees_never_interfere() {
     assert!(!intersects(&e, &f, Placement::default()));
     assert_eq!(clearance(&e, &f, Placement::default()), None);
     assert!(first_contact(Placed::fixed(&f), [0; 3], Placed::fixed(&e), [1, 1, 1]).is_none());
-    assert_eq!(interference(&f, &f, Placement::at([1, 2, 3]), false).overlap_voxels, 7 * 6 * 5);
+    assert_eq!(
+        interference(&f, &f, Placement::at([1, 2, 3]), false).overlap_voxels,
+        7 * 6 * 5
+    );
 }
 
 fn cube(side: i64) -> LinearOctree {
@@ -338,11 +391,19 @@ fn world_matches_brute_force_step_by_step() {
         let mut expected_contacts = Vec::new();
         for f in &sim.frames {
             let n = f.step;
-            let off: Vec<Voxel> = (0..3).map(|k| world.objects[k].trajectory.offset_at(n as f64 * 0.5)).collect();
+            let off: Vec<Voxel> = (0..3)
+                .map(|k| world.objects[k].trajectory.offset_at(n as f64 * 0.5))
+                .collect();
             assert_eq!(f.offsets, off, "seed {seed}");
             let mut overlaps = Vec::new();
-            let bodies: Vec<(Option<usize>, usize)> =
-                vec![(None, 0), (None, 1), (None, 2), (Some(0), 1), (Some(0), 2), (Some(1), 2)];
+            let bodies: Vec<(Option<usize>, usize)> = vec![
+                (None, 0),
+                (None, 1),
+                (None, 2),
+                (Some(0), 1),
+                (Some(0), 2),
+                (Some(1), 2),
+            ];
             for &(i, j) in &bodies {
                 let va = i.map_or(venv.clone(), |i| placed(i, off[i]));
                 let vb = placed(j, off[j]);
@@ -353,8 +414,9 @@ fn world_matches_brute_force_step_by_step() {
                         expected_contacts.push((0, Fraction::ZERO, i, j));
                     }
                 } else if n < steps {
-                    let next: Vec<Voxel> =
-                        (0..3).map(|k| world.objects[k].trajectory.offset_at((n + 1) as f64 * 0.5)).collect();
+                    let next: Vec<Voxel> = (0..3)
+                        .map(|k| world.objects[k].trajectory.offset_at((n + 1) as f64 * 0.5))
+                        .collect();
                     let mv = |k: usize| [0, 1, 2].map(|a| next[k][a] - off[k][a]);
                     let rel = {
                         let (mb, ma) = (mv(j), i.map_or([0; 3], mv));

@@ -301,7 +301,8 @@ impl World {
                 ) else {
                     continue;
                 };
-                let still = interference_placed(self.placed(i, &next), self.placed(Some(j), &next), false);
+                let still =
+                    interference_placed(self.placed(i, &next), self.placed(Some(j), &next), false);
                 step_contacts.push(Contact {
                     time: time + c.time.to_f64() * time_step,
                     step: n,

@@ -17,7 +17,7 @@ mod trace;
 #[cfg(test)]
 mod tests;
 
-pub use trace::{Hit, Ray, RayTree};
+pub use trace::{Hit, Ray, RayTree, TraversalStack};
 
 use std::io::Write;
 use std::path::Path;
@@ -280,12 +280,12 @@ fn normalize(a: [f64; 3]) -> [f64; 3] {
 }
 
 impl Frame {
-    fn new(tree: &LinearOctree, opts: &RenderOptions) -> Frame {
-        let (lo, hi) = match tree.bbox() {
+    fn new(rt: &RayTree, opts: &RenderOptions) -> Frame {
+        let (lo, hi) = match rt.bbox() {
             Some((lo, hi)) => (lo.map(|v| v as f64), hi.map(|v| v as f64 + 1.0)),
             None => {
-                let o = tree.origin().map(|v| v as f64);
-                (o, o.map(|v| v + tree.side() as f64))
+                let o = rt.origin().map(|v| v as f64);
+                (o, o.map(|v| v + f64::from(1u32 << rt.depth())))
             }
         };
         let centre = [
@@ -378,6 +378,63 @@ impl Frame {
     }
 }
 
+/// The side of a beam tile, in pixels.
+const BEAM: usize = 8;
+
+impl Frame {
+    /// A lower bound on the first hit of every primary ray of pixels
+    /// `[x0, x1) × [y0, y1)` (see [`RayTree::beam_start`]).
+    fn beam(&self, rt: &RayTree, w: usize, h: usize, x: [usize; 2], y: [usize; 2]) -> f64 {
+        let sx = |px: usize| px as f64 / w as f64 * 2.0 - 1.0;
+        let sy = |py: usize| 1.0 - py as f64 / h as f64 * 2.0;
+        let (sx0, sx1, sy0, sy1) = (sx(x[0]), sx(x[1]), sy(y[1]), sy(y[0]));
+        let footprint = (sx1 - sx0).max(sy1 - sy0) * self.half_w.max(self.half_h);
+        if !self.perspective {
+            // Parallel rays: t = (p − eye) · forward for every ray; the tile is a
+            // rectangle of the image plane.
+            let (rx0, rx1) = (sx0 * self.half_w, sx1 * self.half_w);
+            let (ry0, ry1) = (sy0 * self.half_h, sy1 * self.half_h);
+            let stop = footprint.max(1.0).log2().floor() as u8;
+            let (eye, f, r, u) = (self.eye, self.forward, self.right, self.up);
+            let near = move |lo: [f64; 3], hi: [f64; 3]| {
+                let c = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]) - eye[i]);
+                let e = [0, 1, 2].map(|i| 0.5 * (hi[i] - lo[i]));
+                let spread =
+                    |v: [f64; 3]| v[0].abs() * e[0] + v[1].abs() * e[1] + v[2].abs() * e[2];
+                let (cx, hx) = (dot(c, r), spread(r));
+                let (cy, hy) = (dot(c, u), spread(u));
+                if cx + hx < rx0 || cx - hx > rx1 || cy + hy < ry0 || cy - hy > ry1 {
+                    return None;
+                }
+                Some(dot(c, f) - spread(f))
+            };
+            return rt.beam_start(stop, &near);
+        }
+        // Rays from the eye: the tile is a cone around its centre ray.
+        let axis = self.ray(0.5 * (sx0 + sx1), 0.5 * (sy0 + sy1)).dir;
+        let half_angle = [(sx0, sy0), (sx0, sy1), (sx1, sy0), (sx1, sy1)]
+            .iter()
+            .map(|&(a, b)| dot(self.ray(a, b).dir, axis).clamp(-1.0, 1.0).acos())
+            .fold(0.0f64, f64::max);
+        let eye = self.eye;
+        let stop = 0u8;
+        let near = move |lo: [f64; 3], hi: [f64; 3]| {
+            let v = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]) - eye[i]);
+            let rn = 0.5 * (hi[0] - lo[0]) * 3f64.sqrt();
+            let dist = dot(v, v).sqrt();
+            if dist <= rn {
+                return Some(0.0);
+            }
+            let angle = (dot(v, axis) / dist).clamp(-1.0, 1.0).acos();
+            if angle > half_angle + (rn / dist).asin() + 1e-9 {
+                return None;
+            }
+            Some(dist - rn)
+        };
+        rt.beam_start(stop, &near)
+    }
+}
+
 /// The parameter interval of `ray` inside the clip's kept half-space.
 fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
     let Some(c) = clip else {
@@ -419,18 +476,13 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
 #[must_use]
 pub fn render(tree: &LinearOctree, shader: Option<Shader<'_>>, opts: &RenderOptions) -> Image {
     let rt = RayTree::new(tree);
-    render_with(&rt, tree, shader, opts)
+    render_with(&rt, shader, opts)
 }
 
 /// As [`render`], with the ray index already built (for several views of one tree).
 #[must_use]
-pub fn render_with(
-    rt: &RayTree,
-    tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
-    opts: &RenderOptions,
-) -> Image {
-    let frame = Frame::new(tree, opts);
+pub fn render_with(rt: &RayTree, shader: Option<Shader<'_>>, opts: &RenderOptions) -> Image {
+    let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -438,12 +490,15 @@ pub fn render_with(
         .into_par_iter()
         .map(|ti| {
             let (tx, ty) = (ti % tiles_x, ti / tiles_x);
-            let mut buf = Vec::with_capacity(TILE * TILE);
-            for y in ty * TILE..((ty + 1) * TILE).min(h) {
-                for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    buf.push(shade_pixel(rt, &frame, shader, opts, x, y));
-                }
-            }
+            let xr = [tx * TILE, ((tx + 1) * TILE).min(w)];
+            let yr = [ty * TILE, ((ty + 1) * TILE).min(h)];
+            let tw = xr[1] - xr[0];
+            let mut buf = vec![opts.background; tw * (yr[1] - yr[0])];
+            let mut stack = TraversalStack::default();
+            trace_block(rt, &frame, opts, xr, yr, &mut stack, |x, y, ray, hit| {
+                buf[(y - yr[0]) * tw + (x - xr[0])] =
+                    shade_pixel(rt, &frame, shader, opts, ray, hit);
+            });
             (ti, buf)
         })
         .collect();
@@ -459,22 +514,65 @@ pub fn render_with(
     img
 }
 
+/// Casts the primary rays of the pixels `xr × yr`, beam tile by beam tile: each
+/// 8 × 8 tile first finds a lower bound on its rays' first hits
+/// ([`RayTree::beam_start`]), so its rays skip the empty space in front, and a tile
+/// whose beam meets nothing casts no ray at all.
+fn trace_block(
+    rt: &RayTree,
+    frame: &Frame,
+    opts: &RenderOptions,
+    xr: [usize; 2],
+    yr: [usize; 2],
+    stack: &mut TraversalStack,
+    mut each: impl FnMut(usize, usize, &Ray, Option<Hit>),
+) {
+    let (w, h) = (opts.width, opts.height);
+    for by in (yr[0]..yr[1]).step_by(BEAM) {
+        for bx in (xr[0]..xr[1]).step_by(BEAM) {
+            let (bx1, by1) = ((bx + BEAM).min(xr[1]), (by + BEAM).min(yr[1]));
+            let start = frame.beam(rt, w, h, [bx, bx1], [by, by1]);
+            let margin = 1e-6 * (1.0 + start.abs());
+            for y in by..by1 {
+                for x in bx..bx1 {
+                    let ray = pixel_ray(frame, w, h, x, y);
+                    let (t0, t1) = clip_interval(&ray, opts.clip);
+                    let from = t0.max(start - margin);
+                    let mut hit = if start.is_finite() && from <= t1 {
+                        rt.cast_with(&ray, from, t1, stack)
+                    } else {
+                        None
+                    };
+                    if hit.is_some_and(|h| h.at_start) && from > t0 {
+                        // Only rounding can put a hit at the beam's start: cast again.
+                        hit = rt.cast_with(&ray, t0, t1, stack);
+                    }
+                    each(x, y, &ray, hit);
+                }
+            }
+        }
+    }
+}
+
 /// Casts the primary rays of every pixel and returns how many hit the solid: the
 /// traversal alone, without shading (for benchmarks and coverage tests).
 #[must_use]
-pub fn primary_hits(rt: &RayTree, tree: &LinearOctree, opts: &RenderOptions) -> usize {
-    let frame = Frame::new(tree, opts);
+pub fn primary_hits(rt: &RayTree, opts: &RenderOptions) -> usize {
+    let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
-    (0..h)
+    let tiles_x = w.div_ceil(TILE);
+    (0..tiles_x * h.div_ceil(TILE))
         .into_par_iter()
-        .map(|y| {
-            (0..w)
-                .filter(|&x| {
-                    let ray = pixel_ray(&frame, w, h, x, y);
-                    let (t0, t1) = clip_interval(&ray, opts.clip);
-                    rt.cast(&ray, t0, t1).is_some()
-                })
-                .count()
+        .map(|ti| {
+            let (tx, ty) = (ti % tiles_x, ti / tiles_x);
+            let xr = [tx * TILE, ((tx + 1) * TILE).min(w)];
+            let yr = [ty * TILE, ((ty + 1) * TILE).min(h)];
+            let mut stack = TraversalStack::default();
+            let mut n = 0;
+            trace_block(rt, &frame, opts, xr, yr, &mut stack, |_, _, _, hit| {
+                n += usize::from(hit.is_some());
+            });
+            n
         })
         .sum()
 }
@@ -490,16 +588,9 @@ fn shade_pixel(
     frame: &Frame,
     shader: Option<Shader<'_>>,
     opts: &RenderOptions,
-    x: usize,
-    y: usize,
+    ray: &Ray,
+    hit: Option<Hit>,
 ) -> [u8; 3] {
-    let ray = pixel_ray(frame, opts.width, opts.height, x, y);
-    let (t0, t1) = clip_interval(&ray, opts.clip);
-    let hit = if t0 <= t1 {
-        rt.cast(&ray, t0, t1)
-    } else {
-        None
-    };
     let ground_t = if opts.shadows && ray.dir[2] < -1e-9 {
         let t = (frame.ground_z - ray.origin[2]) / ray.dir[2];
         (t > 0.0).then_some(t)
@@ -507,11 +598,9 @@ fn shade_pixel(
         None
     };
     match hit {
-        Some(h) if ground_t.is_none_or(|g| h.t <= g) => {
-            shade_hit(rt, frame, shader, opts, &ray, &h)
-        }
+        Some(h) if ground_t.is_none_or(|g| h.t <= g) => shade_hit(rt, frame, shader, opts, ray, &h),
         _ => match ground_t {
-            Some(g) => shade_ground(rt, frame, opts, &ray, g),
+            Some(g) => shade_ground(rt, frame, opts, ray, g),
             None => opts.background,
         },
     }
@@ -675,7 +764,7 @@ pub fn contact_sheet(
         let (az, el) = v.angles();
         o.camera.azimuth_deg = az;
         o.camera.elevation_deg = el;
-        let img = render_with(&rt, tree, shader, &o);
+        let img = render_with(&rt, shader, &o);
         let (c, r) = (i % columns, i / columns);
         sheet.blit(
             &img,

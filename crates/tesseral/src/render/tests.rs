@@ -192,8 +192,8 @@ fn ray_tree_contains_equals_the_linear_octree() {
 
 fn coverage(tree: &LinearOctree, opts: &RenderOptions) -> (f64, f64) {
     let rt = RayTree::new(tree);
-    let hits = primary_hits(&rt, tree, opts) as f64;
-    let frame = Frame::new(tree, opts);
+    let hits = primary_hits(&rt, opts) as f64;
+    let frame = Frame::new(&rt, opts);
     let pixel_area =
         (2.0 * frame.half_w / opts.width as f64) * (2.0 * frame.half_h / opts.height as f64);
     (hits, pixel_area)
@@ -297,8 +297,8 @@ fn perspective_sphere_silhouette() {
         ..Default::default()
     };
     let rt = RayTree::new(&tree);
-    let hits = primary_hits(&rt, &tree, &opts) as f64;
-    let frame = Frame::new(&tree, &opts);
+    let hits = primary_hits(&rt, &opts) as f64;
+    let frame = Frame::new(&rt, &opts);
     let dist = dot(
         add(frame.eye, scale([64.0, 64.0, 64.0], -1.0)),
         add(frame.eye, scale([64.0, 64.0, 64.0], -1.0)),
@@ -345,8 +345,8 @@ fn perspective_box_silhouette_matches_projected_hull() {
             ..Default::default()
         };
         let rt = RayTree::new(&tree);
-        let hits = primary_hits(&rt, &tree, &opts) as f64;
-        let f = Frame::new(&tree, &opts);
+        let hits = primary_hits(&rt, &opts) as f64;
+        let f = Frame::new(&rt, &opts);
         let mut pts: Vec<(f64, f64)> = (0..8)
             .map(|c| {
                 let q =
@@ -475,7 +475,7 @@ fn images_modes_and_png() {
         shadows: false,
         ..base.clone()
     };
-    assert_eq!(primary_hits(&RayTree::new(&tree), &tree, &none), 0);
+    assert_eq!(primary_hits(&RayTree::new(&tree), &none), 0);
     let persp = render(
         &tree,
         None,
