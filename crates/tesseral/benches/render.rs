@@ -36,7 +36,7 @@ fn bench_render(c: &mut Criterion) {
         b.iter(|| one.install(|| black_box(primary_hits(&rt, &opts))))
     });
     g.bench_function("shaded_1024x1024_showcase", |b| {
-        b.iter(|| black_box(render(&tree, None, &opts)))
+        b.iter(|| black_box(render(&tree, Default::default(), &opts)))
     });
     g.finish();
 }

@@ -68,6 +68,11 @@ pub struct Args {
     /// Colour of an octree file's solid (a scene's objects carry their own).
     #[arg(long, default_value = "#96a5b9")]
     colour: String,
+    /// Shading: `faces` shows the blocks' faces, `smooth` the surface's normals (a
+    /// scene's own, else estimated from the octree), `auto` picks smooth where voxels
+    /// are smaller than two pixels.
+    #[arg(long, default_value = "auto")]
+    normals: String,
     /// Print sizes and timings as JSON on stdout.
     #[arg(long)]
     json: bool,
@@ -183,6 +188,19 @@ pub fn run(args: Args) -> Result<()> {
         Some(s) => s,
         None => &fixed,
     };
+    let normal_fn = csg.as_ref().map(|c| move |p: [f64; 3]| c.normal_at(p));
+    let surface = render::Surface {
+        colour: Some(shader_ref),
+        normal: normal_fn
+            .as_ref()
+            .map(|f| f as &(dyn Fn([f64; 3]) -> Option<[f64; 3]> + Sync)),
+    };
+    let normals = match args.normals.as_str() {
+        "auto" => render::Normals::Auto,
+        "faces" => render::Normals::Faces,
+        "smooth" => render::Normals::Smooth,
+        other => bail!("--normals {other:?}: expected auto, faces or smooth"),
+    };
     let (az, el) = view.angles();
     let opts = RenderOptions {
         width,
@@ -206,17 +224,18 @@ pub fn run(args: Args) -> Result<()> {
             keep_above: op == '>',
         }),
         background,
+        normals,
     };
     let start = Instant::now();
     let image = if let Some((axis, _, c)) = slice {
         let layer = to_voxel(axis, c).floor() as i64;
         let side = tree.side() as usize;
         let scale = args.slice_scale.clamp(1, (MAX_SIDE / side.max(1)).max(1));
-        render::section(&tree, Some(shader_ref), axis, layer, scale)
+        render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
-        render::contact_sheet(&tree, Some(shader_ref), &opts, &View::ALL, 2)
+        render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)
     } else {
-        render::render(&tree, Some(shader_ref), &opts)
+        render::render(&tree, surface, &opts)
     };
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
     image

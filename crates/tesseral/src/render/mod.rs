@@ -219,6 +219,8 @@ pub struct RenderOptions {
     pub clip: Option<Clip>,
     /// The background colour.
     pub background: [u8; 3],
+    /// How surfaces are shaded.
+    pub normals: Normals,
 }
 
 impl Default for RenderOptions {
@@ -232,6 +234,7 @@ impl Default for RenderOptions {
             ao_samples: 0,
             clip: None,
             background: [250, 250, 252],
+            normals: Normals::Auto,
         }
     }
 }
@@ -239,6 +242,34 @@ impl Default for RenderOptions {
 /// The colour of the solid at a point (voxel coordinates), e.g. a scene's
 /// per-object colours.
 pub type Shader<'a> = &'a (dyn Fn([f64; 3]) -> [u8; 3] + Sync);
+
+/// An outward unit normal of the solid near a point (voxel coordinates), when known:
+/// e.g. [`crate::csg::Csg::normal_at`].
+pub type NormalFn<'a> = &'a (dyn Fn([f64; 3]) -> Option<[f64; 3]> + Sync);
+
+/// What the renderer may ask about the solid beyond its octree: colours and normals.
+/// Both are optional; an octree file alone is drawn in [`DEFAULT_COLOUR`] with normals
+/// estimated from the octree.
+#[derive(Clone, Copy, Default)]
+pub struct Surface<'a> {
+    /// The colour at a point inside the solid.
+    pub colour: Option<Shader<'a>>,
+    /// The normal at a point on the surface.
+    pub normal: Option<NormalFn<'a>>,
+}
+
+/// How surfaces are shaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Normals {
+    /// Smooth where voxels are smaller than two pixels, block faces otherwise.
+    #[default]
+    Auto,
+    /// The faces of the blocks: the octree as it is.
+    Faces,
+    /// Smooth: the surface's own normal when given, else the gradient of the octree's
+    /// occupancy around the hit.
+    Smooth,
+}
 
 /// The colour used when no shader is given.
 pub const DEFAULT_COLOUR: [u8; 3] = [150, 165, 185];
@@ -458,8 +489,8 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
     }
 }
 
-/// Renders `tree` as seen by `opts.camera`. `shader` gives the colour at a point
-/// inside the solid (voxel coordinates); `None` paints [`DEFAULT_COLOUR`].
+/// Renders `tree` as seen by `opts.camera`. `surface` gives colours and normals when
+/// known (a scene's); by default the solid is [`DEFAULT_COLOUR`].
 ///
 /// # Runtime
 /// O(pixels × nodes visited per ray), in parallel over 32 × 32 tiles; plus
@@ -469,19 +500,19 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
 /// use tesseral::linear::LinearOctree;
 /// use tesseral::render::{render, RenderOptions};
 /// let tree = LinearOctree::full(3, [0, 0, 0]).unwrap();
-/// let img = render(&tree, None, &RenderOptions { width: 64, height: 48, ..Default::default() });
+/// let img = render(&tree, Default::default(), &RenderOptions { width: 64, height: 48, ..Default::default() });
 /// assert_eq!((img.width, img.height), (64, 48));
 /// assert_ne!(img.get(32, 24), RenderOptions::default().background);
 /// ```
 #[must_use]
-pub fn render(tree: &LinearOctree, shader: Option<Shader<'_>>, opts: &RenderOptions) -> Image {
+pub fn render(tree: &LinearOctree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
     let rt = RayTree::new(tree);
-    render_with(&rt, shader, opts)
+    render_with(&rt, surface, opts)
 }
 
 /// As [`render`], with the ray index already built (for several views of one tree).
 #[must_use]
-pub fn render_with(rt: &RayTree, shader: Option<Shader<'_>>, opts: &RenderOptions) -> Image {
+pub fn render_with(rt: &RayTree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
     let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
     let tiles_x = w.div_ceil(TILE);
@@ -497,7 +528,7 @@ pub fn render_with(rt: &RayTree, shader: Option<Shader<'_>>, opts: &RenderOption
             let mut stack = TraversalStack::default();
             trace_block(rt, &frame, opts, xr, yr, &mut stack, |x, y, ray, hit| {
                 buf[(y - yr[0]) * tw + (x - xr[0])] =
-                    shade_pixel(rt, &frame, shader, opts, ray, hit);
+                    shade_pixel(rt, &frame, surface, opts, ray, hit);
             });
             (ti, buf)
         })
@@ -586,7 +617,7 @@ fn pixel_ray(frame: &Frame, w: usize, h: usize, x: usize, y: usize) -> Ray {
 fn shade_pixel(
     rt: &RayTree,
     frame: &Frame,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
     ray: &Ray,
     hit: Option<Hit>,
@@ -598,7 +629,9 @@ fn shade_pixel(
         None
     };
     match hit {
-        Some(h) if ground_t.is_none_or(|g| h.t <= g) => shade_hit(rt, frame, shader, opts, ray, &h),
+        Some(h) if ground_t.is_none_or(|g| h.t <= g) => {
+            shade_hit(rt, frame, surface, opts, ray, &h)
+        }
         _ => match ground_t {
             Some(g) => shade_ground(rt, frame, opts, ray, g),
             None => opts.background,
@@ -609,7 +642,7 @@ fn shade_pixel(
 fn shade_hit(
     rt: &RayTree,
     frame: &Frame,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
     ray: &Ray,
     h: &Hit,
@@ -625,10 +658,22 @@ fn shade_hit(
     }
     // Sample the colour half a voxel inside the surface.
     let inside = add(p, scale(n, -0.5));
-    let base = match shader {
-        Some(f) => f(inside),
-        None => DEFAULT_COLOUR,
+    let face = n;
+    let smooth = match opts.normals {
+        Normals::Faces => false,
+        Normals::Smooth => true,
+        Normals::Auto => frame.pixel_size(h.t, opts.height) > 0.5,
     };
+    if smooth && !opts.outline && !cut {
+        let given = surface
+            .normal
+            .and_then(|f| f(p))
+            .filter(|m| dot(*m, face) > 0.05);
+        n = given.unwrap_or_else(|| smooth_normal(rt, inside, face));
+    }
+    // The centre of the voxel hit: the solid's predicate holds there exactly.
+    let centre = inside.map(|c| c.floor() + 0.5);
+    let base = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
     let base = if cut {
         // Cut faces: the object's colour, darker, hatched, so the section reads.
         let stripe = ((p[0] + p[1] + p[2]) / 3.0).rem_euclid(6.0) < 3.0;
@@ -638,9 +683,10 @@ fn shade_hit(
         base
     };
     let mut light = dot(n, frame.light).max(0.0);
-    let lit_side = dot(n, frame.light) > 0.0;
-    if opts.shadows && lit_side {
-        let from = add(p, scale(n, 1e-3));
+    if opts.shadows && light > 0.0 {
+        // From a smooth surface, start the shadow ray clear of the voxel staircase.
+        let lift = if smooth { 1.5 } else { 0.0 };
+        let from = add(add(p, scale(face, 1e-3)), scale(n, lift));
         if rt
             .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
             .is_some()
@@ -675,6 +721,42 @@ fn shade_hit(
         }
     }
     rgb.map(|c| c.round() as u8)
+}
+
+/// A smooth normal at the surface voxel holding `inside`: minus the gradient of the
+/// occupancy of its 26 neighbours at distances 1 and 2, blended with the face normal
+/// so flat faces stay flat. Any octree gets it; no solid is needed.
+fn smooth_normal(rt: &RayTree, inside: [f64; 3], face: [f64; 3]) -> [f64; 3] {
+    let v = inside.map(|c| c.floor() as i64);
+    let mut g = [0.0; 3];
+    for step in [1i64, 2] {
+        for dz in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    if dx == 0 && dy == 0 && dz == 0 {
+                        continue;
+                    }
+                    let o = [dx * step, dy * step, dz * step];
+                    if rt.contains([v[0] + o[0], v[1] + o[1], v[2] + o[2]]) {
+                        let w = 1.0 / ((dx * dx + dy * dy + dz * dz) as f64).sqrt();
+                        g = add(g, scale([dx as f64, dy as f64, dz as f64], w));
+                    }
+                }
+            }
+        }
+    }
+    let len = dot(g, g).sqrt();
+    if len < 1e-9 {
+        return face;
+    }
+    let m = add(scale(g, -0.8 / len), scale(face, 0.35));
+    let n = normalize(m);
+    // Never turn further than a right angle from the face actually seen.
+    if dot(n, face) > 0.05 {
+        n
+    } else {
+        face
+    }
 }
 
 fn ambient_occlusion(
@@ -724,9 +806,9 @@ fn shade_ground(rt: &RayTree, frame: &Frame, opts: &RenderOptions, ray: &Ray, t:
         return opts.background;
     }
     // A soft-edged disc with a faint grid, 16 cells across the solid.
-    let cell = (frame.radius / 8.0).max(1.0);
+    let cell = (frame.radius / 6.0).max(1.0);
     let grid = ((p[0] / cell).floor() + (p[1] / cell).floor()).rem_euclid(2.0) == 0.0;
-    let mut k = if grid { 0.93 } else { 0.97 };
+    let mut k = if grid { 0.955 } else { 0.98 };
     let from = [p[0], p[1], p[2] + 1e-3];
     if rt
         .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
@@ -745,7 +827,7 @@ fn shade_ground(rt: &RayTree, frame: &Frame, opts: &RenderOptions, ray: &Ray, t:
 #[must_use]
 pub fn contact_sheet(
     tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
     views: &[View],
     columns: usize,
@@ -764,7 +846,7 @@ pub fn contact_sheet(
         let (az, el) = v.angles();
         o.camera.azimuth_deg = az;
         o.camera.elevation_deg = el;
-        let img = render_with(&rt, shader, &o);
+        let img = render_with(&rt, surface, &o);
         let (c, r) = (i % columns, i / columns);
         sheet.blit(
             &img,
@@ -776,7 +858,7 @@ pub fn contact_sheet(
 }
 
 /// A 2-D slice of the tree: the layer of voxels with coordinate `at` on `axis`, one
-/// square of `pixels` pixels per voxel, black voxels coloured by `shader`, and the
+/// square of `pixels` pixels per voxel, black voxels coloured by `surface`, and the
 /// outlines of the octree blocks the layer crosses drawn in dark grey.
 ///
 /// The image's horizontal axis is the next axis after `axis` (cyclically) and its
@@ -787,7 +869,7 @@ pub fn contact_sheet(
 #[must_use]
 pub fn section(
     tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     axis: usize,
     at: i64,
     pixels: usize,
@@ -807,7 +889,7 @@ pub fn section(
             v[v_ax] += vy as i64;
             if rt.contains(v) {
                 let centre = v.map(|c| c as f64 + 0.5);
-                let colour = shader.map_or(DEFAULT_COLOUR, |f| f(centre));
+                let colour = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
                 for dy in 0..px {
                     for dx in 0..px {
                         let (x, y) = (ux * px + dx, size - 1 - (vy * px + dy));
