@@ -497,7 +497,7 @@ fn images_modes_and_png() {
     assert_eq!(primary_hits(&RayTree::new(&tree), &none), 0);
     let persp = render(
         &tree,
-        None,
+        Surface::default(),
         &RenderOptions {
             camera: Camera {
                 projection: Projection::Perspective { fov_deg: 35.0 },
