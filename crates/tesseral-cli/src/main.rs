@@ -47,6 +47,10 @@ enum Command {
     Op(cmd::op::Args),
     /// The complement of an octree within its space.
     Complement(cmd::transform::ComplementArgs),
+    /// Draws a scene or an octree file as a PNG image.
+    Render(cmd::render::Args),
+    /// Builds a scene's octree and writes it to a file.
+    Build(cmd::build::Args),
 }
 
 fn main() -> ExitCode {
@@ -67,6 +71,8 @@ fn main() -> ExitCode {
         Command::Scale(args) => cmd::transform::scale(args),
         Command::Op(args) => cmd::op::run(args),
         Command::Complement(args) => cmd::transform::complement(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Build(args) => cmd::build::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,5 +1,6 @@
 //! One module per subcommand. Each has an `Args` (clap derive) and a `run`.
 
+pub mod build;
 pub mod calc;
 pub mod collide;
 pub mod convert;
@@ -12,3 +13,6 @@ pub mod rsmc;
 pub mod simulate;
 pub mod tables;
 pub mod transform;
+pub mod render;
+pub mod rsmc;
+pub mod tables;
