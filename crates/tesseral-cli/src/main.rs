@@ -19,10 +19,14 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// Applies an operations log (+ x y z, - x y z, ? x y z) to an unbounded octree.
+    Replay(cmd::replay::Args),
     /// The papers' digit tables, computed; misprints marked and footnoted.
     Tables(cmd::tables::Args),
     /// Monte Carlo of self-avoiding random surfaces (Libes §6).
     Rsmc(cmd::rsmc::Args),
+    /// Converts between file formats, chosen by extension.
+    Convert(cmd::convert::Args),
     /// Interference of two octrees: overlap, overlap volume, clearance.
     Collide(cmd::collide::Args),
     /// Run a world of moving objects; report every contact, with exact times.
@@ -35,8 +39,10 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Replay(args) => cmd::replay::run(args),
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
         Command::Collide(args) => cmd::collide::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Plan(args) => cmd::plan::run(args),

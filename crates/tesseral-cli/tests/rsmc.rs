@@ -215,6 +215,21 @@ fn bad_input_is_a_clear_error() {
         "checkpoint.json",
     );
     fails(&tesseral(&["rsmc", "--steps", "abc"], d), "--steps");
+    fails(
+        &tesseral(
+            &[
+                "rsmc",
+                "--steps",
+                "100000000000",
+                "--sample-every",
+                "1",
+                "--out",
+                "o",
+            ],
+            d,
+        ),
+        "--sample-every",
+    );
     // A damaged checkpoint.
     ok(&tesseral(&["rsmc", "--steps", "1000", "--out", "c"], d));
     std::fs::write(d.join("c/checkpoint.json"), "{\"chain\": 3}").unwrap();
@@ -249,4 +264,35 @@ fn bad_input_is_a_clear_error() {
         ),
         "--beta",
     );
+}
+
+#[test]
+fn octree_and_dense_backends_write_identical_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    for backend in ["octree", "dense"] {
+        let out = tesseral(
+            &[
+                "rsmc",
+                "--steps",
+                "40000",
+                "--beta",
+                "-0.1",
+                "--seed",
+                "3",
+                "--backend",
+                backend,
+                "--out",
+                backend,
+                "--json",
+            ],
+            dir.path(),
+        );
+        let v: serde_json::Value = serde_json::from_str(ok(&out).trim()).unwrap();
+        assert_eq!(v["backend"], backend);
+    }
+    for f in ["series.csv", "surface.obj", "checkpoint.json"] {
+        let x = std::fs::read(dir.path().join("octree").join(f)).unwrap();
+        let y = std::fs::read(dir.path().join("dense").join(f)).unwrap();
+        assert!(x == y, "{f} differs between the backends");
+    }
 }

@@ -10,6 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, Ordering};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{Chain, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -84,13 +85,19 @@ fn bench_backend<L: Lattice>(c: &mut Criterion, name: &str, voxels: &[Voxel], ca
     group.bench_function(name, |b| b.iter(|| chain.run(N)));
     group.finish();
     // A direct timing as well, for the ratio printed below.
+    let before = chain.counters();
     let t = std::time::Instant::now();
     chain.run(5_000_000);
     let rate = 5e6 / t.elapsed().as_secs_f64();
+    let after = chain.counters();
+    let pct = |a: u64, b: u64| 100.0 * (a - b) as f64 / 5e6;
     eprintln!(
-        "rsmc {name} area {}: {:.2} M steps/s (direct, 5M steps)",
+        "rsmc {name} area {}: {:.2} M steps/s (direct, 5M steps; {:.1}% accepted, {:.1}% illegal, {:.1}% capped)",
         chain.area(),
-        rate / 1e6
+        rate / 1e6,
+        pct(after.accepted, before.accepted),
+        pct(after.illegal, before.illegal),
+        pct(after.capped, before.capped),
     );
     rate
 }
@@ -99,7 +106,11 @@ fn bench_rsmc(c: &mut Criterion) {
     for target in [10_000u64, 100_000] {
         let (voxels, area) = grow(target);
         let dense = bench_backend::<DenseLattice>(c, "dense", &voxels, area);
-        let _ = dense;
+        let octree = bench_backend::<DynamicOctree>(c, "octree", &voxels, area);
+        eprintln!(
+            "rsmc area {target}: octree/dense speed ratio {:.2}",
+            octree / dense
+        );
     }
 }
 

@@ -78,7 +78,11 @@ pub fn run(args: Args) -> Result<()> {
         serde_json::to_writer(&mut out, &report)?;
         writeln!(out)?;
     } else {
-        writeln!(out, "intersects: {}", if report.intersects { "yes" } else { "no" })?;
+        writeln!(
+            out,
+            "intersects: {}",
+            if report.intersects { "yes" } else { "no" }
+        )?;
         writeln!(out, "overlap voxels: {}", report.overlap_voxels)?;
         match report.clearance {
             Some(c) => writeln!(out, "clearance: {c}")?,

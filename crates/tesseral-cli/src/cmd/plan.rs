@@ -48,14 +48,22 @@ pub struct Args {
 fn parse_region(s: &str) -> Result<Aabb, String> {
     let v: Vec<i64> = s
         .split(',')
-        .map(|p| p.trim().parse::<i64>().map_err(|_| format!("{p:?} in {s:?} is not an integer")))
+        .map(|p| {
+            p.trim()
+                .parse::<i64>()
+                .map_err(|_| format!("{p:?} in {s:?} is not an integer"))
+        })
         .collect::<Result<_, _>>()?;
     if v.len() != 6 {
-        return Err(format!("expected X0,Y0,Z0,X1,Y1,Z1 (six integers), got {s:?}"));
+        return Err(format!(
+            "expected X0,Y0,Z0,X1,Y1,Z1 (six integers), got {s:?}"
+        ));
     }
     let (min, max) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
     if (0..3).any(|a| max[a] < min[a]) {
-        return Err(format!("the region {s:?} is empty: each of X1,Y1,Z1 must be at least X0,Y0,Z0"));
+        return Err(format!(
+            "the region {s:?} is empty: each of X1,Y1,Z1 must be at least X0,Y0,Z0"
+        ));
     }
     Ok(Aabb { min, max })
 }
@@ -90,7 +98,13 @@ pub fn run(args: Args) -> Result<()> {
     };
     let result = plan(&env, &obj, args.from, args.to, &options);
     if let Some(path) = &args.output {
-        picture(path, &env, &obj, &args, result.as_ref().ok().map(|p| p.waypoints.as_slice()))?;
+        picture(
+            path,
+            &env,
+            &obj,
+            &args,
+            result.as_ref().ok().map(|p| p.waypoints.as_slice()),
+        )?;
     }
     let mut out = std::io::stdout().lock();
     match result {

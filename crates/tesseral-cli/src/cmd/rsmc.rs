@@ -8,6 +8,7 @@ use std::time::Instant;
 use anyhow::{bail, ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::{Deserialize, Serialize};
+use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -37,7 +38,7 @@ pub struct Args {
     #[arg(long)]
     libes: bool,
     /// Lattice implementation.
-    #[arg(long, value_enum, default_value_t = Backend::Dense)]
+    #[arg(long, value_enum, default_value_t = Backend::Octree)]
     backend: Backend,
     /// Folder for series.csv, area.png, the mesh and checkpoint.json.
     #[arg(long, default_value = "rsmc-out")]
@@ -67,7 +68,9 @@ pub struct Args {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 enum Backend {
-    /// Dense array that follows the surface (baseline).
+    /// The unbounded dynamic octree: O(|S|) memory.
+    Octree,
+    /// Dense array that follows the surface (baseline): O(box volume) memory.
     Dense,
 }
 
@@ -98,6 +101,8 @@ struct Row {
 }
 
 const MAX_BOX_SIDE: u64 = 1000;
+/// The series is kept in memory (it is rewritten at each checkpoint and plotted).
+const MAX_ROWS: u64 = 10_000_000;
 const MAX_START_VOXELS: u64 = 10_000_000;
 
 fn parse_start(s: &str) -> Result<Vec<Voxel>> {
@@ -182,8 +187,15 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
+    ensure!(
+        args.steps / args.sample_every <= MAX_ROWS,
+        "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
+        args.steps,
+        args.sample_every
+    );
     fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     match args.backend {
+        Backend::Octree => simulate::<DynamicOctree>(args),
         Backend::Dense => simulate::<DenseLattice>(args),
     }
 }
@@ -306,11 +318,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         write_file(&cp_path, |w| w.write_all(&json))
     };
     let next_multiple = |s: u64, every: u64| {
-        if every == 0 {
-            u64::MAX
-        } else {
-            (s / every + 1) * every
-        }
+        s.checked_div(every)
+            .map_or(u64::MAX, |q| (q + 1).saturating_mul(every))
     };
     let t0 = Instant::now();
     while chain.steps() < args.steps {

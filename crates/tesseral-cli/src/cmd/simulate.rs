@@ -118,7 +118,11 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-fn write_frames(dir: &std::path::Path, world: &tesseral::motion::World, sim: &tesseral::motion::Simulation) -> Result<()> {
+fn write_frames(
+    dir: &std::path::Path,
+    world: &tesseral::motion::World,
+    sim: &tesseral::motion::Simulation,
+) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     // One view for the whole run: the box around everything at every step.
     let mut lo = [i64::MAX; 3];

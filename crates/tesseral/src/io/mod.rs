@@ -20,6 +20,7 @@
 
 pub mod binvox;
 pub mod native;
+pub mod octomap;
 mod reframe;
 pub mod vox;
 pub mod xyz;
@@ -207,10 +208,10 @@ pub struct ReadOptions {}
 pub struct WriteOptions {}
 
 /// The extensions [`read_octree`] understands.
-pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox";
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot";
 
 /// The extensions [`write_octree`] understands.
-pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox";
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot";
 
 /// Reads an octree from `path`, choosing the format by its extension. Meshes are
 /// voxelized with [`ReadOptions::default`].
@@ -239,6 +240,7 @@ pub fn read_model_with(path: &Path, _options: &ReadOptions) -> Result<VoxelModel
         "xyz" => xyz::read(path).map(VoxelModel::new),
         "binvox" => binvox::read(path),
         "vox" => vox::read(path),
+        "bt" | "ot" => octomap::read(path),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -278,6 +280,7 @@ pub fn write_model_with(
         "xyz" => write_atomic(path, |w| xyz::write(w, &model.tree)),
         "binvox" => binvox::write_file(path, model),
         "vox" => vox::write_file(path, model),
+        "bt" | "ot" => octomap::write_file(path, model),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,

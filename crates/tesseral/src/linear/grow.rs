@@ -42,6 +42,7 @@ pub(crate) fn grown_space(
 
 /// The child label that the old root takes in each root expansion from
 /// `(depth, origin)` to the grown `(new_depth, new_origin)`, outermost first.
+#[allow(dead_code)]
 pub(crate) fn expansion_labels(
     depth: u8,
     origin: Voxel,

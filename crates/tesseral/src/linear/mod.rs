@@ -8,7 +8,7 @@
 
 pub(crate) mod arith;
 mod build;
-mod grow;
+pub(crate) mod grow;
 mod leaf;
 mod ops;
 mod resample;
@@ -379,6 +379,6 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
 }
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 #[cfg(test)]
-mod tests_ops;
+pub(crate) mod tests_ops;

@@ -326,7 +326,11 @@ pub fn interference(
 /// [`interference`] with both trees placed.
 #[must_use]
 pub fn interference_placed(a: Placed<'_>, b: Placed<'_>, contacts: bool) -> Interference {
-    let mode = if contacts { Mode::Contacts } else { Mode::Volume };
+    let mode = if contacts {
+        Mode::Contacts
+    } else {
+        Mode::Volume
+    };
     run_overlap(a, b, mode)
 }
 

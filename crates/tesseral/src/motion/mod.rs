@@ -29,12 +29,16 @@ pub use interfere::{
     clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
-pub use plan::{config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions};
-pub use picture::{Rgb, TopView};
 pub use orient::{Rotation, RotationError};
-pub use world::{Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World};
-pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
+pub use picture::{Rgb, TopView};
+pub use plan::{
+    config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
+};
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
+pub use world::{
+    Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
+};
+pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 
 #[cfg(test)]
 mod tests;

@@ -64,7 +64,14 @@ impl Rotation {
     /// All 24 rotations, identity first, in a fixed order (so an index names one).
     #[must_use]
     pub fn all() -> Vec<Rotation> {
-        const PERMS: [[u8; 3]; 6] = [[0, 1, 2], [0, 2, 1], [1, 0, 2], [1, 2, 0], [2, 0, 1], [2, 1, 0]];
+        const PERMS: [[u8; 3]; 6] = [
+            [0, 1, 2],
+            [0, 2, 1],
+            [1, 0, 2],
+            [1, 2, 0],
+            [2, 0, 1],
+            [2, 1, 0],
+        ];
         let mut out = Vec::with_capacity(24);
         for perm in PERMS {
             for signs in 0..8u8 {

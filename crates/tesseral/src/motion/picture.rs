@@ -69,7 +69,8 @@ impl TopView {
     /// The pixel range covering world columns `lo..hi` on one axis.
     fn span(&self, lo: i64, hi: i64, origin: i64, len: usize) -> (usize, usize) {
         let a = ((lo - origin).div_euclid(self.shrink) * self.zoom).clamp(0, len as i64);
-        let b = (((hi - origin) + self.shrink - 1).div_euclid(self.shrink) * self.zoom).clamp(0, len as i64);
+        let b = (((hi - origin) + self.shrink - 1).div_euclid(self.shrink) * self.zoom)
+            .clamp(0, len as i64);
         (a as usize, b as usize)
     }
 
@@ -121,17 +122,26 @@ impl TopView {
     pub fn draw_polyline(&mut self, points: &[[f64; 3]], color: Rgb) {
         let to_px = |p: &[f64; 3]| {
             let s = self.zoom as f64 / self.shrink as f64;
-            ((p[0] - self.x0 as f64) * s, (self.height as f64) - (p[1] - self.y0 as f64) * s)
+            (
+                (p[0] - self.x0 as f64) * s,
+                (self.height as f64) - (p[1] - self.y0 as f64) * s,
+            )
         };
         for w in points.windows(2) {
             let (a, b) = (to_px(&w[0]), to_px(&w[1]));
-            let n = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) * 2.0).ceil().max(1.0) as usize;
+            let n = ((b.0 - a.0).abs().max((b.1 - a.1).abs()) * 2.0)
+                .ceil()
+                .max(1.0) as usize;
             for k in 0..=n {
                 let t = k as f64 / n as f64;
                 let (x, y) = (a.0 + (b.0 - a.0) * t, a.1 + (b.1 - a.1) * t);
                 for (dx, dy) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
                     let (px, py) = ((x - 0.5 + dx).floor(), (y - 0.5 + dy).floor());
-                    if px >= 0.0 && py >= 0.0 && (px as usize) < self.width && (py as usize) < self.height {
+                    if px >= 0.0
+                        && py >= 0.0
+                        && (px as usize) < self.width
+                        && (py as usize) < self.height
+                    {
                         let i = py as usize * self.width + px as usize;
                         self.rgb[i] = color;
                         self.top[i] = i64::MAX;
@@ -158,7 +168,9 @@ impl TopView {
             enc.set_depth(png::BitDepth::Eight);
             let mut writer = enc.write_header().map_err(std::io::Error::other)?;
             let data: Vec<u8> = self.rgb.iter().flatten().copied().collect();
-            writer.write_image_data(&data).map_err(std::io::Error::other)?;
+            writer
+                .write_image_data(&data)
+                .map_err(std::io::Error::other)?;
             writer.finish().map_err(std::io::Error::other)
         })
     }

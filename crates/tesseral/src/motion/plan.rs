@@ -275,13 +275,17 @@ pub enum NoPath {
         bounds: Aabb,
     },
     /// At the start the object already overlaps the environment.
-    #[error("no path: at the start the object overlaps the environment in {overlap_voxels} voxels")]
+    #[error(
+        "no path: at the start the object overlaps the environment in {overlap_voxels} voxels"
+    )]
     StartBlocked {
         /// Shared voxels at the start.
         overlap_voxels: u64,
     },
     /// At the goal the object would overlap the environment.
-    #[error("no path: at the goal the object would overlap the environment in {overlap_voxels} voxels")]
+    #[error(
+        "no path: at the goal the object would overlap the environment in {overlap_voxels} voxels"
+    )]
     GoalBlocked {
         /// Shared voxels at the goal.
         overlap_voxels: u64,
@@ -471,7 +475,9 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Plan, NoPath> {
     let rotation = options.rotation;
-    let obj_box = rotated(object, rotation).bbox().ok_or(NoPath::EmptyObject)?;
+    let obj_box = rotated(object, rotation)
+        .bbox()
+        .ok_or(NoPath::EmptyObject)?;
     let region = match options.region {
         Some(r) => r,
         None => {
@@ -499,12 +505,18 @@ pub fn plan(
     }
     let inside = |p: Voxel| (0..3).all(|a| bounds.min[a] <= p[a] && p[a] <= bounds.max[a]);
     if !inside(from) {
-        return Err(NoPath::StartOutOfBounds { start: from, bounds });
+        return Err(NoPath::StartOutOfBounds {
+            start: from,
+            bounds,
+        });
     }
     if !inside(to) {
         return Err(NoPath::GoalOutOfBounds { goal: to, bounds });
     }
-    let at = |p: Voxel| Placement { rotation, offset: p };
+    let at = |p: Voxel| Placement {
+        rotation,
+        offset: p,
+    };
     let hit = interference(environment, object, at(from), false);
     if hit.intersects {
         return Err(NoPath::StartBlocked {
@@ -704,12 +716,24 @@ fn push_point(points: &mut Vec<Voxel>, p: Voxel) {
 
 /// Whether the object moves from `p` to `q` in a straight line without sharing a
 /// voxel with the environment at any instant.
-fn segment_free(env: &LinearOctree, obj: &LinearOctree, rotation: Rotation, p: Voxel, q: Voxel) -> bool {
+fn segment_free(
+    env: &LinearOctree,
+    obj: &LinearOctree,
+    rotation: Rotation,
+    p: Voxel,
+    q: Voxel,
+) -> bool {
     let mv = [0, 1, 2].map(|a| q[a] - p[a]);
     first_contact(
         Placed::fixed(env),
         [0; 3],
-        Placed::new(obj, Placement { rotation, offset: p }),
+        Placed::new(
+            obj,
+            Placement {
+                rotation,
+                offset: p,
+            },
+        ),
         mv,
     )
     .is_none()
@@ -735,7 +759,12 @@ fn smooth(env: &LinearOctree, obj: &LinearOctree, rotation: Rotation, raw: &[Vox
 }
 
 /// The least clearance along the polyline, sampled every half voxel.
-fn path_clearance(env: &LinearOctree, obj: &LinearOctree, rotation: Rotation, path: &[Voxel]) -> Option<f64> {
+fn path_clearance(
+    env: &LinearOctree,
+    obj: &LinearOctree,
+    rotation: Rotation,
+    path: &[Voxel],
+) -> Option<f64> {
     let mut best: Option<f64> = None;
     let mut take = |p: [f64; 3]| {
         if let Some(d) = clearance_at(env, obj, rotation, p) {

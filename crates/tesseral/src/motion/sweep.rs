@@ -270,6 +270,9 @@ pub fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fractio
         hi: [p[0] + 1, p[1] + 1, p[2] + 1],
     };
     a.iter()
-        .flat_map(|&p| b.iter().filter_map(move |&q| first_time(&unit(p), &unit(q), v)))
+        .flat_map(|&p| {
+            b.iter()
+                .filter_map(move |&q| first_time(&unit(p), &unit(q), v))
+        })
         .min()
 }

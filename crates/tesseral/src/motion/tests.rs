@@ -10,7 +10,11 @@ use crate::linear::LinearOctree;
 use crate::Voxel;
 
 /// A random solid: a few boxes (so the octree has large blocks) plus loose voxels.
-pub(crate) fn random_solid(rng: &mut Pcg64, depth: u8, origin: Voxel) -> (LinearOctree, Vec<Voxel>) {
+pub(crate) fn random_solid(
+    rng: &mut Pcg64,
+    depth: u8,
+    origin: Voxel,
+) -> (LinearOctree, Vec<Voxel>) {
     let side = 1i64 << depth;
     let mut set = HashSet::new();
     for _ in 0..rng.random_range(0..=4) {
@@ -19,7 +23,11 @@ pub(crate) fn random_solid(rng: &mut Pcg64, depth: u8, origin: Voxel) -> (Linear
         for x in 0..ext[0] {
             for y in 0..ext[1] {
                 for z in 0..ext[2] {
-                    set.insert([origin[0] + lo[0] + x, origin[1] + lo[1] + y, origin[2] + lo[2] + z]);
+                    set.insert([
+                        origin[0] + lo[0] + x,
+                        origin[1] + lo[1] + y,
+                        origin[2] + lo[2] + z,
+                    ]);
                 }
             }
         }
@@ -47,7 +55,13 @@ fn unit_gap2(p: Voxel, q: Voxel) -> u128 {
 }
 
 /// An offset that puts the rotated `b` near `a` (within `jitter` voxels of centring).
-fn offset_near(rng: &mut Pcg64, va: &[Voxel], vb: &[Voxel], rotation: Rotation, jitter: i64) -> Voxel {
+fn offset_near(
+    rng: &mut Pcg64,
+    va: &[Voxel],
+    vb: &[Voxel],
+    rotation: Rotation,
+    jitter: i64,
+) -> Voxel {
     let centre = |vs: &mut dyn Iterator<Item = Voxel>| {
         let (mut sum, mut n) = ([0i64; 3], 0i64);
         for v in vs {
@@ -107,7 +121,9 @@ fn rotated_voxels_of_a_cube_fill_a_cube() {
             .map(|i| r.apply_voxel([i % n, i / n % n, i / n / n]))
             .collect();
         assert_eq!(img.len(), 27);
-        let lo = img.iter().fold([i64::MAX; 3], |m, v| [m[0].min(v[0]), m[1].min(v[1]), m[2].min(v[2])]);
+        let lo = img.iter().fold([i64::MAX; 3], |m, v| {
+            [m[0].min(v[0]), m[1].min(v[1]), m[2].min(v[2])]
+        });
         for v in &img {
             assert!((0..3).all(|a| v[a] - lo[a] < n));
         }
@@ -160,8 +176,16 @@ fn interference_matches_brute_force() {
             .iter()
             .flat_map(|&p| moved.iter().map(move |&q| unit_gap2(p, q)))
             .min();
-        assert_eq!(clearance_squared(Placed::fixed(&a), Placed::new(&b, place)), brute, "seed {seed}");
-        assert_eq!(clearance(&a, &b, place), brute.map(|d| (d as f64).sqrt()), "seed {seed}");
+        assert_eq!(
+            clearance_squared(Placed::fixed(&a), Placed::new(&b, place)),
+            brute,
+            "seed {seed}"
+        );
+        assert_eq!(
+            clearance(&a, &b, place),
+            brute.map(|d| (d as f64).sqrt()),
+            "seed {seed}"
+        );
         hits[usize::from(got.intersects)] += 1;
     }
     // Both outcomes are well represented, so the comparison is not vacuous.
@@ -180,7 +204,11 @@ fn first_contact_matches_brute_force_and_sampling() {
         let rotation = all[rng.random_range(0..24)];
         let near = offset_near(&mut rng, &va, &vb, rotation, 4);
         // Start away from `a` and move back through it (or near it).
-        let v = [rng.random_range(-20..20), rng.random_range(-20..20), rng.random_range(-3..3)];
+        let v = [
+            rng.random_range(-20..20),
+            rng.random_range(-20..20),
+            rng.random_range(-3..3),
+        ];
         let back = rng.random_range(0..=2);
         let offset = [0, 1, 2].map(|ax| near[ax] - v[ax] * back / 4);
         let place = Placement { rotation, offset };
@@ -192,9 +220,9 @@ fn first_contact_matches_brute_force_and_sampling() {
         // just after it.
         let overlap_at = |t: f64| {
             va.iter().any(|p| {
-                moved
-                    .iter()
-                    .any(|q| (0..3).all(|ax| (q[ax] as f64 + t * v[ax] as f64 - p[ax] as f64).abs() < 1.0))
+                moved.iter().any(|q| {
+                    (0..3).all(|ax| (q[ax] as f64 + t * v[ax] as f64 - p[ax] as f64).abs() < 1.0)
+                })
             })
         };
         let end = got.map_or(1.0, |c| c.time.to_f64());
@@ -205,7 +233,11 @@ fn first_contact_matches_brute_force_and_sampling() {
             }
         }
         if let Some(c) = got {
-            assert!(overlap_at(c.time.to_f64() + 1e-7), "seed {seed}: no overlap after {}", c.time);
+            assert!(
+                overlap_at(c.time.to_f64() + 1e-7),
+                "seed {seed}: no overlap after {}",
+                c.time
+            );
             assert!(c.time < Fraction::ONE);
         }
         hits[match got {
@@ -226,15 +258,20 @@ fn thin_wall_tunnelling_is_caught_by_the_swept_test() {
         (0..16).flat_map(|y| (0..16).map(move |z| [20, y, z])),
     )
     .unwrap();
-    let cube =
-        LinearOctree::from_voxels(2, [0, 0, 0], (0..64).map(|i| [i % 4, i / 4 % 4, i / 16])).unwrap();
+    let cube = LinearOctree::from_voxels(2, [0, 0, 0], (0..64).map(|i| [i % 4, i / 4 % 4, i / 16]))
+        .unwrap();
     let start = Placement::at([0, 4, 4]);
     let end = Placement::at([40, 4, 4]);
     // Sampled at the two steps, nothing touches: a per-step test misses the wall.
     assert!(!intersects(&wall, &cube, start));
     assert!(!intersects(&wall, &cube, end));
-    let hit = first_contact(Placed::fixed(&wall), [0; 3], Placed::new(&cube, start), [40, 0, 0])
-        .expect("the swept test catches the wall");
+    let hit = first_contact(
+        Placed::fixed(&wall),
+        [0; 3],
+        Placed::new(&cube, start),
+        [40, 0, 0],
+    )
+    .expect("the swept test catches the wall");
     // The cube's front face x = 4 reaches the wall's face x = 20 after 16 of 40 voxels.
     assert_eq!(hit.time, Fraction::new(2, 5));
     assert_eq!(hit.a_block.min[0], 20);
@@ -242,12 +279,25 @@ fn thin_wall_tunnelling_is_caught_by_the_swept_test() {
 
 #[test]
 fn sliding_along_a_face_is_not_a_collision() {
-    let floor = LinearOctree::from_voxels(3, [0, 0, 0], (0..64).map(|i| [i % 8, i / 8, 0])).unwrap();
+    let floor =
+        LinearOctree::from_voxels(3, [0, 0, 0], (0..64).map(|i| [i % 8, i / 8, 0])).unwrap();
     let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
-    assert!(first_contact(Placed::fixed(&floor), [0; 3], Placed::new(&dot, Placement::at([0, 0, 1])), [7, 7, 0]).is_none());
+    assert!(first_contact(
+        Placed::fixed(&floor),
+        [0; 3],
+        Placed::new(&dot, Placement::at([0, 0, 1])),
+        [7, 7, 0]
+    )
+    .is_none());
     assert_eq!(clearance(&floor, &dot, Placement::at([3, 3, 1])), Some(0.0));
     // Already overlapping at the start: time 0.
-    let hit = first_contact(Placed::fixed(&floor), [0; 3], Placed::new(&dot, Placement::at([0, 0, 0])), [1, 0, 0]).unwrap();
+    let hit = first_contact(
+        Placed::fixed(&floor),
+        [0; 3],
+        Placed::new(&dot, Placement::at([0, 0, 0])),
+        [1, 0, 0],
+    )
+    .unwrap();
     assert_eq!(hit.time, Fraction::ZERO);
 }
 
@@ -258,7 +308,10 @@ fn empty_trees_never_interfere() {
     assert!(!intersects(&e, &f, Placement::default()));
     assert_eq!(clearance(&e, &f, Placement::default()), None);
     assert!(first_contact(Placed::fixed(&f), [0; 3], Placed::fixed(&e), [1, 1, 1]).is_none());
-    assert_eq!(interference(&f, &f, Placement::at([1, 2, 3]), false).overlap_voxels, 7 * 6 * 5);
+    assert_eq!(
+        interference(&f, &f, Placement::at([1, 2, 3]), false).overlap_voxels,
+        7 * 6 * 5
+    );
 }
 
 fn cube(side: i64) -> LinearOctree {
@@ -277,7 +330,16 @@ fn assert_same_run(x: &Simulation, y: &Simulation, seed: u64) {
     let key = |s: &Simulation| -> Vec<_> {
         s.contacts
             .iter()
-            .map(|c| (c.step, c.fraction, c.a.clone(), c.b.clone(), c.between_steps, c.time.to_bits()))
+            .map(|c| {
+                (
+                    c.step,
+                    c.fraction,
+                    c.a.clone(),
+                    c.b.clone(),
+                    c.between_steps,
+                    c.time.to_bits(),
+                )
+            })
             .collect()
     };
     assert_eq!(key(x), key(y), "seed {seed}");
@@ -296,8 +358,16 @@ fn assert_same_run(x: &Simulation, y: &Simulation, seed: u64) {
         out
     };
     for (f, g) in x.frames.iter().zip(&y.frames) {
-        assert_eq!((f.step, &f.offsets, &f.overlaps), (g.step, &g.offsets, &g.overlaps), "seed {seed}");
-        assert_eq!(voxels(&f.contact_boxes), voxels(&g.contact_boxes), "seed {seed}");
+        assert_eq!(
+            (f.step, &f.offsets, &f.overlaps),
+            (g.step, &g.offsets, &g.overlaps),
+            "seed {seed}"
+        );
+        assert_eq!(
+            voxels(&f.contact_boxes),
+            voxels(&g.contact_boxes),
+            "seed {seed}"
+        );
     }
 }
 
@@ -374,11 +444,19 @@ fn world_matches_brute_force_step_by_step() {
         let mut expected_contacts = Vec::new();
         for f in &sim.frames {
             let n = f.step;
-            let off: Vec<Voxel> = (0..3).map(|k| world.objects[k].trajectory.offset_at(n as f64 * 0.5)).collect();
+            let off: Vec<Voxel> = (0..3)
+                .map(|k| world.objects[k].trajectory.offset_at(n as f64 * 0.5))
+                .collect();
             assert_eq!(f.offsets, off, "seed {seed}");
             let mut overlaps = Vec::new();
-            let bodies: Vec<(Option<usize>, usize)> =
-                vec![(None, 0), (None, 1), (None, 2), (Some(0), 1), (Some(0), 2), (Some(1), 2)];
+            let bodies: Vec<(Option<usize>, usize)> = vec![
+                (None, 0),
+                (None, 1),
+                (None, 2),
+                (Some(0), 1),
+                (Some(0), 2),
+                (Some(1), 2),
+            ];
             for &(i, j) in &bodies {
                 let va = i.map_or(venv.clone(), |i| placed(i, off[i]));
                 let vb = placed(j, off[j]);
@@ -389,8 +467,9 @@ fn world_matches_brute_force_step_by_step() {
                         expected_contacts.push((0, Fraction::ZERO, i, j));
                     }
                 } else if n < steps {
-                    let next: Vec<Voxel> =
-                        (0..3).map(|k| world.objects[k].trajectory.offset_at((n + 1) as f64 * 0.5)).collect();
+                    let next: Vec<Voxel> = (0..3)
+                        .map(|k| world.objects[k].trajectory.offset_at((n + 1) as f64 * 0.5))
+                        .collect();
                     let mv = |k: usize| [0, 1, 2].map(|a| next[k][a] - off[k][a]);
                     let rel = {
                         let (mb, ma) = (mv(j), i.map_or([0; 3], mv));
@@ -438,7 +517,10 @@ fn minkowski_sum_matches_brute_force() {
         sum.assert_valid();
         let brute: HashSet<Voxel> = va
             .iter()
-            .flat_map(|p| vb.iter().map(move |q| [p[0] + q[0], p[1] + q[1], p[2] + q[2]]))
+            .flat_map(|p| {
+                vb.iter()
+                    .map(move |q| [p[0] + q[0], p[1] + q[1], p[2] + q[2]])
+            })
             .collect();
         let got: HashSet<Voxel> = sum.voxels().collect();
         assert_eq!(got, brute, "seed {seed}");
@@ -449,7 +531,11 @@ fn minkowski_sum_matches_brute_force() {
 fn rotated_and_reflected_trees_match_their_voxels() {
     for seed in 0..100u64 {
         let mut rng = seeded("rotated_and_reflected_trees_match_their_voxels", seed);
-        let o = [rng.random_range(-9..9), rng.random_range(-9..9), rng.random_range(-9..9)];
+        let o = [
+            rng.random_range(-9..9),
+            rng.random_range(-9..9),
+            rng.random_range(-9..9),
+        ];
         let (t, vs) = random_solid(&mut rng, 3, o);
         let r = Rotation::all()[rng.random_range(0..24)];
         let rt = rotated(&t, r);
@@ -477,9 +563,16 @@ fn config_obstacles_match_brute_force_interference() {
         for x in -12..12 {
             for y in -12..12 {
                 for z in -12..12 {
-                    let place = Placement { rotation: r, offset: [x, y, z] };
+                    let place = Placement {
+                        rotation: r,
+                        offset: [x, y, z],
+                    };
                     let brute = vobj.iter().any(|&v| senv.contains(&place.apply_voxel(v)));
-                    assert_eq!(cobs.contains([x, y, z]), brute, "seed {seed} at {x},{y},{z}");
+                    assert_eq!(
+                        cobs.contains([x, y, z]),
+                        brute,
+                        "seed {seed} at {x},{y},{z}"
+                    );
                 }
             }
         }
@@ -488,9 +581,19 @@ fn config_obstacles_match_brute_force_interference() {
 
 /// Every lattice position of the raw path, step by step, is free and in bounds; every
 /// smoothed segment is free by the brute-force swept test and by sampling.
-fn check_path(plan: &Plan, venv: &HashSet<Voxel>, vobj: &[Voxel], r: Rotation, bounds: (Voxel, Voxel), seed: u64) {
+fn check_path(
+    plan: &Plan,
+    venv: &HashSet<Voxel>,
+    vobj: &[Voxel],
+    r: Rotation,
+    bounds: (Voxel, Voxel),
+    seed: u64,
+) {
     let free = |p: Voxel| {
-        let place = Placement { rotation: r, offset: p };
+        let place = Placement {
+            rotation: r,
+            offset: p,
+        };
         (0..3).all(|a| bounds.0[a] <= p[a] && p[a] <= bounds.1[a])
             && vobj.iter().all(|&v| !venv.contains(&place.apply_voxel(v)))
     };
@@ -510,19 +613,27 @@ fn check_path(plan: &Plan, venv: &HashSet<Voxel>, vobj: &[Voxel], r: Rotation, b
     assert_eq!(steps, plan.steps, "seed {seed}: raw length");
     let venv_list: Vec<Voxel> = venv.iter().copied().collect();
     let moved = |p: Voxel| -> Vec<Voxel> {
-        let place = Placement { rotation: r, offset: p };
+        let place = Placement {
+            rotation: r,
+            offset: p,
+        };
         vobj.iter().map(|&v| place.apply_voxel(v)).collect()
     };
     for w in plan.waypoints.windows(2) {
         assert!(free(w[0]) && free(w[1]), "seed {seed}");
         let mv = [0, 1, 2].map(|a| w[1][a] - w[0][a]);
-        assert_eq!(first_contact_brute(&venv_list, &moved(w[0]), mv), None, "seed {seed}: segment {w:?}");
+        assert_eq!(
+            first_contact_brute(&venv_list, &moved(w[0]), mv),
+            None,
+            "seed {seed}: segment {w:?}"
+        );
         let start = moved(w[0]);
         for k in 0..=40 {
             let t = f64::from(k) / 40.0;
             let hit = start.iter().any(|q| {
-                venv.iter()
-                    .any(|e| (0..3).all(|a| (q[a] as f64 + t * mv[a] as f64 - e[a] as f64).abs() < 1.0))
+                venv.iter().any(|e| {
+                    (0..3).all(|a| (q[a] as f64 + t * mv[a] as f64 - e[a] as f64).abs() < 1.0)
+                })
             });
             assert!(!hit, "seed {seed}: segment {w:?} blocked at t = {t}");
         }
@@ -561,7 +672,10 @@ fn dense_shortest(free: &dyn Fn(Voxel) -> bool, from: Voxel, to: Voxel) -> Optio
 fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
     let mut outcomes = [0; 3];
     for seed in 0..120u64 {
-        let mut rng = seeded("plans_are_optimal_against_dense_dijkstra_and_collision_free", seed);
+        let mut rng = seeded(
+            "plans_are_optimal_against_dense_dijkstra_and_collision_free",
+            seed,
+        );
         // Walls with holes make mazes; plus random blocks.
         let side = 16i64;
         let mut env_set: HashSet<Voxel> = HashSet::new();
@@ -572,7 +686,8 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
             let hs = rng.random_range(0..=3);
             for u in 0..side {
                 for w in 0..side {
-                    if (hole[0]..hole[0] + hs).contains(&u) && (hole[1]..hole[1] + hs).contains(&w) {
+                    if (hole[0]..hole[0] + hs).contains(&u) && (hole[1]..hole[1] + hs).contains(&w)
+                    {
                         continue;
                     }
                     let mut v = [0; 3];
@@ -593,27 +708,44 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
         }
         let r = Rotation::all()[rng.random_range(0..24)];
         let obj_box = rotated(&obj, r).bbox().unwrap();
-        let bounds = ([0, 1, 2].map(|a| -obj_box.0[a]), [0, 1, 2].map(|a| side - 1 - obj_box.1[a]));
+        let bounds = (
+            [0, 1, 2].map(|a| -obj_box.0[a]),
+            [0, 1, 2].map(|a| side - 1 - obj_box.1[a]),
+        );
         let free = |p: Voxel| {
-            let place = Placement { rotation: r, offset: p };
+            let place = Placement {
+                rotation: r,
+                offset: p,
+            };
             (0..3).all(|a| bounds.0[a] <= p[a] && p[a] <= bounds.1[a])
-                && vobj.iter().all(|&v| !env_set.contains(&place.apply_voxel(v)))
+                && vobj
+                    .iter()
+                    .all(|&v| !env_set.contains(&place.apply_voxel(v)))
         };
         let pick = |rng: &mut Pcg64| [0, 1, 2].map(|a| rng.random_range(bounds.0[a]..=bounds.1[a]));
         let (from, to) = (pick(&mut rng), pick(&mut rng));
         let options = PlanOptions {
             rotation: r,
-            region: Some(Aabb { min: [0; 3], max: [side - 1; 3] }),
+            region: Some(Aabb {
+                min: [0; 3],
+                max: [side - 1; 3],
+            }),
             ..PlanOptions::default()
         };
         let got = plan(&env, &obj, from, to, &options);
         match (free(from), free(to)) {
             (false, _) => {
-                assert!(matches!(got, Err(NoPath::StartBlocked { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::StartBlocked { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 continue;
             }
             (true, false) => {
-                assert!(matches!(got, Err(NoPath::GoalBlocked { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::GoalBlocked { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 continue;
             }
             _ => {}
@@ -629,13 +761,19 @@ fn plans_are_optimal_against_dense_dijkstra_and_collision_free() {
                 }
             }
             None => {
-                assert!(matches!(got, Err(NoPath::Unreachable { .. })), "seed {seed}: {got:?}");
+                assert!(
+                    matches!(got, Err(NoPath::Unreachable { .. })),
+                    "seed {seed}: {got:?}"
+                );
                 outcomes[1] += 1;
             }
         }
     }
     // Found paths, enclosed goals and actual smoothing all occur.
-    assert!(outcomes[0] > 30 && outcomes[1] > 3 && outcomes[2] > 10, "{outcomes:?}");
+    assert!(
+        outcomes[0] > 30 && outcomes[1] > 3 && outcomes[2] > 10,
+        "{outcomes:?}"
+    );
 }
 
 #[test]
@@ -654,27 +792,69 @@ fn no_path_says_why() {
     let env = LinearOctree::from_voxels(4, [0, 0, 0], walls).unwrap();
     let dot = LinearOctree::from_voxels(0, [0, 0, 0], [[0, 0, 0]]).unwrap();
     let o = PlanOptions {
-        region: Some(Aabb { min: [0; 3], max: [15; 3] }),
+        region: Some(Aabb {
+            min: [0; 3],
+            max: [15; 3],
+        }),
         ..PlanOptions::default()
     };
     let e = plan(&env, &dot, [3, 3, 3], [12, 12, 12], &o).unwrap_err();
-    assert!(matches!(e, NoPath::Unreachable { cells: _, positions: 216 }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            NoPath::Unreachable {
+                cells: _,
+                positions: 216
+            }
+        ),
+        "{e:?}"
+    );
     assert!(e.to_string().starts_with("no path"));
-    assert!(matches!(plan(&env, &dot, [0, 3, 3], [4, 4, 4], &o), Err(NoPath::StartBlocked { overlap_voxels: 1 })));
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [7, 4, 4], &o), Err(NoPath::GoalBlocked { .. })));
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [16, 4, 4], &o), Err(NoPath::GoalOutOfBounds { .. })));
-    assert!(matches!(plan(&env, &dot, [-1, 3, 3], [4, 4, 4], &o), Err(NoPath::StartOutOfBounds { .. })));
+    assert!(matches!(
+        plan(&env, &dot, [0, 3, 3], [4, 4, 4], &o),
+        Err(NoPath::StartBlocked { overlap_voxels: 1 })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [7, 4, 4], &o),
+        Err(NoPath::GoalBlocked { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [16, 4, 4], &o),
+        Err(NoPath::GoalOutOfBounds { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [-1, 3, 3], [4, 4, 4], &o),
+        Err(NoPath::StartOutOfBounds { .. })
+    ));
     let big = LinearOctree::full(5, [0, 0, 0]).unwrap();
-    assert!(matches!(plan(&env, &big, [0; 3], [0; 3], &o), Err(NoPath::ObjectTooLarge)));
+    assert!(matches!(
+        plan(&env, &big, [0; 3], [0; 3], &o),
+        Err(NoPath::ObjectTooLarge)
+    ));
     let empty = LinearOctree::empty(1, [0, 0, 0]).unwrap();
-    assert!(matches!(plan(&env, &empty, [0; 3], [0; 3], &o), Err(NoPath::EmptyObject)));
+    assert!(matches!(
+        plan(&env, &empty, [0; 3], [0; 3], &o),
+        Err(NoPath::EmptyObject)
+    ));
     // Inside the box a path exists, and start = goal is the empty move.
     // The default region is the bounding box: going around the outside needs a margin.
     let d = PlanOptions::default();
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
-    let around = PlanOptions { margin: 1, ..PlanOptions::default() };
-    assert!(matches!(plan(&env, &dot, [3, 3, 3], [9, 3, 3], &around), Err(NoPath::Unreachable { .. })));
-    assert!(matches!(plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &d), Err(NoPath::Unreachable { .. })));
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [9, 3, 3], &d),
+        Err(NoPath::Unreachable { .. })
+    ));
+    let around = PlanOptions {
+        margin: 1,
+        ..PlanOptions::default()
+    };
+    assert!(matches!(
+        plan(&env, &dot, [3, 3, 3], [9, 3, 3], &around),
+        Err(NoPath::Unreachable { .. })
+    ));
+    assert!(matches!(
+        plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &d),
+        Err(NoPath::Unreachable { .. })
+    ));
     let p = plan(&env, &dot, [-1, 3, 3], [9, 3, 3], &around).unwrap();
     assert_eq!(p.steps, 10 + 2 * 4); // around the side: y from 3 to -1 and back
     assert_eq!(p.clearance, Some(0.0));

@@ -71,7 +71,10 @@ impl Node {
 
     /// The number of black voxels in the cell.
     pub fn voxel_count(&self, leaves: &[Leaf]) -> u64 {
-        leaves[self.lo..self.hi].iter().map(|l| l.voxel_count()).sum()
+        leaves[self.lo..self.hi]
+            .iter()
+            .map(|l| l.voxel_count())
+            .sum()
     }
 
     /// Writes the non-empty children of a gray cell into `out`, in label order, and

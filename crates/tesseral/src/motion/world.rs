@@ -14,8 +14,8 @@ use serde::Serialize;
 
 use super::interfere::{interference_placed, Aabb, Placed, Placement};
 use super::orient::Rotation;
-use super::sweep::{first_contact, Fraction};
 use super::plan::rotated;
+use super::sweep::{first_contact, Fraction};
 use crate::linear::{LinearOctree, OctreeError};
 use crate::Voxel;
 
@@ -194,7 +194,12 @@ impl World {
         }
     }
 
-    fn placed<'s>(&'s self, current: &'s [LinearOctree], i: Option<usize>, offsets: &[Voxel]) -> Placed<'s> {
+    fn placed<'s>(
+        &'s self,
+        current: &'s [LinearOctree],
+        i: Option<usize>,
+        offsets: &[Voxel],
+    ) -> Placed<'s> {
         match i {
             None => Placed::fixed(&self.environment),
             Some(i) if self.method == TranslationMethod::Linear => Placed::fixed(&current[i]),

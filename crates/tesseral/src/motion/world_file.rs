@@ -173,7 +173,9 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
         let field = |f: &str, m: String| invalid(format!("object {name:?}, {f}: {m}"));
         let rotation = match &o.rotate {
             None => Rotation::IDENTITY,
-            Some(s) => s.parse().map_err(|e: super::RotationError| field("rotate", e.to_string()))?,
+            Some(s) => s
+                .parse()
+                .map_err(|e: super::RotationError| field("rotate", e.to_string()))?,
         };
         let finite = |p: &[f64; 3]| p.iter().all(|c| c.is_finite() && c.abs() < MAX_COORD);
         let trajectory = match (o.waypoints, o.start, o.velocity) {
@@ -184,7 +186,10 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
                 let mut out = Vec::with_capacity(points.len());
                 for w in points {
                     if !finite(&w.at) || !w.time.is_finite() {
-                        return Err(field("waypoints", "positions and times must be finite and below 2^40".into()));
+                        return Err(field(
+                            "waypoints",
+                            "positions and times must be finite and below 2^40".into(),
+                        ));
                     }
                     if out.last().is_some_and(|&(t, _)| w.time < t) {
                         return Err(field("waypoints", "times must not decrease".into()));
@@ -203,7 +208,10 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
                 let start = start.unwrap_or([0.0; 3]);
                 let velocity = velocity.unwrap_or([0.0; 3]);
                 if !finite(&start) || !finite(&velocity) {
-                    return Err(field("start/velocity", "must be finite and below 2^40".into()));
+                    return Err(field(
+                        "start/velocity",
+                        "must be finite and below 2^40".into(),
+                    ));
                 }
                 Trajectory::Constant { start, velocity }
             }
