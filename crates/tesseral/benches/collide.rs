@@ -43,7 +43,9 @@ fn ball(r: i64) -> Vec<Voxel> {
     for x in 0..2 * r {
         for y in 0..2 * r {
             for z in 0..2 * r {
-                let d = (2 * x + 1 - 2 * r).pow(2) + (2 * y + 1 - 2 * r).pow(2) + (2 * z + 1 - 2 * r).pow(2);
+                let d = (2 * x + 1 - 2 * r).pow(2)
+                    + (2 * y + 1 - 2 * r).pow(2)
+                    + (2 * z + 1 - 2 * r).pow(2);
                 if d < r2 {
                     v.push([x, y, z]);
                 }
@@ -71,7 +73,10 @@ fn terrain() -> Vec<Voxel> {
     let mut v = Vec::new();
     for x in 0..128i64 {
         for y in 0..128i64 {
-            let h = 20.0 + 8.0 * (x as f64 / 9.0).sin() + 6.0 * (y as f64 / 7.0).cos() + 3.0 * ((x + y) as f64 / 4.0).sin();
+            let h = 20.0
+                + 8.0 * (x as f64 / 9.0).sin()
+                + 6.0 * (y as f64 / 7.0).cos()
+                + 3.0 * ((x + y) as f64 / 4.0).sin();
             for z in 0..h as i64 {
                 v.push([x, y, z]);
             }
@@ -94,18 +99,39 @@ impl SplitMix64 {
 
 fn porous(seed: u64) -> Vec<Voxel> {
     let mut r = SplitMix64(seed);
-    cube(64)
-        .into_iter()
-        .filter(|_| r.next() % 10 < 3)
-        .collect()
+    cube(64).into_iter().filter(|_| r.next() % 10 < 3).collect()
 }
 
 fn pairs() -> Vec<Pair> {
     vec![
-        Pair { name: "spheres", a: ball(32), b: ball(32), start: [0, 0, 0], dir: [1, 1, 0] },
-        Pair { name: "room", a: room(), b: cube(16), start: [56, 56, 56], dir: [1, 0, 0] },
-        Pair { name: "terrain", a: terrain(), b: ball(16), start: [48, 48, 0], dir: [0, 0, 1] },
-        Pair { name: "porous", a: porous(1), b: porous(2), start: [0, 0, 0], dir: [1, 1, 1] },
+        Pair {
+            name: "spheres",
+            a: ball(32),
+            b: ball(32),
+            start: [0, 0, 0],
+            dir: [1, 1, 0],
+        },
+        Pair {
+            name: "room",
+            a: room(),
+            b: cube(16),
+            start: [56, 56, 56],
+            dir: [1, 0, 0],
+        },
+        Pair {
+            name: "terrain",
+            a: terrain(),
+            b: ball(16),
+            start: [48, 48, 0],
+            dir: [0, 0, 1],
+        },
+        Pair {
+            name: "porous",
+            a: porous(1),
+            b: porous(2),
+            start: [0, 0, 0],
+            dir: [1, 1, 1],
+        },
     ]
 }
 
@@ -131,10 +157,22 @@ fn prepare(p: Pair) -> Prepared {
         k += 1;
         assert!(k < 10_000, "{}: no flip along the approach", p.name);
     }
-    let (touching, separated) = if first { (at(k), at(k + 4)) } else { (at(k + 1), at(k - 3)) };
+    let (touching, separated) = if first {
+        (at(k), at(k + 4))
+    } else {
+        (at(k + 1), at(k - 3))
+    };
     assert!(intersects(&a, &b, Placement::at(touching)));
     assert!(!intersects(&a, &b, Placement::at(separated)));
-    Prepared { name: p.name, a, b, va: p.a, vb: p.b, touching, separated }
+    Prepared {
+        name: p.name,
+        a,
+        b,
+        va: p.a,
+        vb: p.b,
+        touching,
+        separated,
+    }
 }
 
 /// Mean nanoseconds per call, best of 5 batches of at least 0.2 s.
@@ -166,7 +204,12 @@ fn write_pairs(dir: &Path, prepared: &[Prepared]) {
             std::fs::write(dir.join(format!("{}_{side}.xyz", p.name)), s).unwrap();
         }
         for (state, o, hit) in [("touching", p.touching, 1), ("separated", p.separated, 0)] {
-            writeln!(manifest, "{} {state} {} {} {} {hit}", p.name, o[0], o[1], o[2]).unwrap();
+            writeln!(
+                manifest,
+                "{} {state} {} {} {} {hit}",
+                p.name, o[0], o[1], o[2]
+            )
+            .unwrap();
         }
     }
     std::fs::write(dir.join("pairs.txt"), manifest).unwrap();
@@ -248,7 +291,16 @@ fn main() {
     let env = LinearOctree::from_voxels_fitted(&room_voxels).unwrap();
     let crate16 = LinearOctree::from_voxels_fitted(&cube(16)).unwrap();
     c.bench_function("plan/room_door", |b| {
-        b.iter(|| plan(&env, &crate16, [8, 8, 8], [100, 100, 8], &PlanOptions::default()).unwrap())
+        b.iter(|| {
+            plan(
+                &env,
+                &crate16,
+                [8, 8, 8],
+                [100, 100, 8],
+                &PlanOptions::default(),
+            )
+            .unwrap()
+        })
     });
     c.final_summary();
 }

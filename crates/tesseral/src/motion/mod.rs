@@ -16,24 +16,24 @@
 //! when they share a voxel (interior), and *touch* when their closed cubes meet
 //! without sharing interior.
 
+mod draw;
 mod interfere;
 mod orient;
-mod draw;
 mod plan;
 mod sweep;
 mod traverse;
 mod world;
 mod world_file;
 
+pub use draw::{
+    render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
+    SWEPT_COLOUR,
+};
 pub use interfere::{
     clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
 pub use orient::{Rotation, RotationError};
-pub use draw::{
-    render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
-    SWEPT_COLOUR,
-};
 pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
