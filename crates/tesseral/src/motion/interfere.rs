@@ -423,3 +423,101 @@ impl Clearance<'_> {
         }
     }
 }
+
+/// [`clearance`] with `b` at a real-valued offset (after its rotation): the least
+/// Euclidean distance between the closed unit cubes of the two solids, or `None`
+/// when either is empty. Used to measure the clearance along smoothed paths, whose
+/// points need not be lattice points.
+#[must_use]
+pub fn clearance_at(
+    a: &LinearOctree,
+    b: &LinearOctree,
+    rotation: Rotation,
+    offset: [f64; 3],
+) -> Option<f64> {
+    let ra = Node::tight_root(a)?;
+    let rb = Node::tight_root(b)?;
+    let mut c = ClearanceF {
+        a: a.leaves(),
+        b: b.leaves(),
+        rotation,
+        offset,
+        best: f64::INFINITY,
+    };
+    c.visit(ra, rb);
+    Some(c.best.sqrt())
+}
+
+struct ClearanceF<'t> {
+    a: &'t [Leaf],
+    b: &'t [Leaf],
+    rotation: Rotation,
+    offset: [f64; 3],
+    best: f64,
+}
+
+impl ClearanceF<'_> {
+    fn a_box(n: &Node) -> ([f64; 3], [f64; 3]) {
+        let lo = n.min.map(|c| c as f64);
+        let s = n.side() as f64;
+        (lo, [lo[0] + s, lo[1] + s, lo[2] + s])
+    }
+
+    fn b_box(&self, n: &Node) -> ([f64; 3], [f64; 3]) {
+        let r = self.rotation.apply_cube(n.min, n.side());
+        let lo = [0, 1, 2].map(|a| r[a] as f64 + self.offset[a]);
+        let s = n.side() as f64;
+        (lo, [lo[0] + s, lo[1] + s, lo[2] + s])
+    }
+
+    fn gap2(x: &([f64; 3], [f64; 3]), y: &([f64; 3], [f64; 3])) -> f64 {
+        (0..3)
+            .map(|a| {
+                let g = (y.0[a] - x.1[a]).max(x.0[a] - y.1[a]).max(0.0);
+                g * g
+            })
+            .sum()
+    }
+
+    fn visit(&mut self, na: Node, nb: Node) {
+        let ba = Self::a_box(&na);
+        let bb = self.b_box(&nb);
+        let d = Self::gap2(&ba, &bb);
+        if d >= self.best {
+            return;
+        }
+        let fa = na.is_full(self.a);
+        let fb = nb.is_full(self.b);
+        if fa && fb {
+            self.best = d;
+            return;
+        }
+        let mut kids = [na; 8];
+        let mut order = [(0f64, 0usize); 8];
+        let split_a = !fa && (fb || na.k >= nb.k);
+        let n = if split_a {
+            na.children(self.a, &mut kids)
+        } else {
+            nb.children(self.b, &mut kids)
+        };
+        for i in 0..n {
+            order[i].0 = if split_a {
+                Self::gap2(&Self::a_box(&kids[i]), &bb)
+            } else {
+                Self::gap2(&ba, &self.b_box(&kids[i]))
+            };
+            order[i].1 = i;
+        }
+        order[..n].sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        for &(d, i) in &order[..n] {
+            if d >= self.best {
+                break;
+            }
+            if split_a {
+                self.visit(kids[i], nb);
+            } else {
+                self.visit(na, kids[i]);
+            }
+        }
+    }
+}

@@ -54,6 +54,13 @@ impl Rotation {
         neg: [false; 3],
     };
 
+    /// The point reflection `p -> -p` (determinant −1, so not a rotation): used
+    /// internally to reflect a solid for Minkowski differences.
+    pub(crate) const REFLECTION: Rotation = Rotation {
+        perm: [0, 1, 2],
+        neg: [true; 3],
+    };
+
     /// All 24 rotations, identity first, in a fixed order (so an index names one).
     #[must_use]
     pub fn all() -> Vec<Rotation> {

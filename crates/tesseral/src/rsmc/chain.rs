@@ -271,9 +271,9 @@ impl<L: Lattice> Chain<L> {
             }
         }
         let sign: i128 = if shrink { -1 } else { 1 };
-        for a in 0..3 {
-            self.sum[a] += sign * i128::from(p[a]);
-            self.sum_sq += sign * i128::from(p[a]) * i128::from(p[a]);
+        for (sum, &x) in self.sum.iter_mut().zip(&p) {
+            *sum += sign * i128::from(x);
+            self.sum_sq += sign * i128::from(x) * i128::from(x);
         }
         if shrink {
             self.lattice.remove(p);

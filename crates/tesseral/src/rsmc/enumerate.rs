@@ -185,6 +185,17 @@ mod tests {
     }
 
     #[test]
+    #[ignore = "prints the table for docs/rsmc.md"]
+    fn print_counts() {
+        let c = sphere_counts(24).unwrap();
+        for (a, n) in c.iter().enumerate() {
+            if *n > 0 {
+                println!("c[{a}] = {n}");
+            }
+        }
+    }
+
+    #[test]
     fn limit_is_enforced() {
         assert!(matches!(sphere_counts(100), Err(RsmcError::TooLarge(_))));
     }
