@@ -183,3 +183,36 @@ pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
     w.write_all(b"BIN\0")?;
     w.write_all(&bin)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn glb_is_well_formed() {
+        let tree =
+            crate::linear::LinearOctree::from_voxels(2, [0; 3], [[0, 0, 0], [1, 1, 1]]).unwrap();
+        let m = crate::mesh::boundary_mesh(&tree);
+        let mut b = Vec::new();
+        write_glb(&mut b, &m).unwrap();
+        let u = |i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as usize;
+        assert_eq!(&b[..4], b"glTF");
+        assert_eq!((u(4), u(8)), (2, b.len()));
+        let json_len = u(12);
+        assert_eq!(&b[16..20], b"JSON");
+        assert_eq!(json_len % 4, 0);
+        let json: serde_json::Value = serde_json::from_slice(&b[20..20 + json_len]).unwrap();
+        let bin_at = 20 + json_len;
+        assert_eq!(&b[bin_at + 4..bin_at + 8], b"BIN\0");
+        let bin_len = u(bin_at);
+        assert_eq!(bin_at + 8 + bin_len, b.len());
+        assert_eq!(json["buffers"][0]["byteLength"], bin_len);
+        assert_eq!(json["accessors"][0]["count"], m.positions.len());
+        assert_eq!(json["accessors"][1]["count"], 3 * m.triangles.len());
+        let views = &json["bufferViews"];
+        let end =
+            views[1]["byteOffset"].as_u64().unwrap() + views[1]["byteLength"].as_u64().unwrap();
+        assert!(end as usize <= bin_len);
+        assert_eq!(views[0]["byteLength"], 12 * m.positions.len());
+    }
+}
