@@ -19,7 +19,8 @@
 //!   per z-slice, bit `x + 8y`), one cache line. So a lookup touches about
 //!   `k − 3` nodes and one block, and a stored voxel costs a bit, not a node.
 //! - With [`DynamicOctree::with_faces`], every exposed face is kept in one dense list
-//!   with back-pointers (a hash map from face to index), so a random face is drawn
+//!   with back-pointers (one record of six list positions per surface voxel, found
+//!   through a compact hash index), so a random face is drawn
 //!   in O(1) and a face is removed by `swap_remove` in O(1) (Libes §5).
 //!
 //! # Invariants (checked by [`DynamicOctree::assert_valid`])
