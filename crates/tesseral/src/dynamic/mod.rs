@@ -1251,7 +1251,8 @@ impl DynamicOctree {
     }
 
     /// Every black voxel, in tesseral (Morton) order relative to the root corner.
-    /// O(voxels + nodes).
+    /// O(voxels + nodes): full octants are enumerated voxel by voxel, so for large
+    /// solids prefer [`DynamicOctree::to_linear`], whose cost follows the surface.
     ///
     /// ```
     /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[1, 0, 0], [0, 0, 0]]);
@@ -1259,7 +1260,7 @@ impl DynamicOctree {
     /// ```
     #[must_use]
     pub fn voxels(&self) -> Vec<Voxel> {
-        let mut out = Vec::with_capacity(usize::try_from(self.voxels).unwrap_or(0));
+        let mut out = Vec::with_capacity(usize::try_from(self.voxels.min(1 << 24)).unwrap_or(0));
         self.visit(|base, level, bits| match bits {
             None => {
                 let side = 1u64 << level;
