@@ -128,6 +128,7 @@ fn trajectories_keep_sphere_topology() {
             assert_eq!(report.volume, chain.volume(), "seed {seed}");
             assert_eq!(report.euler(), 2);
             chain.lattice().assert_valid();
+            chain.assert_valid();
         }
         let c = chain.counters();
         assert_eq!(c.steps, 20_000);
@@ -395,6 +396,7 @@ fn octree_and_dense_give_identical_trajectories() {
             b.radius_of_gyration().to_bits()
         );
         b.lattice().assert_valid();
+        b.assert_valid();
         // And after a checkpoint round trip on the other backend.
         let cp = a.checkpoint();
         let mut c = Chain::from_checkpoint(DynamicOctree::with_faces(), cp).unwrap();
