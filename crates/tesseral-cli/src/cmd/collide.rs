@@ -5,13 +5,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{clearance, interference, Aabb, Placement, Rotation};
+use tesseral::motion::{clearance, interference, read_solid, Aabb, Placement, Rotation};
 use tesseral::Voxel;
 
 /// Arguments of `tesseral collide`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The first octree file; it stays where it is.
+    /// The first octree file (any octree format, or a .tss scene); it stays where it is.
     a: PathBuf,
     /// The second octree file, turned by --rotate and then moved by --offset.
     b: PathBuf,
@@ -58,8 +58,8 @@ struct Report {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let a = tesseral::io::read_octree(&args.a).context("reading the first octree")?;
-    let b = tesseral::io::read_octree(&args.b).context("reading the second octree")?;
+    let a = read_solid(&args.a).context("reading the first octree")?;
+    let b = read_solid(&args.b).context("reading the second octree")?;
     let place = Placement {
         rotation: args.rotate,
         offset: args.offset,

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{plan, Aabb, Placed, Placement, PlanOptions, Rotation, TopView};
+use tesseral::motion::{plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
 use super::collide::parse_voxel;
@@ -40,9 +41,17 @@ pub struct Args {
     /// Print JSON.
     #[arg(long)]
     json: bool,
-    /// Write a top-down PNG picture of the path through the scene.
+    /// Render a PNG picture of the path through the scene: the environment grey,
+    /// the object green at the start and blue at the goal, the path yellow.
     #[arg(short = 'o', long = "output", value_name = "PATH.png")]
     output: Option<PathBuf>,
+    /// The view of the picture: top, iso, front or side.
+    #[arg(long, default_value = "top", value_parser = parse_view)]
+    view: View,
+}
+
+fn parse_view(s: &str) -> Result<View, String> {
+    View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
 }
 
 fn parse_region(s: &str) -> Result<Aabb, String> {
@@ -87,8 +96,8 @@ struct NotFound {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let env = tesseral::io::read_octree(&args.env).context("reading the environment")?;
-    let obj = tesseral::io::read_octree(&args.obj).context("reading the object")?;
+    let env = read_solid(&args.env).context("reading the environment")?;
+    let obj = read_solid(&args.obj).context("reading the object")?;
     let options = PlanOptions {
         rotation: args.rotate,
         smooth: !args.no_smooth,
@@ -167,38 +176,12 @@ fn picture(
     args: &Args,
     waypoints: Option<&[Voxel]>,
 ) -> Result<()> {
-    let turned = tesseral::motion::rotated(obj, args.rotate);
-    let (olo, ohi) = turned.bbox().unwrap_or(([0; 3], [0; 3]));
-    let (mut lo, mut hi) = env.bbox().unwrap_or((args.from, args.from));
-    for p in [args.from, args.to] {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a] + olo[a]);
-            hi[a] = hi[a].max(p[a] + ohi[a]);
-        }
-    }
-    let mut view = TopView::new(Aabb { min: lo, max: hi });
-    view.draw_tree(Placed::fixed(env), [150, 150, 150]);
-    for (p, color) in [(args.from, [30, 170, 80]), (args.to, [40, 110, 230])] {
-        view.draw_tree(
-            Placed::new(
-                obj,
-                Placement {
-                    rotation: args.rotate,
-                    offset: p,
-                },
-            ),
-            color,
-        );
-    }
-    if let Some(w) = waypoints {
-        // Through the centre of the object's box.
-        let c = [0, 1, 2].map(|a| (olo[a] + ohi[a] + 1) as f64 / 2.0);
-        let pts: Vec<[f64; 3]> = w
-            .iter()
-            .map(|p| [0, 1, 2].map(|a| p[a] as f64 + c[a]))
-            .collect();
-        view.draw_polyline(&pts, [240, 200, 0]);
-    }
-    view.write_png(path)
+    let opts = RenderOptions {
+        camera: Camera::view(args.view),
+        ..RenderOptions::default()
+    };
+    let img = render_plan(env, obj, args.rotate, args.from, args.to, waypoints, &opts)
+        .context("drawing the path")?;
+    img.write_png(path)
         .with_context(|| format!("writing {}", path.display()))
 }

@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{read_world, Aabb, Body, Frame, Placed, Placement, TopView};
+use tesseral::motion::{read_world, render_frame, Aabb, Body, Frame};
+use tesseral::render::{Camera, RenderOptions, View};
 
 /// Arguments of `tesseral simulate`.
 #[derive(clap::Args)]
@@ -16,10 +17,20 @@ pub struct Args {
     /// Print JSON: every contact and every step.
     #[arg(long)]
     json: bool,
-    /// Write a top-down PNG picture of every step into this folder (created if
-    /// missing), contacts marked in red.
+    /// Render a PNG picture of every step into this folder (created if missing):
+    /// objects in colour, overlaps and objects in contact red, blocks hit between
+    /// steps magenta.
     #[arg(long, value_name = "DIR")]
     frames: Option<PathBuf>,
+    /// The view of the frames: iso, front, top or side.
+    #[arg(long, default_value = "iso", value_parser = parse_view)]
+    view: View,
+    /// The frames' width in pixels.
+    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    width: u32,
+    /// The frames' height in pixels.
+    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    height: u32,
 }
 
 #[derive(Serialize)]
@@ -50,14 +61,9 @@ fn name(b: &Body) -> String {
     }
 }
 
-const PALETTE: [[u8; 3]; 6] = [
-    [40, 110, 230],
-    [30, 170, 80],
-    [230, 150, 20],
-    [150, 60, 200],
-    [20, 170, 180],
-    [200, 80, 130],
-];
+fn parse_view(s: &str) -> Result<View, String> {
+    View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
+}
 
 pub fn run(args: Args) -> Result<()> {
     let wf = read_world(&args.world).context("reading the world file")?;
@@ -66,7 +72,13 @@ pub fn run(args: Args) -> Result<()> {
         .simulate(wf.time_step, wf.steps)
         .context("keeping the objects' octrees current")?;
     if let Some(dir) = &args.frames {
-        write_frames(dir, world, &sim)?;
+        write_frames(
+            dir,
+            world,
+            &sim,
+            args.view,
+            (args.width as usize, args.height as usize),
+        )?;
     }
     let contacts: Vec<ContactOut> = sim
         .contacts
@@ -122,40 +134,16 @@ fn write_frames(
     dir: &std::path::Path,
     world: &tesseral::motion::World,
     sim: &tesseral::motion::Simulation,
+    view: View,
+    size: (usize, usize),
 ) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    // One view for the whole run: the box around everything at every step.
-    let mut lo = [i64::MAX; 3];
-    let mut hi = [i64::MIN; 3];
-    let mut grow = |b: Option<(tesseral::Voxel, tesseral::Voxel)>| {
-        if let Some((l, h)) = b {
-            for a in 0..3 {
-                lo[a] = lo[a].min(l[a]);
-                hi[a] = hi[a].max(h[a]);
-            }
-        }
+    let opts = RenderOptions {
+        width: size.0,
+        height: size.1,
+        camera: Camera::view(view),
+        ..RenderOptions::default()
     };
-    grow(world.environment.bbox());
-    let object_boxes: Vec<_> = world
-        .objects
-        .iter()
-        .map(|o| tesseral::motion::rotated(&o.tree, o.rotation).bbox())
-        .collect();
-    for f in &sim.frames {
-        for (b, off) in object_boxes.iter().zip(&f.offsets) {
-            grow(b.map(|(l, h)| {
-                (
-                    [0, 1, 2].map(|a| l[a] + off[a]),
-                    [0, 1, 2].map(|a| h[a] + off[a]),
-                )
-            }));
-        }
-    }
-    if lo[0] > hi[0] {
-        lo = [0; 3];
-        hi = [0; 3];
-    }
-    let bounds = Aabb { min: lo, max: hi };
     let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bar = if show {
         indicatif::ProgressBar::new(sim.frames.len() as u64)
@@ -163,16 +151,6 @@ fn write_frames(
         indicatif::ProgressBar::hidden()
     };
     for f in &sim.frames {
-        let mut view = TopView::new(bounds);
-        view.draw_tree(Placed::fixed(&world.environment), [150, 150, 150]);
-        for (k, o) in world.objects.iter().enumerate() {
-            let place = Placement {
-                rotation: o.rotation,
-                offset: f.offsets[k],
-            };
-            view.draw_tree(Placed::new(&o.tree, place), PALETTE[k % PALETTE.len()]);
-        }
-        view.mark_boxes(&f.contact_boxes, [230, 20, 20]);
         // Contacts that begin during the move out of this step, where they happen.
         let swept: Vec<Aabb> = sim
             .contacts
@@ -180,9 +158,10 @@ fn write_frames(
             .filter(|c| c.step == f.step && c.between_steps)
             .map(|c| c.a_block)
             .collect();
-        view.mark_boxes(&swept, [255, 0, 255]);
+        let img = render_frame(world, f, &swept, &opts)
+            .with_context(|| format!("drawing step {}", f.step))?;
         let path = dir.join(format!("frame_{:05}.png", f.step));
-        view.write_png(&path)
+        img.write_png(&path)
             .with_context(|| format!("writing {}", path.display()))?;
         bar.inc(1);
     }

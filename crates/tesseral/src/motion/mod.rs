@@ -16,21 +16,24 @@
 //! when they share a voxel (interior), and *touch* when their closed cubes meet
 //! without sharing interior.
 
+mod draw;
 mod interfere;
 mod orient;
-mod picture;
 mod plan;
 mod sweep;
 mod traverse;
 mod world;
 mod world_file;
 
+pub use draw::{
+    render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
+    SWEPT_COLOUR,
+};
 pub use interfere::{
     clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
 pub use orient::{Rotation, RotationError};
-pub use picture::{Rgb, TopView};
 pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
@@ -38,7 +41,7 @@ pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
 pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
 };
-pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
+pub use world_file::{read_solid, read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 
 #[cfg(test)]
 mod tests;

@@ -390,8 +390,10 @@ fn world_catches_a_fast_object_tunnelling_through_a_thin_wall() {
         },
     });
     let sim = world.simulate(1.0, 3).unwrap();
-    world.method = TranslationMethod::Linear;
-    assert_same_run(&world.simulate(1.0, 3).unwrap(), &sim, 0);
+    for method in [TranslationMethod::Linear, TranslationMethod::Labels] {
+        world.method = method;
+        assert_same_run(&world.simulate(1.0, 3).unwrap(), &sim, 0);
+    }
     // No step samples the bullet inside the wall (x = 0, 25, 50, 75).
     assert!(sim.frames.iter().all(|f| f.overlaps.is_empty()));
     assert_eq!(sim.contacts.len(), 1);
@@ -427,8 +429,10 @@ fn world_matches_brute_force_step_by_step() {
         let steps = 8;
         let sim = world.simulate(0.5, steps).unwrap();
         // Keeping each object's tree current by linear translation gives the same run.
-        world.method = TranslationMethod::Linear;
-        assert_same_run(&world.simulate(0.5, steps).unwrap(), &sim, seed);
+        for method in [TranslationMethod::Linear, TranslationMethod::Labels] {
+            world.method = method;
+            assert_same_run(&world.simulate(0.5, steps).unwrap(), &sim, seed);
+        }
         assert_eq!(sim.frames.len(), steps as usize + 1);
         let placed = |k: usize, off: Voxel| -> Vec<Voxel> {
             let place = Placement {

@@ -17,6 +17,7 @@ use super::orient::Rotation;
 use super::plan::rotated;
 use super::sweep::{first_contact, Fraction};
 use crate::linear::{LinearOctree, OctreeError};
+use crate::pointer::PointerOctree;
 use crate::Voxel;
 
 /// How an object moves: its position (the offset added to its octree's voxels after
@@ -84,6 +85,18 @@ pub enum TranslationMethod {
     /// octree's translation by tesseral addition), so the stored tree always stands
     /// where the object is, as Ahuja & Nash keep a moving object's octree current.
     Linear,
+    /// As [`TranslationMethod::Linear`], but each object is kept as a pointer octree
+    /// and translated by Ahuja & Nash's label arithmetic
+    /// ([`crate::pointer::PointerOctree::translate`]: label increments with carries,
+    /// postorder in the direction of motion, compaction); its linear form is read
+    /// off after each move for the interference tests.
+    Labels,
+}
+
+impl TranslationMethod {
+    fn keeps_trees(self) -> bool {
+        self != TranslationMethod::Offset
+    }
 }
 
 /// One moving object.
@@ -202,7 +215,7 @@ impl World {
     ) -> Placed<'s> {
         match i {
             None => Placed::fixed(&self.environment),
-            Some(i) if self.method == TranslationMethod::Linear => Placed::fixed(&current[i]),
+            Some(i) if self.method.keeps_trees() => Placed::fixed(&current[i]),
             Some(i) => Placed::new(
                 &self.objects[i].tree,
                 Placement {
@@ -235,10 +248,11 @@ impl World {
     ///
     /// # Runtime
     /// `steps × pairs` interference and swept traversals, plus, with
-    /// [`TranslationMethod::Linear`], one translation of each object's tree per step.
+    /// [`TranslationMethod::Linear`] or [`TranslationMethod::Labels`], one translation
+    /// of each object's tree per step.
     ///
     /// # Errors
-    /// Only with [`TranslationMethod::Linear`]: [`OctreeError`] when a translated tree
+    /// Only when trees are kept current: [`OctreeError`] when a translated tree
     /// would outgrow [`crate::linear::MAX_DEPTH`] or its coordinates overflow.
     pub fn simulate(&self, time_step: f64, steps: u64) -> Result<Simulation, OctreeError> {
         let pairs = self.pairs();
@@ -253,10 +267,14 @@ impl World {
         let mut frames = Vec::new();
         let mut offsets = offsets_at(0);
         let mut current: Vec<LinearOctree> = Vec::new();
-        if self.method == TranslationMethod::Linear {
+        let mut pointers: Vec<PointerOctree> = Vec::new();
+        if self.method.keeps_trees() {
             for (o, off) in self.objects.iter().zip(&offsets) {
                 current.push(rotated(&o.tree, o.rotation).translate(*off)?);
             }
+        }
+        if self.method == TranslationMethod::Labels {
+            pointers = current.iter().map(PointerOctree::from_linear).collect();
         }
         let mut overlapping = vec![false; pairs.len()];
         for n in 0..=steps {
@@ -329,7 +347,7 @@ impl World {
                         self.placed(&current, Some(j), &next),
                         false,
                     ),
-                    TranslationMethod::Linear => {
+                    TranslationMethod::Linear | TranslationMethod::Labels => {
                         // The trees stand at the step's start: place them by the moves.
                         let at = |k: Option<usize>| match k {
                             None => Placed::fixed(&self.environment),
@@ -351,10 +369,22 @@ impl World {
             }
             step_contacts.sort_by(|x, y| x.fraction.cmp(&y.fraction));
             contacts.extend(step_contacts);
-            if self.method == TranslationMethod::Linear {
-                for (tree, mv) in current.iter_mut().zip(&moves) {
-                    if *mv != [0; 3] {
-                        *tree = tree.translate(*mv)?;
+            match self.method {
+                TranslationMethod::Offset => {}
+                TranslationMethod::Linear => {
+                    for (tree, mv) in current.iter_mut().zip(&moves) {
+                        if *mv != [0; 3] {
+                            *tree = tree.translate(*mv)?;
+                        }
+                    }
+                }
+                TranslationMethod::Labels => {
+                    for ((ptr, tree), mv) in pointers.iter_mut().zip(current.iter_mut()).zip(&moves)
+                    {
+                        if *mv != [0; 3] {
+                            ptr.translate(*mv)?;
+                            *tree = ptr.to_linear();
+                        }
                     }
                 }
             }
