@@ -389,7 +389,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             ao_samples: 4,
             ..RenderOptions::default()
         };
-        let image = render::render(&tree, None, &opts);
+        let image = render::render(&tree, render::Surface::default(), &opts);
         write_file(&args.out.join("surface.png"), |w| image.encode_png(w))?;
     }
     let k = chain.counters();

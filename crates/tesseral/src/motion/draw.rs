@@ -9,7 +9,7 @@ use super::orient::Rotation;
 use super::plan::rotated;
 use super::world::{Frame, World};
 use crate::linear::{LinearOctree, OctreeError};
-use crate::render::{render, Image, RenderOptions};
+use crate::render::{render, Image, RenderOptions, Surface};
 use crate::Voxel;
 
 /// The colour of the static environment.
@@ -82,7 +82,7 @@ pub fn render_frame(
         }
         ENVIRONMENT_COLOUR
     };
-    Ok(render(&all, Some(&shader), opts))
+    Ok(render(&all, Surface { colour: Some(&shader), normal: None }, opts))
 }
 
 /// Renders a planned path: the environment in grey, the object at the start in
@@ -135,5 +135,5 @@ pub fn render_plan(
             ENVIRONMENT_COLOUR
         }
     };
-    Ok(render(&all, Some(&shader), opts))
+    Ok(render(&all, Surface { colour: Some(&shader), normal: None }, opts))
 }
