@@ -190,61 +190,130 @@ const fn repeat(pattern: u64, width: u32) -> u64 {
     out
 }
 
-/// The 4 × 4 × 4 block at offset `r` (each in 0..4) inside the 8 × 8 × 8 region
-/// made of the eight blocks `m` (index `x + 2y + 4z`), all in layout `x + 4y + 16z`.
+/// How to cut a 4 × 4 × 4 block at offset `r` (each in 0..4) out of the 8 × 8 × 8
+/// region of eight blocks: the shifts and the masks of the bits that come from the
+/// lower block on each axis, computed once per resample.
+#[derive(Clone, Copy)]
+struct Cut {
+    r: [u32; 3],
+    low_x: u64,
+    low_y: u64,
+}
+
+impl Cut {
+    fn new(r: [i64; 3]) -> Self {
+        let r = r.map(|v| v as u32);
+        Self {
+            r,
+            low_x: repeat((1 << (4 - r[0])) - 1, 4),
+            low_y: repeat((1 << (4 * (4 - r[1]))) - 1, 16),
+        }
+    }
+
+    /// The block, from the eight blocks `m` (index `x + 2y + 4z`), all in layout
+    /// `x + 4y + 16z`.
+    #[inline]
+    fn extract(&self, m: [u64; 8]) -> u64 {
+        let [rx, ry, rz] = self.r;
+        let sx = |a: u64, b: u64| -> u64 {
+            if rx == 0 {
+                a
+            } else {
+                ((a >> rx) & self.low_x) | ((b << (4 - rx)) & !self.low_x)
+            }
+        };
+        let sy = |a: u64, b: u64| -> u64 {
+            if ry == 0 {
+                a
+            } else {
+                ((a >> (4 * ry)) & self.low_y) | ((b << (4 * (4 - ry))) & !self.low_y)
+            }
+        };
+        let p0 = sy(sx(m[0], m[1]), sx(m[2], m[3]));
+        if rz == 0 {
+            return p0;
+        }
+        let p1 = sy(sx(m[4], m[5]), sx(m[6], m[7]));
+        (p0 >> (16 * rz)) | (p1 << (16 * (4 - rz)))
+    }
+}
+
+/// Appends the canonical leaves of a 4 × 4 × 4 block (bit `x + 4y + 16z`) whose
+/// lowest voxel has code `code`.
 #[inline]
-fn extract(m: [u64; 8], r: [i64; 3]) -> u64 {
-    let sx = |a: u64, b: u64| -> u64 {
-        let r = r[0] as u32;
-        if r == 0 {
-            return a;
+fn emit_block(block: u64, code: u64, out: &mut Vec<Leaf>) {
+    if block == u64::MAX {
+        out.push(Leaf::new(code, 2));
+        return;
+    }
+    if block == 0 {
+        return;
+    }
+    for d in 0..8usize {
+        let x = block >> octant_shift(d);
+        // The octant's eight voxels as a byte, bit e for voxel label e.
+        let byte = (x & 0x3) | ((x >> 2) & 0xc) | ((x >> 12) & 0x30) | ((x >> 14) & 0xc0);
+        let c = code + 8 * d as u64;
+        if byte == 0xff {
+            out.push(Leaf::new(c, 1));
+            continue;
         }
-        let low = repeat((1 << (4 - r)) - 1, 4);
-        ((a >> r) & low) | ((b << (4 - r)) & !low)
-    };
-    let sy = |a: u64, b: u64| -> u64 {
-        let r = r[1] as u32;
-        if r == 0 {
-            return a;
+        let mut bits = byte;
+        while bits != 0 {
+            let e = u64::from(bits.trailing_zeros());
+            out.push(Leaf::new(c + e, 0));
+            bits &= bits - 1;
         }
-        let low = repeat((1 << (4 * (4 - r))) - 1, 16);
-        ((a >> (4 * r)) & low) | ((b << (4 * (4 - r))) & !low)
-    };
-    let sz = |a: u64, b: u64| -> u64 {
-        let r = r[2] as u32;
-        if r == 0 {
-            return a;
-        }
-        (a >> (16 * r)) | (b << (16 * (4 - r)))
-    };
-    let p0 = sy(sx(m[0], m[1]), sx(m[2], m[3]));
-    let p1 = sy(sx(m[4], m[5]), sx(m[6], m[7]));
-    sz(p0, p1)
+    }
 }
 
 /// For one depth: which parent-window entry and which child digit each of the eight
 /// window entries of each of the eight children reads.
-type ChildTable = [[(u8, u8); 8]; 8];
+/// Children's windows are drawn from a 3 × 3 × 3 grid of input cells of half the
+/// side (the parent window's children that the children's preimages can touch).
+#[derive(Clone, Copy)]
+struct ChildTable {
+    /// For each grid cell: the parent-window entry and the child digit it is.
+    grid: [(u8, u8); 27],
+    /// For each child and each of its window entries: the grid cell.
+    pick: [[u8; 8]; 8],
+}
+
+const EMPTY_TABLE: ChildTable = ChildTable {
+    grid: [(0, 0); 27],
+    pick: [[0; 8]; 8],
+};
 
 fn child_table(r: [i64; 3], k: u8) -> ChildTable {
     // r: the offset of the preimage inside window cell 0 at depth k (side 2^k).
+    // Along each axis the children's cells are u = base + d + e in the 4-wide grid
+    // of the parent window's children, base = r >> (k - 1); g = u - base is 0..=2.
     let half = 1i64 << (k - 1);
-    let mut t = [[(0u8, 0u8); 8]; 8];
-    for (d, row) in t.iter_mut().enumerate() {
+    let mut t = EMPTY_TABLE;
+    for (g, entry) in t.grid.iter_mut().enumerate() {
+        let (mut parent, mut digit) = (0u8, 0u8);
+        for (a, ga) in [g % 3, (g / 3) % 3, g / 9].into_iter().enumerate() {
+            let u = (r[a] >> (k - 1)) + ga as i64;
+            // u can reach 4 only for a grid cell no child picks: clamp it.
+            let u = u.min(3);
+            parent |= ((u >> 1) as u8) << a;
+            digit |= ((u & 1) as u8) << a;
+        }
+        *entry = (parent, digit);
+    }
+    for (d, row) in t.pick.iter_mut().enumerate() {
         for (e, entry) in row.iter_mut().enumerate() {
-            let (mut parent, mut digit) = (0u8, 0u8);
-            for a in 0..3 {
-                let da = ((d >> a) & 1) as i64;
-                let mut ea = ((e >> a) & 1) as i64;
+            let mut g = 0;
+            for (a, scale) in [1usize, 3, 9].into_iter().enumerate() {
+                let da = (d >> a) & 1;
+                let mut ea = (e >> a) & 1;
                 // An aligned axis needs one cell: duplicate entry 0.
                 if r[a] % half == 0 {
                     ea = 0;
                 }
-                let u = (r[a] >> (k - 1)) + da + ea;
-                parent |= ((u >> 1) as u8) << a;
-                digit |= ((u & 1) as u8) << a;
+                g += (da + ea) * scale;
             }
-            *entry = (parent, digit);
+            *entry = g as u8;
         }
     }
     t
@@ -256,8 +325,12 @@ const PARALLEL_MIN_SIZE_LOG2: u8 = 7;
 
 struct Resampler<'a> {
     index: &'a Index,
-    /// The offset of the preimage in its window at side 4.
-    r2: [i64; 3],
+    /// Cuts a child's 4 × 4 × 4 block out of its window at side 4.
+    cut: Cut,
+    /// The output depth and the input's leaf count: a guess at each parallel
+    /// part's size, so that parts rarely reallocate.
+    depth: u8,
+    input_leaves: usize,
     /// `tables[k]` serves the children of an output cell of side `2^k`.
     tables: Vec<ChildTable>,
 }
@@ -278,39 +351,46 @@ impl Resampler<'_> {
             for (mask, &slot) in m.iter_mut().zip(window.iter()) {
                 *mask = self.index.mask(slot);
             }
-            let block = extract(m, self.r2);
-            if block == u64::MAX {
-                out.push(Leaf::new(code, 2));
-            } else if block != 0 {
-                for d in 0..8usize {
-                    let oct = OCTANT << octant_shift(d);
-                    let c = code + 8 * d as u64;
-                    if block & oct == oct {
-                        out.push(Leaf::new(c, 1));
-                    } else if block & oct != 0 {
-                        for e in 0..8usize {
-                            if block >> (octant_shift(d) + octant_shift(e) / 2) & 1 == 1 {
-                                out.push(Leaf::new(c + e as u64, 0));
-                            }
-                        }
-                    }
-                }
-            }
+            emit_block(self.cut.extract(m), code, out);
             return;
         }
         let table = &self.tables[usize::from(k)];
         let child_cells = 1u64 << (3 * u32::from(k - 1));
+        let mut grid = [EMPTY; 27];
+        for (slot, &(p, digit)) in grid.iter_mut().zip(table.grid.iter()) {
+            *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+        }
+        if k == 3 {
+            // The children are 4 x 4 x 4 blocks: read the grid's occupancy masks
+            // once and cut each child's block out of them directly.
+            let mut masks = [0u64; 27];
+            for (m, &slot) in masks.iter_mut().zip(grid.iter()) {
+                *m = self.index.mask(slot);
+            }
+            for (d, row) in table.pick.iter().enumerate() {
+                let mut m = [0u64; 8];
+                for (mask, &g) in m.iter_mut().zip(row.iter()) {
+                    *mask = masks[usize::from(g)];
+                }
+                emit_block(self.cut.extract(m), code + 64 * d as u64, out);
+            }
+            if let Some(last) = out.pop() {
+                push_merging(out, last);
+            }
+            return;
+        }
         let mut windows = [[EMPTY; 8]; 8];
-        for (row, w) in table.iter().zip(windows.iter_mut()) {
-            for (&(p, digit), slot) in row.iter().zip(w.iter_mut()) {
-                *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+        for (row, w) in table.pick.iter().zip(windows.iter_mut()) {
+            for (&g, slot) in row.iter().zip(w.iter_mut()) {
+                *slot = grid[usize::from(g)];
             }
         }
         if k >= PARALLEL_MIN_SIZE_LOG2 {
             let parts: Vec<Vec<Leaf>> = (0..8usize)
                 .into_par_iter()
                 .map(|d| {
-                    let mut part = Vec::new();
+                    let share = self.input_leaves >> (3 * u32::from(self.depth - k + 1));
+                    let mut part = Vec::with_capacity(share + share / 4 + 16);
                     self.cell(k - 1, windows[d], code + d as u64 * child_cells, &mut part);
                     part
                 })
@@ -429,7 +509,7 @@ impl LinearOctree {
         let tables = (0..=depth)
             .map(|k| {
                 if k == 0 {
-                    [[(0, 0); 8]; 8]
+                    EMPTY_TABLE
                 } else {
                     child_table(r(k), k)
                 }
@@ -448,7 +528,9 @@ impl LinearOctree {
         });
         let resampler = Resampler {
             index: &index,
-            r2: r(2.min(depth)),
+            cut: Cut::new(r(2.min(depth))),
+            depth,
+            input_leaves: self.leaves.len(),
             tables,
         };
         let mut out = Vec::with_capacity(self.leaves.len());
