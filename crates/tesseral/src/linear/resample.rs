@@ -549,44 +549,58 @@ impl LinearOctree {
         all_inside: bool,
     ) -> Option<Vec<Leaf>> {
         let max_k = self.leaves.iter().map(|l| l.size_log2()).max().unwrap_or(0);
-        if delta.iter().any(|&v| v.rem_euclid(1 << max_k) != 0) {
+        // Cells of side 2^a move whole: a is the displacement's alignment, capped
+        // by the new space; every leaf must fit in such a cell.
+        let align = delta
+            .iter()
+            .map(|&v| if v == 0 { 64 } else { v.trailing_zeros() })
+            .min()
+            .unwrap_or(64);
+        let a = align.min(u32::from(depth)) as u8;
+        if max_k > a {
             return None;
         }
-        // New relative coordinate = old - delta, kept when inside [0, 2^depth).
-        let lo = delta;
         let side = 1i64 << depth;
-        // A leaf larger than the new space would be cut: not this path.
-        if max_k > depth {
-            return None;
-        }
-        // Kept leaves land inside [0, 2^depth), so the 21-bit modular tesseral sum
-        // is exact for them.
+        // The tesseral sum is taken modulo 2^21 per axis; kept cells land inside
+        // [0, 2^depth), where it is exact. The displacement's low `a` digits are
+        // zero, so a leaf's digits below `a` ride along unchanged.
         let t = arith::displacement_code([-delta[0], -delta[1], -delta[2]]);
-        let inside = |l: &Leaf| {
-            let v = code::decode(l.code());
-            (0..3).all(|a| {
-                let c = i64::from(v[a]) - lo[a];
+        let shift = 3 * u32::from(a);
+        let low = (1u64 << shift) - 1;
+        let inside = |cell: u64| {
+            let v = code::decode(cell);
+            (0..3).all(|i| {
+                let c = i64::from(v[i]) - delta[i];
                 c >= 0 && c < side
             })
         };
-        let mut moved: Vec<Leaf> = if all_inside {
-            self.leaves
-                .iter()
-                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
-                .collect()
-        } else {
-            self.leaves
-                .iter()
-                .filter(|l| inside(l))
-                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
-                .collect()
-        };
-        if !moved.is_sorted() {
-            super::sort::sort_leaves(&mut moved);
+        // Runs of leaves sharing a cell, with the cell's new code.
+        let mut runs: Vec<(u64, usize, usize)> = Vec::new();
+        let mut rest = &self.leaves[..];
+        let mut start = 0;
+        while let Some(first) = rest.first() {
+            let cell = first.code() & !low;
+            let end_code = cell + low + 1;
+            let n = rest.partition_point(|l| l.packed() < end_code << 1);
+            if all_inside || inside(cell) {
+                runs.push((arith::add(cell, t), start, start + n));
+            }
+            start += n;
+            rest = &rest[n..];
         }
-        let mut out = Vec::with_capacity(moved.len());
-        for l in moved {
-            push_merging(&mut out, l);
+        if !runs.is_sorted_by_key(|r| r.0) {
+            runs.sort_unstable_by_key(|r| r.0);
+        }
+        let mut out = Vec::with_capacity(self.leaves.len());
+        for (cell, i, j) in runs {
+            let part = &self.leaves[i..j];
+            if part.len() == 1 && part[0].size_log2() == a {
+                // A full cell: it may complete a parent with its new neighbours.
+                push_merging(&mut out, Leaf::new(cell, a));
+            } else {
+                // Partly full: canonical inside, and no parent can be completed.
+                out.extend(part.iter().map(|l| Leaf::new(cell | (l.code() & low), l.size_log2())));
+            }
         }
         Some(out)
     }
