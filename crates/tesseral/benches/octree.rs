@@ -85,7 +85,13 @@ fn translation(c: &mut Criterion) {
     let mut g = c.benchmark_group("translate");
     // Unaligned displacements (the targets), then aligned ones: (64, 0, 0)
     // and (32, -32, 0) are multiples of every leaf's side, so leaves move whole.
-    for by in [[50, 0, 0], [37, -11, 5], [1, 0, 0], [64, 0, 0], [32, -32, 0]] {
+    for by in [
+        [50, 0, 0],
+        [37, -11, 5],
+        [1, 0, 0],
+        [64, 0, 0],
+        [32, -32, 0],
+    ] {
         g.bench_function(format!("linear {by:?}"), |bch| {
             bch.iter(|| black_box(a.translate(by).unwrap()))
         });
@@ -96,7 +102,9 @@ fn translation(c: &mut Criterion) {
     for by in [[50, 0, 0], [37, -11, 5]] {
         g.bench_function(format!("rebuild_from_voxels {by:?}"), |bch| {
             bch.iter(|| {
-                let moved = voxels.iter().map(|v| [v[0] + by[0], v[1] + by[1], v[2] + by[2]]);
+                let moved = voxels
+                    .iter()
+                    .map(|v| [v[0] + by[0], v[1] + by[1], v[2] + by[2]]);
                 black_box(LinearOctree::from_voxels(9, [-256, -256, 0], moved).unwrap())
             })
         });

@@ -414,7 +414,15 @@ fn extreme(
                 min[1] + ((d as u64 >> 1) & 1) * half,
                 min[2] + ((d as u64 >> 2) & 1) * half,
             ];
-            extreme(part, code + d as u64 * child, k - 1, m, axis, reversed, best);
+            extreme(
+                part,
+                code + d as u64 * child,
+                k - 1,
+                m,
+                axis,
+                reversed,
+                best,
+            );
         }
     }
 }

@@ -47,7 +47,12 @@ struct Index {
 impl Index {
     /// Builds the index in one pass over the sorted leaves, keeping the path of open
     /// gray nodes on a stack.
-    fn new(leaves: &[Leaf], depth: u8) -> Self {
+    ///
+    /// With `compact` (for depth ≥ 2), the gray nodes of side 4 are the deepest
+    /// built: leaves of side 1 and 2 go straight into their 64-bit masks, and no
+    /// node of side 2 is made (they are most of the nodes, and only masks are read
+    /// at those levels).
+    fn new(leaves: &[Leaf], depth: u8, compact: bool) -> Self {
         let Some(first) = leaves.first() else {
             return Self {
                 nodes: Vec::new(),
@@ -67,8 +72,16 @@ impl Index {
         let d = u32::from(depth);
         let mut nodes: Vec<[u32; 8]> = Vec::with_capacity(leaves.len() / 3 + 1);
         let mut levels: Vec<u8> = Vec::with_capacity(leaves.len() / 3 + 1);
+        let mut masks: Vec<u64> = Vec::new();
         nodes.push([EMPTY; 8]);
         levels.push(depth);
+        if compact {
+            masks.reserve(leaves.len() / 6 + 1);
+            masks.push(0);
+        }
+        debug_assert!(!compact || depth >= 2);
+        // In compact mode, leaves below side 4 are held by the node of side 4.
+        let holder = if compact { d - 1 } else { d + 1 };
         let mut stack: Vec<u32> = Vec::with_capacity(usize::from(depth) + 1);
         stack.push(0);
         let mut prev = first.code();
@@ -81,18 +94,33 @@ impl Index {
             } else {
                 d - 1 - (63 - diff.leading_zeros()) / 3
             };
-            let keep = common.min(leaf_depth - 1) as usize + 1;
+            let small = leaf_depth >= holder;
+            let target = if small { holder } else { leaf_depth };
+            let keep = common.min(target - 1) as usize + 1;
             stack.truncate(keep);
-            while (stack.len() as u32) < leaf_depth {
+            while (stack.len() as u32) < target {
                 let parent = *stack.last().expect("root stays on the stack") as usize;
                 let digit = (c >> (3 * (d - stack.len() as u32))) & 7;
                 let id = nodes.len() as u32;
                 nodes.push([EMPTY; 8]);
                 levels.push(depth - stack.len() as u8);
+                if compact {
+                    masks.push(0);
+                }
                 nodes[parent][digit as usize] = id + 2;
                 stack.push(id);
             }
             let parent = *stack.last().expect("root stays on the stack") as usize;
+            if small {
+                let base = octant_shift(((c >> 3) & 7) as usize);
+                masks[parent] |= if leaf.size_log2() == 1 {
+                    OCTANT << base
+                } else {
+                    1 << (base + octant_shift((c & 7) as usize) / 2)
+                };
+                prev = c;
+                continue;
+            }
             let digit = (c >> (3 * (d - leaf_depth))) & 7;
             nodes[parent][digit as usize] = FULL;
             prev = c;
@@ -100,7 +128,7 @@ impl Index {
         Self {
             nodes,
             levels,
-            masks: Vec::new(),
+            masks,
             root: 2,
         }
     }
@@ -490,7 +518,8 @@ impl LinearOctree {
 
     /// The general top-down resample; `delta` is the new origin minus ours.
     pub(super) fn resample_general(&self, depth: u8, delta: [i64; 3]) -> Vec<Leaf> {
-        let mut index = Index::new(&self.leaves, self.depth);
+        let compact = self.depth >= 2 && depth >= 2;
+        let mut index = Index::new(&self.leaves, self.depth, compact);
         // Wrap the input in gray ancestors until it is at least as deep as the
         // output (the input space becomes child 0 of each new root), so windows at
         // every output depth can be read from the index.
@@ -500,10 +529,15 @@ impl LinearOctree {
             node[0] = index.root;
             index.nodes.push(node);
             index.levels.push(src_depth + 1);
+            if compact {
+                index.masks.push(0);
+            }
             index.root = index.nodes.len() as u32 + 1;
             src_depth += 1;
         }
-        index.fill_masks();
+        if !compact {
+            index.fill_masks();
+        }
         let side = |k: u8| 1i64 << k;
         let r = |k: u8| -> [i64; 3] { delta.map(|v| v.rem_euclid(side(k))) };
         let tables = (0..=depth)
@@ -599,7 +633,10 @@ impl LinearOctree {
                 push_merging(&mut out, Leaf::new(cell, a));
             } else {
                 // Partly full: canonical inside, and no parent can be completed.
-                out.extend(part.iter().map(|l| Leaf::new(cell | (l.code() & low), l.size_log2())));
+                out.extend(
+                    part.iter()
+                        .map(|l| Leaf::new(cell | (l.code() & low), l.size_log2())),
+                );
             }
         }
         Some(out)

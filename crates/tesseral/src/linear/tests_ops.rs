@@ -361,7 +361,11 @@ fn fast_sibling_check_matches_the_reference() {
         let mut run = Vec::new();
         let mut code = parent;
         for _ in 0..8 {
-            let kk = if next() % 10 == 0 { k.saturating_sub(1) } else { k };
+            let kk = if next() % 10 == 0 {
+                k.saturating_sub(1)
+            } else {
+                k
+            };
             if next() % 12 == 0 {
                 code += 1 << (3 * u32::from(kk));
             }
