@@ -11,9 +11,15 @@
 #![deny(missing_docs)]
 
 pub mod code;
+pub mod csg;
+pub mod dynamic;
 pub mod io;
 pub mod linear;
+pub mod mesh;
+pub mod motion;
 pub mod pointer;
+pub mod render;
+pub mod rsmc;
 
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];

@@ -1,38 +1,65 @@
-//! Tesseral addressing: (x, y, z) to and from tesseral (Morton) codes.
+//! Tesseral addressing and arithmetic: (x, y, z) to and from tesseral (Morton) codes,
+//! and translation by arithmetic on the codes themselves.
 //!
 //! A code interleaves the coordinate bits: bit `3i` is bit `i` of x, bit `3i+1` is
 //! bit `i` of y and bit `3i+2` is bit `i` of z. Read in octal, its digits are the
-//! child labels `x + 2y + 4z` on the path from the root, most significant first.
+//! child labels `x + 2y + 4z` on the path from the root, most significant first
+//! (Harakal & Chmúrny §3 "tesseral addressing"; Ahuja & Nash §3.1 labels).
 //!
-//! `u64` codes cover depth up to [`MAX_DEPTH_U64`] (21).
+//! * Widths: `u64` codes cover depth up to [`MAX_DEPTH_U64`] (21), `u128` codes up to
+//!   [`MAX_DEPTH_U128`] (42). Both implement [`CodeWord`]; everything else is generic
+//!   and written once.
+//! * Addressing: [`encode`]/[`decode`] (portable magic bits, inlined), and the slice
+//!   kernels in [`batch`] that pick BMI2 `pdep`/`pext` at run time ([`Backend`]).
+//!   Single codes use magic bits: a run-time CPU check per call, and a call that
+//!   cannot be inlined, would cost more than `pdep` saves; slices pay the check once.
+//! * Arithmetic: [`Space`] (a bounded space of `D` digits) adds, subtracts, negates,
+//!   steps and compares codes without decoding them; carries out of the top are
+//!   dropped and reported ([`Carried`]), or refused (`checked_*`).
+//! * The papers: [`digits`] computes their tables and keeps the digit-by-digit adder
+//!   as the reference; [`padic`] does the P-adic subtraction step by step;
+//!   [`notation`] reads and writes octal strings, including `...6062` for negative
+//!   (repeating) codes.
+
+mod arith;
+pub mod batch;
+pub mod digits;
+mod error;
+pub mod notation;
+pub mod padic;
+mod word;
+
+pub use arith::{Axis, Carried, Space};
+pub use batch::Backend;
+pub use error::{CodeError, ParseCodeError};
+pub use word::CodeWord;
 
 /// The deepest tree whose codes fit a `u64`: 21 octal digits, 63 bits.
 pub const MAX_DEPTH_U64: u32 = 21;
 
+/// The deepest tree whose codes fit a `u128`: 42 octal digits, 126 bits.
+pub const MAX_DEPTH_U128: u32 = 42;
+
 /// Spreads the low 21 bits of `v` so that bit `i` moves to bit `3i`.
+///
+/// ```
+/// assert_eq!(tesseral::code::dilate3(0b101), 0o101);
+/// ```
 #[inline]
 #[must_use]
 pub fn dilate3(v: u32) -> u64 {
-    let mut x = u64::from(v) & 0x1f_ffff;
-    x = (x | (x << 32)) & 0x001f_0000_0000_ffff;
-    x = (x | (x << 16)) & 0x001f_0000_ff00_00ff;
-    x = (x | (x << 8)) & 0x100f_00f0_0f00_f00f;
-    x = (x | (x << 4)) & 0x10c3_0c30_c30c_30c3;
-    x = (x | (x << 2)) & 0x1249_2492_4924_9249;
-    x
+    <u64 as CodeWord>::dilate(v)
 }
 
 /// Gathers bits `3i` of `d` into bit `i`: the inverse of [`dilate3`].
+///
+/// ```
+/// assert_eq!(tesseral::code::undilate3(0o101), 0b101);
+/// ```
 #[inline]
 #[must_use]
 pub fn undilate3(d: u64) -> u32 {
-    let mut x = d & 0x1249_2492_4924_9249;
-    x = (x | (x >> 2)) & 0x10c3_0c30_c30c_30c3;
-    x = (x | (x >> 4)) & 0x100f_00f0_0f00_f00f;
-    x = (x | (x >> 8)) & 0x001f_0000_ff00_00ff;
-    x = (x | (x >> 16)) & 0x001f_0000_0000_ffff;
-    x = (x | (x >> 32)) & 0x1f_ffff;
-    x as u32
+    d.undilate()
 }
 
 /// The tesseral code of `(x, y, z)`; each coordinate keeps its low 21 bits.
@@ -44,7 +71,7 @@ pub fn undilate3(d: u64) -> u32 {
 #[inline]
 #[must_use]
 pub fn encode(x: u32, y: u32, z: u32) -> u64 {
-    dilate3(x) | (dilate3(y) << 1) | (dilate3(z) << 2)
+    <u64 as CodeWord>::encode(x, y, z)
 }
 
 /// The coordinates `[x, y, z]` of a tesseral code.
@@ -55,36 +82,27 @@ pub fn encode(x: u32, y: u32, z: u32) -> u64 {
 #[inline]
 #[must_use]
 pub fn decode(code: u64) -> [u32; 3] {
-    [undilate3(code), undilate3(code >> 1), undilate3(code >> 2)]
+    code.decode()
+}
+
+/// The `u128` tesseral code of `(x, y, z)`; each coordinate keeps its low 42 bits.
+///
+/// ```
+/// let c = tesseral::code::encode_wide(1 << 41, 0, 3);
+/// assert_eq!(tesseral::code::decode_wide(c), [1 << 41, 0, 3]);
+/// ```
+#[inline]
+#[must_use]
+pub fn encode_wide(x: u64, y: u64, z: u64) -> u128 {
+    <u128 as CodeWord>::encode(x, y, z)
+}
+
+/// The coordinates `[x, y, z]` of a `u128` tesseral code.
+#[inline]
+#[must_use]
+pub fn decode_wide(code: u128) -> [u64; 3] {
+    code.decode()
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn naive_encode(x: u32, y: u32, z: u32) -> u64 {
-        (0..21).fold(0, |c, i| {
-            c | (u64::from(x >> i & 1) << (3 * i))
-                | (u64::from(y >> i & 1) << (3 * i + 1))
-                | (u64::from(z >> i & 1) << (3 * i + 2))
-        })
-    }
-
-    #[test]
-    fn encode_matches_bit_by_bit_reference() {
-        let mut s = 0x9e37_79b9_7f4a_7c15_u64;
-        for _ in 0..10_000 {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let (x, y, z) = (
-                (s >> 1) as u32 & 0x1f_ffff,
-                (s >> 22) as u32 & 0x1f_ffff,
-                (s >> 43) as u32 & 0x1f_ffff,
-            );
-            let c = encode(x, y, z);
-            assert_eq!(c, naive_encode(x, y, z));
-            assert_eq!(decode(c), [x, y, z]);
-        }
-    }
-}
+mod tests;

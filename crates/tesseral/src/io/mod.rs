@@ -1,18 +1,39 @@
 //! Reading and writing octrees in the formats people use, chosen by file extension.
 //!
-//! Every command that reads an octree goes through [`read_octree`], and every one that
-//! writes goes through [`write_octree`], so each format added here works everywhere.
+//! Every command that reads an octree goes through [`read_octree`] (or
+//! [`read_model`], which also keeps the voxel size, placement and colours a format
+//! carries), and every one that writes goes through [`write_octree`] /
+//! [`write_model`], so each format added here works everywhere.
 //! Files are written to a temporary name in the same folder and renamed into place
 //! ([`write_atomic`]), so a crash never leaves a half-written file where a good one
 //! stood.
+//!
+//! | extension | format | module |
+//! |---|---|---|
+//! | `.tess` | tesseral's native binary linear octree | [`native`] |
+//! | `.xyz` | plain voxel list | [`xyz`] |
+//! | `.binvox` | binvox run-length voxel grid | [`binvox`] |
+//! | `.vox` | MagicaVoxel, with palette colours | [`vox`] |
+//! | `.bt`, `.ot` | OctoMap binary and full occupancy trees | [`octomap`] |
+//! | `.stl`, `.obj`, `.ply` | meshes, voxelized on read, meshed on write | [`crate::mesh`] |
+//! | `.glb` | glTF binary mesh (write only) | [`crate::mesh`] |
 
+pub mod binvox;
+pub mod native;
+pub mod octomap;
+mod reframe;
+pub mod vox;
 pub mod xyz;
 
+pub use reframe::reframe;
+
+use std::collections::BTreeMap;
 use std::fs;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use crate::linear::{LinearOctree, OctreeError};
+use crate::Voxel;
 
 /// What can go wrong reading or writing a file.
 #[derive(Debug, thiserror::Error)]
@@ -62,18 +83,169 @@ pub enum FormatError {
         /// The underlying error.
         source: OctreeError,
     },
+    /// The file is well formed but exceeds a limit that protects memory and time
+    /// (grid size, voxel count, element count).
+    #[error("{path}: {message}")]
+    TooLarge {
+        /// The file.
+        path: PathBuf,
+        /// Which limit, and the value found.
+        message: String,
+    },
+    /// The octree cannot be expressed in the target format (too big for its grid,
+    /// too many colours), or the file uses a feature we do not read.
+    #[error("{path}: {message}")]
+    Unsupported {
+        /// The file.
+        path: PathBuf,
+        /// What cannot be expressed or read.
+        message: String,
+    },
+    /// A mesh that should bound a solid has open edges, so inside and outside are not
+    /// defined. Voxelize its surface only, or repair it.
+    #[error("{path}: mesh is not watertight: {open_edges} edge(s) are not shared by an even number of triangles (first near {example:?}); use --surface-only to voxelize the surface")]
+    NotWatertight {
+        /// The file.
+        path: PathBuf,
+        /// How many edges have an odd number of triangles.
+        open_edges: usize,
+        /// The coordinates of one end of one open edge.
+        example: [f64; 3],
+    },
 }
 
-/// The extensions [`read_octree`] and [`write_octree`] understand.
-pub const KNOWN_EXTENSIONS: &str = "xyz";
+impl FormatError {
+    pub(crate) fn corrupt(path: &Path, message: impl Into<String>) -> Self {
+        Self::Corrupt {
+            path: path.to_owned(),
+            message: message.into(),
+        }
+    }
+    pub(crate) fn too_large(path: &Path, message: impl Into<String>) -> Self {
+        Self::TooLarge {
+            path: path.to_owned(),
+            message: message.into(),
+        }
+    }
+    pub(crate) fn unsupported(path: &Path, message: impl Into<String>) -> Self {
+        Self::Unsupported {
+            path: path.to_owned(),
+            message: message.into(),
+        }
+    }
+    pub(crate) fn io(path: &Path, source: io::Error) -> Self {
+        Self::Io {
+            path: path.to_owned(),
+            source,
+        }
+    }
+    pub(crate) fn octree(path: &Path, source: OctreeError) -> Self {
+        Self::Octree {
+            path: path.to_owned(),
+            source,
+        }
+    }
+}
 
-/// Reads an octree from `path`, choosing the format by its extension.
+/// Where the voxel lattice sits in the world of a file: the corner of voxel
+/// `(i, j, k)` is `translate + voxel_size * (i, j, k)`.
+///
+/// OctoMap's resolution and binvox's translate and scale become a `Frame`, so a
+/// round trip through tesseral keeps them.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Frame {
+    /// The side of one voxel, in world units (metres for OctoMap).
+    pub voxel_size: f64,
+    /// The world position of the corner of voxel `(0, 0, 0)`.
+    pub translate: [f64; 3],
+}
+
+impl Default for Frame {
+    fn default() -> Self {
+        Self {
+            voxel_size: 1.0,
+            translate: [0.0; 3],
+        }
+    }
+}
+
+/// Per-voxel colours `[r, g, b, a]`, kept beside the octree for formats that carry
+/// colour (MagicaVoxel palettes, OctoMap `ColorOcTree`). Voxels that are not black
+/// in the tree are ignored when written.
+pub type ColorMap = BTreeMap<Voxel, [u8; 4]>;
+
+/// An octree with what a file says about it beyond its voxels.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VoxelModel {
+    /// The black voxels.
+    pub tree: LinearOctree,
+    /// Voxel size and placement in the world, when the file has them.
+    pub frame: Option<Frame>,
+    /// Per-voxel colours, when the file has them.
+    pub colors: Option<ColorMap>,
+}
+
+impl VoxelModel {
+    /// A model with no frame and no colours.
+    #[must_use]
+    pub fn new(tree: LinearOctree) -> Self {
+        Self {
+            tree,
+            frame: None,
+            colors: None,
+        }
+    }
+}
+
+/// How to read formats that need a choice (meshes need a resolution).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct ReadOptions {
+    /// How meshes are voxelized.
+    pub mesh: crate::mesh::VoxelizeOptions,
+}
+
+/// How to write formats that need a choice (meshes can be blocky or smooth).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WriteOptions {
+    /// How meshes are made from the octree.
+    pub mesh: crate::mesh::MeshOptions,
+}
+
+/// The extensions [`read_octree`] understands.
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply";
+
+/// The extensions [`write_octree`] understands.
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply, glb";
+
+/// Reads an octree from `path`, choosing the format by its extension. Meshes are
+/// voxelized with [`ReadOptions::default`].
 ///
 /// # Errors
 /// [`FormatError`] naming the file, and the line and column or field at fault.
 pub fn read_octree(path: &Path) -> Result<LinearOctree, FormatError> {
+    Ok(read_model(path)?.tree)
+}
+
+/// Reads an octree with its frame and colours, with default options.
+///
+/// # Errors
+/// [`FormatError`] naming the file, and the line and column or field at fault.
+pub fn read_model(path: &Path) -> Result<VoxelModel, FormatError> {
+    read_model_with(path, &ReadOptions::default())
+}
+
+/// Reads an octree with its frame and colours, choosing the format by extension.
+///
+/// # Errors
+/// [`FormatError`] naming the file, and the line and column or field at fault.
+pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<VoxelModel, FormatError> {
     match extension(path).as_str() {
-        "xyz" => xyz::read(path),
+        "tess" => native::read(path),
+        "xyz" => xyz::read(path).map(VoxelModel::new),
+        "binvox" => binvox::read(path),
+        "vox" => vox::read(path),
+        "bt" | "ot" => octomap::read(path),
+        "stl" | "obj" | "ply" => crate::mesh::read_voxelized(path, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -86,11 +258,38 @@ pub fn read_octree(path: &Path) -> Result<LinearOctree, FormatError> {
 /// # Errors
 /// [`FormatError`] naming the file.
 pub fn write_octree(path: &Path, tree: &LinearOctree) -> Result<(), FormatError> {
+    write_model(path, &VoxelModel::new(tree.clone()))
+}
+
+/// Writes a model with its frame and colours, with default options.
+///
+/// # Errors
+/// [`FormatError`] naming the file.
+pub fn write_model(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
+    write_model_with(path, model, &WriteOptions::default())
+}
+
+/// Writes a model to `path` atomically, choosing the format by its extension.
+/// Formats without colour or frame drop them.
+///
+/// # Errors
+/// [`FormatError`] naming the file; [`FormatError::Unsupported`] when the octree
+/// does not fit the format (for example a `.vox` wider than 256 voxels).
+pub fn write_model_with(
+    path: &Path,
+    model: &VoxelModel,
+    options: &WriteOptions,
+) -> Result<(), FormatError> {
     match extension(path).as_str() {
-        "xyz" => write_atomic(path, |w| xyz::write(w, tree)),
+        "tess" => write_atomic(path, |w| native::write(w, model)),
+        "xyz" => write_atomic(path, |w| xyz::write(w, &model.tree)),
+        "binvox" => binvox::write_file(path, model),
+        "vox" => vox::write_file(path, model),
+        "bt" | "ot" => octomap::write_file(path, model),
+        "stl" | "obj" | "ply" | "glb" => crate::mesh::write_meshed(path, model, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
-            known: KNOWN_EXTENSIONS,
+            known: KNOWN_WRITE_EXTENSIONS,
         }),
     }
 }
@@ -133,3 +332,51 @@ pub fn write_atomic(
     }
     result.map_err(wrap)
 }
+
+/// Like [`write_atomic`], for a body whose own errors are [`FormatError`]s (a format
+/// that can refuse an octree before writing a byte).
+///
+/// # Errors
+/// The body's error, or [`FormatError::Io`] naming `path`.
+pub fn write_atomic_checked(
+    path: &Path,
+    body: impl FnOnce(&mut dyn Write) -> Result<(), FormatError>,
+) -> Result<(), FormatError> {
+    let mut inner: Option<FormatError> = None;
+    let result = write_atomic(path, |w| {
+        body(w).map_err(|e| match e {
+            FormatError::Io { source, .. } => source,
+            other => {
+                inner = Some(other);
+                io::Error::other("refused")
+            }
+        })
+    });
+    match inner {
+        Some(e) => Err(e),
+        None => result,
+    }
+}
+
+/// Reads a whole file, refusing files larger than `limit` bytes.
+pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
+    let meta = fs::metadata(path).map_err(|e| FormatError::io(path, e))?;
+    if meta.len() > limit {
+        return Err(FormatError::too_large(
+            path,
+            format!("file is {} bytes; the limit is {limit}", meta.len()),
+        ));
+    }
+    fs::read(path).map_err(|e| FormatError::io(path, e))
+}
+
+/// Reads a whole file up to the reader limit (for the mesh parsers).
+pub(crate) fn read_limited_pub(path: &Path) -> Result<Vec<u8>, FormatError> {
+    read_limited(path, MAX_FILE_BYTES)
+}
+
+/// The largest file the whole-file readers load (4 GiB).
+pub(crate) const MAX_FILE_BYTES: u64 = 4 << 30;
+
+/// The most voxels a dense format (binvox, `.vox`) may expand to before we refuse.
+pub const MAX_DENSE_VOXELS: u64 = 1 << 28;

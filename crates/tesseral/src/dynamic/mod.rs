@@ -1,0 +1,1642 @@
+//! The unbounded dynamic octree of Libes, *Modeling dynamic surfaces with octrees*
+//! (§3–5): an octree whose root expands (×8) when a voxel is created outside it and
+//! contracts while all content lies inside one of its children, with voxel
+//! create/delete, `oct_find` that starts from any node, neighbour finding, and
+//! optional bookkeeping of every exposed surface face.
+//!
+//! # Layout
+//! - Coordinates are any `i64`. The root is a cube of side `2^k` (`0 ≤ k ≤ 64`) with
+//!   an arbitrary minimum corner; below the root, cells are aligned to the root.
+//!   Offsets from the root corner are computed in wrapping `u64` arithmetic, so a root
+//!   with `k = 64` covers every `i64` coordinate (the world wraps at ±2^63, as two's
+//!   complement does).
+//! - Interior nodes live in one pool (`Vec`, `u32` indices, free list). A node holds
+//!   eight child slots and a parent index. A slot is *empty*, *full*, or the index of a
+//!   stored child: a full slot stands for a full octant of any size (Libes §4: "a
+//!   voxel that is one of eight others that share the same parent will be implicitly
+//!   stored simply by marking the parent as full").
+//! - The lowest level is an 8×8×8 block of voxels stored as 512 bits (eight `u64`, one
+//!   per z-slice, bit `x + 8y`), one cache line. So a lookup touches about
+//!   `k − 3` nodes and one block, and a stored voxel costs a bit, not a node.
+//! - With [`DynamicOctree::with_faces`], every exposed face is kept in one dense list
+//!   with back-pointers (a hash map from face to index), so a random face is drawn
+//!   in O(1) and a face is removed by `swap_remove` in O(1) (Libes §5).
+//!
+//! # Invariants (checked by [`DynamicOctree::assert_valid`])
+//! - No stored node or block is all-empty or all-full (those are slots, not nodes).
+//! - Parent links point at the node whose slot holds the child.
+//! - The root cannot contract: its content does not lie inside one of its children.
+//! - The voxel count and the face list (when kept) are exact.
+//!
+//! ```
+//! use tesseral::dynamic::DynamicOctree;
+//! let mut t = DynamicOctree::with_faces();
+//! assert!(t.insert([0, 0, 0]));
+//! assert!(t.insert([1, 0, 0]));
+//! assert!(t.contains([1, 0, 0]));
+//! assert_eq!(t.face_count(), 10); // two cubes sharing one face
+//! assert!(t.insert([-1_000_000, 5, 5])); // the root grows to take it in
+//! t.assert_valid();
+//! ```
+
+// Loops over the three axes index several per-axis arrays at once.
+#![allow(clippy::needless_range_loop)]
+
+mod faces;
+
+use std::fmt;
+
+use faces::FaceList;
+pub use faces::{opposite, step, Face};
+
+use crate::linear::{CellClass, Classifier, LinearOctree, OctreeError};
+use crate::Voxel;
+
+/// log2 of the side of a leaf block (8×8×8 voxels, 512 bits).
+const LEAF_LOG2: u32 = 3;
+/// An empty slot (and the "no node" parent; index 0 of each pool is never used).
+const EMPTY: u32 = 0;
+/// A full slot.
+const FULL: u32 = u32::MAX;
+/// No parent: the node is the root.
+const NONE: u32 = 0;
+/// The parent field of a node or block on the free list.
+const FREED: u32 = u32::MAX;
+static ZERO_BLOCK: [u64; 8] = [0; 8];
+static FULL_BLOCK: [u64; 8] = [!0; 8];
+/// All 27 bits of a 3×3×3 neighbourhood.
+pub const NEIGHBOURHOOD_ALL: u32 = (1 << 27) - 1;
+/// Bit of the 27-bit neighbourhood for each face direction 0..6 (−x, +x, −y, +y, −z, +z).
+pub const NEIGHBOUR_BIT: [u32; 6] = [12, 14, 10, 16, 4, 22];
+/// Bit of the 27-bit neighbourhood for the centre voxel.
+pub const CENTRE_BIT: u32 = 13;
+
+/// Eight child slots, 32 bytes aligned to 32, so a node never straddles two cache
+/// lines; its parent link lives in a separate array (`node_parent`), which searches
+/// from the root never touch.
+#[derive(Clone, Copy)]
+#[repr(C, align(32))]
+struct Node {
+    child: [u32; 8],
+}
+
+/// 8×8×8 voxels: word `z`, bit `x + 8y`.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Leaf([u64; 8]);
+
+/// An unbounded octree of voxels (Libes §3–5). See the [module docs](self).
+///
+/// Every operation costs O(log n) where n is the extent of the content (the depth of
+/// the root), and space is O(|S|): blocks of 8³ voxels along the surface plus the
+/// nodes above them; full octants cost nothing below their parent's slot.
+#[derive(Clone)]
+pub struct DynamicOctree {
+    /// Slot of the root, at level `max(size_log2, 3)`.
+    root: u32,
+    /// World coordinates of the root's minimum corner.
+    root_min: Voxel,
+    /// log2 of the root's side, 0..=64. Below 3 the root is the low corner of a block.
+    size_log2: u32,
+    nodes: Vec<Node>,
+    node_parent: Vec<u32>,
+    node_free: Vec<u32>,
+    leaves: Vec<Leaf>,
+    leaf_parent: Vec<u32>,
+    leaf_free: Vec<u32>,
+    voxels: u64,
+    expansions: u64,
+    contractions: u64,
+    /// Bumped by every change; makes stale [`Octant`] handles harmless.
+    version: u64,
+    faces: Option<FaceList>,
+}
+
+/// The smallest uniform octant that contains a voxel, as found by
+/// [`DynamicOctree::find`]: an implicit empty or full octant, or the voxel itself
+/// (size 1) inside a stored block. It also remembers the node the search ended in, so
+/// that [`DynamicOctree::find_from`] can start there (Libes §5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Octant {
+    min: Voxel,
+    size_log2: u32,
+    full: bool,
+    /// The deepest stored node on the path (NONE: the root slot itself).
+    node: u32,
+    node_level: u32,
+    /// Offsets (from the root corner at `version`) of a point inside `node`.
+    probe: [u64; 3],
+    version: u64,
+}
+
+impl Octant {
+    /// World coordinates of the octant's minimum corner.
+    #[must_use]
+    pub fn min(&self) -> Voxel {
+        self.min
+    }
+    /// log2 of the octant's side (0 for a single voxel).
+    #[must_use]
+    pub fn size_log2(&self) -> u32 {
+        self.size_log2
+    }
+    /// Whether the octant is full (black); otherwise it is empty (white).
+    #[must_use]
+    pub fn is_full(&self) -> bool {
+        self.full
+    }
+}
+
+impl Default for DynamicOctree {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl fmt::Debug for DynamicOctree {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("DynamicOctree")
+            .field("voxels", &self.voxels)
+            .field("root_min", &self.root_min)
+            .field("root_size_log2", &self.size_log2)
+            .field("nodes", &self.node_count())
+            .field("faces", &self.faces.as_ref().map(|f| f.list.len()))
+            .finish()
+    }
+}
+
+/// Grows a pool by 1/8 (at least 64 entries) when it is full, instead of doubling:
+/// the pools are most of the memory, and doubling would leave up to half of it
+/// unused. Large reallocations are cheap (glibc moves them with `mremap`), so the
+/// amortised cost per push stays O(1).
+#[inline]
+fn grow<T>(v: &mut Vec<T>) {
+    if v.len() == v.capacity() {
+        v.reserve_exact((v.len() / 8).max(64));
+    }
+}
+
+#[inline]
+fn within(u: [u64; 3], log2: u32) -> bool {
+    log2 >= 64 || (u[0] | u[1] | u[2]) >> log2 == 0
+}
+
+#[inline]
+fn child_index(u: [u64; 3], level: u32) -> usize {
+    let s = level - 1;
+    ((u[0] >> s) & 1 | ((u[1] >> s) & 1) << 1 | ((u[2] >> s) & 1) << 2) as usize
+}
+
+#[inline]
+fn leaf_bit(u: [u64; 3]) -> (usize, u64) {
+    ((u[2] & 7) as usize, 1u64 << ((u[0] & 7) + 8 * (u[1] & 7)))
+}
+
+#[inline]
+fn is_index(slot: u32) -> bool {
+    slot != EMPTY && slot != FULL
+}
+
+/// Moves the content of a block by `s` cells along `axis`, up or down. The caller
+/// guarantees that no set bit leaves the block (or wraps into the next row).
+fn shift_leaf(l: &mut [u64; 8], axis: usize, s: u64, up: bool) {
+    match axis {
+        0 | 1 => {
+            let sh = if axis == 0 { s } else { 8 * s };
+            for w in l.iter_mut() {
+                *w = if up { *w << sh } else { *w >> sh };
+            }
+        }
+        _ => {
+            let s = s as usize;
+            if up {
+                for z in (0..8).rev() {
+                    l[z] = if z >= s { l[z - s] } else { 0 };
+                }
+            } else {
+                for z in 0..8 {
+                    l[z] = if z + s < 8 { l[z + s] } else { 0 };
+                }
+            }
+        }
+    }
+}
+
+/// Per-axis occupancy masks of a block: bit `i` of mask `a` is set when some voxel
+/// has coordinate `i` along axis `a`.
+fn leaf_axis_masks(l: &[u64; 8]) -> [u8; 3] {
+    let mut rows = 0u64;
+    let mut zm = 0u8;
+    for (z, &w) in l.iter().enumerate() {
+        rows |= w;
+        if w != 0 {
+            zm |= 1 << z;
+        }
+    }
+    let mut xm = 0u8;
+    let mut ym = 0u8;
+    for y in 0..8 {
+        let b = (rows >> (8 * y)) as u8;
+        xm |= b;
+        if b != 0 {
+            ym |= 1 << y;
+        }
+    }
+    [xm, ym, zm]
+}
+
+/// The 27-bit neighbourhood of local voxel `u & 7` inside one block; needs every local
+/// coordinate in 1..=6.
+#[inline]
+fn extract27(l: &[u64; 8], u: [u64; 3]) -> u32 {
+    let (lx, ly, lz) = (
+        (u[0] & 7) as usize,
+        (u[1] & 7) as usize,
+        (u[2] & 7) as usize,
+    );
+    let sh = lx - 1 + 8 * (ly - 1);
+    let mut r = 0u32;
+    for dz in 0..3 {
+        let w = l[lz - 1 + dz] >> sh;
+        let plane = (w & 7) | ((w >> 8) & 7) << 3 | ((w >> 16) & 7) << 6;
+        r |= (plane as u32) << (9 * dz);
+    }
+    r
+}
+
+impl DynamicOctree {
+    /// An empty tree without face bookkeeping (the occupancy-map use). O(1).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::new();
+    /// assert_eq!(t.voxel_count(), 0);
+    /// assert_eq!(t.face_count(), 0);
+    /// ```
+    #[must_use]
+    pub fn new() -> Self {
+        DynamicOctree {
+            root: EMPTY,
+            root_min: [0; 3],
+            size_log2: 0,
+            nodes: vec![Node { child: [EMPTY; 8] }],
+            node_parent: vec![FREED],
+            node_free: Vec::new(),
+            leaves: vec![Leaf([0; 8])],
+            leaf_parent: vec![FREED],
+            leaf_free: Vec::new(),
+            voxels: 0,
+            expansions: 0,
+            contractions: 0,
+            version: 0,
+            faces: None,
+        }
+    }
+
+    /// An empty tree that tracks every exposed face (Libes §4) in a dense list, for
+    /// O(1) uniform sampling of surface faces. O(1).
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::with_faces();
+    /// t.insert([3, -4, 5]);
+    /// assert_eq!(t.face_count(), 6);
+    /// ```
+    #[must_use]
+    pub fn with_faces() -> Self {
+        let mut t = Self::new();
+        t.faces = Some(FaceList::default());
+        t
+    }
+
+    /// Builds a tree (without face bookkeeping) from a list of voxels; duplicates are
+    /// ignored. O(n log n).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[0, 0, 0], [5, 5, 5], [0, 0, 0]]);
+    /// assert_eq!(t.voxel_count(), 2);
+    /// ```
+    pub fn from_voxels<I: IntoIterator<Item = Voxel>>(voxels: I) -> Self {
+        let mut t = Self::new();
+        t.extend(voxels);
+        t
+    }
+
+    /// Whether this tree keeps the face list.
+    #[must_use]
+    pub fn tracks_faces(&self) -> bool {
+        self.faces.is_some()
+    }
+
+    // ----- pools -------------------------------------------------------------------
+
+    fn alloc_node(&mut self, parent: u32, fill: u32) -> u32 {
+        let n = Node { child: [fill; 8] };
+        if let Some(i) = self.node_free.pop() {
+            self.nodes[i as usize] = n;
+            self.node_parent[i as usize] = parent;
+            i
+        } else {
+            let i = u32::try_from(self.nodes.len())
+                .ok()
+                .filter(|&i| i < FULL)
+                .expect("DynamicOctree: more than 2^32 - 2 nodes");
+            grow(&mut self.nodes);
+            self.nodes.push(n);
+            grow(&mut self.node_parent);
+            self.node_parent.push(parent);
+            i
+        }
+    }
+
+    fn free_node(&mut self, i: u32) {
+        self.node_parent[i as usize] = FREED;
+        self.node_free.push(i);
+    }
+
+    fn alloc_leaf(&mut self, parent: u32, fill: u64) -> u32 {
+        if let Some(i) = self.leaf_free.pop() {
+            self.leaves[i as usize] = Leaf([fill; 8]);
+            self.leaf_parent[i as usize] = parent;
+            i
+        } else {
+            let i = u32::try_from(self.leaves.len())
+                .ok()
+                .filter(|&i| i < FULL)
+                .expect("DynamicOctree: more than 2^32 - 2 blocks");
+            grow(&mut self.leaves);
+            self.leaves.push(Leaf([fill; 8]));
+            grow(&mut self.leaf_parent);
+            self.leaf_parent.push(parent);
+            i
+        }
+    }
+
+    fn free_leaf(&mut self, i: u32) {
+        self.leaf_parent[i as usize] = FREED;
+        self.leaf_free.push(i);
+    }
+
+    #[inline]
+    fn set_slot(&mut self, parent: u32, ci: usize, val: u32) {
+        if parent == NONE {
+            self.root = val;
+        } else {
+            self.nodes[parent as usize].child[ci] = val;
+        }
+    }
+
+    /// Sets the parent link of the stored child `slot` at `level`.
+    fn set_parent(&mut self, slot: u32, level: u32, parent: u32) {
+        if is_index(slot) {
+            if level > LEAF_LOG2 {
+                self.node_parent[slot as usize] = parent;
+            } else {
+                self.leaf_parent[slot as usize] = parent;
+            }
+        }
+    }
+
+    #[inline]
+    fn offsets(&self, v: Voxel) -> [u64; 3] {
+        [
+            (v[0] as u64).wrapping_sub(self.root_min[0] as u64),
+            (v[1] as u64).wrapping_sub(self.root_min[1] as u64),
+            (v[2] as u64).wrapping_sub(self.root_min[2] as u64),
+        ]
+    }
+
+    #[inline]
+    fn phys_log2(&self) -> u32 {
+        self.size_log2.max(LEAF_LOG2)
+    }
+
+    #[inline]
+    fn world(&self, u: [u64; 3]) -> Voxel {
+        [
+            self.root_min[0].wrapping_add(u[0] as i64),
+            self.root_min[1].wrapping_add(u[1] as i64),
+            self.root_min[2].wrapping_add(u[2] as i64),
+        ]
+    }
+
+    // ----- root expansion and contraction (Libes §3) ---------------------------------
+
+    /// Grows the root ×8 towards `v`: the old root becomes a child of the new one.
+    fn expand(&mut self, v: Voxel) {
+        let k = self.size_log2;
+        debug_assert!(k < 64);
+        let size = 1u64 << k;
+        let mut ci = 0usize;
+        for a in 0..3 {
+            if v[a] < self.root_min[a] {
+                self.root_min[a] = self.root_min[a].wrapping_sub(size as i64);
+                ci |= 1 << a;
+            }
+        }
+        if k >= LEAF_LOG2 {
+            let old = self.root;
+            let n = self.alloc_node(NONE, EMPTY);
+            self.nodes[n as usize].child[ci] = old;
+            self.set_parent(old, k, n);
+            self.root = n;
+        } else {
+            // The logical root is the low corner of the root block: growing towards −
+            // moves the content up inside the block.
+            let l = &mut self.leaves[self.root as usize].0;
+            for a in 0..3 {
+                if ci >> a & 1 == 1 {
+                    shift_leaf(l, a, size, true);
+                }
+            }
+        }
+        self.size_log2 = k + 1;
+        self.expansions += 1;
+    }
+
+    /// Shrinks the root while all content lies inside one of its children.
+    fn contract(&mut self) {
+        loop {
+            let k = self.size_log2;
+            if k == 0 || self.root == FULL || self.root == EMPTY {
+                return;
+            }
+            let half = 1u64 << (k - 1);
+            if k > LEAF_LOG2 {
+                let n = self.root as usize;
+                let ch = self.nodes[n].child;
+                let mut only = 0;
+                let mut count = 0;
+                for (i, &c) in ch.iter().enumerate() {
+                    if c != EMPTY {
+                        count += 1;
+                        only = i;
+                    }
+                }
+                if count != 1 {
+                    return;
+                }
+                for a in 0..3 {
+                    if only >> a & 1 == 1 {
+                        self.root_min[a] = self.root_min[a].wrapping_add(half as i64);
+                    }
+                }
+                let c = ch[only];
+                self.free_node(n as u32);
+                self.root = c;
+                self.set_parent(c, k - 1, NONE);
+            } else {
+                let l = &mut self.leaves[self.root as usize].0;
+                let masks = leaf_axis_masks(l);
+                let low = (1u16 << half) - 1;
+                let mut oct = [false; 3];
+                for a in 0..3 {
+                    let m = u16::from(masks[a]);
+                    let (lo, hi) = (m & low != 0, m >> half != 0);
+                    if lo && hi {
+                        return;
+                    }
+                    oct[a] = hi;
+                }
+                for a in 0..3 {
+                    if oct[a] {
+                        shift_leaf(l, a, half, false);
+                        self.root_min[a] = self.root_min[a].wrapping_add(half as i64);
+                    }
+                }
+            }
+            self.size_log2 = k - 1;
+            self.contractions += 1;
+        }
+    }
+
+    // ----- voxel create / delete (Libes §4) -------------------------------------------
+
+    /// Creates voxel `v`; returns `true` when it was not there before. The root
+    /// expands as often as needed (Libes §3). With face bookkeeping, only the faces
+    /// around `v` change, in the order of the face-list rule: for each direction
+    /// 0..6, a black neighbour gives up its face towards `v` (`swap_remove`),
+    /// otherwise `v` gains the face in that direction (push).
+    ///
+    /// O(depth) plus, with faces, six O(1) face updates.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// assert!(t.insert([1, 2, 3]));
+    /// assert!(!t.insert([1, 2, 3]));
+    /// assert_eq!(t.voxel_count(), 1);
+    /// ```
+    pub fn insert(&mut self, v: Voxel) -> bool {
+        if self.root == EMPTY {
+            self.root_min = v;
+            self.size_log2 = 0;
+            self.root = self.alloc_leaf(NONE, 0);
+            self.leaves[self.root as usize].0[0] = 1;
+        } else {
+            let mut u = self.offsets(v);
+            while !within(u, self.size_log2) {
+                self.expand(v);
+                u = self.offsets(v);
+            }
+            if !self.set_bit(u) {
+                return false;
+            }
+        }
+        self.voxels += 1;
+        self.version += 1;
+        if self.faces.is_some() {
+            self.faces_after_insert(v);
+        }
+        true
+    }
+
+    fn set_bit(&mut self, u: [u64; 3]) -> bool {
+        let mut level = self.phys_log2();
+        let mut parent = NONE;
+        let mut ci = 0usize;
+        let mut cur = self.root;
+        while level > LEAF_LOG2 {
+            if cur == FULL {
+                return false;
+            }
+            if cur == EMPTY {
+                cur = self.alloc_node(parent, EMPTY);
+                self.set_slot(parent, ci, cur);
+            }
+            ci = child_index(u, level);
+            parent = cur;
+            cur = self.nodes[cur as usize].child[ci];
+            level -= 1;
+        }
+        if cur == FULL {
+            return false;
+        }
+        if cur == EMPTY {
+            cur = self.alloc_leaf(parent, 0);
+            self.set_slot(parent, ci, cur);
+        }
+        let (w, b) = leaf_bit(u);
+        let l = &mut self.leaves[cur as usize].0;
+        if l[w] & b != 0 {
+            return false;
+        }
+        l[w] |= b;
+        if l[w] == !0 && l.iter().all(|&x| x == !0) {
+            self.collapse_full(cur, parent, u);
+        }
+        true
+    }
+
+    /// A block became full: it turns into a full slot, and so does every ancestor
+    /// whose eight children are all full.
+    fn collapse_full(&mut self, leaf: u32, parent: u32, u: [u64; 3]) {
+        self.free_leaf(leaf);
+        self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), FULL);
+        self.collapse_up(parent, LEAF_LOG2 + 1, u);
+    }
+
+    /// From `node` at `level` (on the path to offsets `u`) upwards: a node whose eight
+    /// children are all full becomes a full slot in its parent.
+    fn collapse_up(&mut self, mut node: u32, mut level: u32, u: [u64; 3]) {
+        while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == FULL) {
+            let p = self.node_parent[node as usize];
+            self.free_node(node);
+            level += 1;
+            let ci = if p != NONE { child_index(u, level) } else { 0 };
+            self.set_slot(p, ci, FULL);
+            node = p;
+        }
+    }
+
+    /// Releases a stored subtree (slot `slot` at `level`).
+    fn free_subtree(&mut self, slot: u32, level: u32) {
+        if !is_index(slot) {
+            return;
+        }
+        if level > LEAF_LOG2 {
+            let ch = self.nodes[slot as usize].child;
+            for c in ch {
+                self.free_subtree(c, level - 1);
+            }
+            self.free_node(slot);
+        } else {
+            self.free_leaf(slot);
+        }
+    }
+
+    /// Makes the aligned cube of side `2^s` at offsets `u` full (no voxel count or
+    /// face update: the caller keeps those).
+    fn fill_aligned(&mut self, u: [u64; 3], s: u32) {
+        let target = s.max(LEAF_LOG2);
+        let mut level = self.phys_log2();
+        let mut parent = NONE;
+        let mut ci = 0usize;
+        let mut cur = self.root;
+        while level > target {
+            if cur == FULL {
+                return;
+            }
+            if cur == EMPTY {
+                cur = self.alloc_node(parent, EMPTY);
+                self.set_slot(parent, ci, cur);
+            }
+            ci = child_index(u, level);
+            parent = cur;
+            cur = self.nodes[cur as usize].child[ci];
+            level -= 1;
+        }
+        if cur == FULL {
+            return;
+        }
+        if s >= LEAF_LOG2 {
+            self.free_subtree(cur, level);
+            self.set_slot(parent, ci, FULL);
+            self.collapse_up(parent, level + 1, u);
+            return;
+        }
+        if cur == EMPTY {
+            cur = self.alloc_leaf(parent, 0);
+            self.set_slot(parent, ci, cur);
+        }
+        let side = 1u64 << s;
+        let (x0, y0, z0) = (u[0] & 7, u[1] & 7, u[2] & 7);
+        let row = ((1u64 << side) - 1) << x0;
+        let plane = (y0..y0 + side).fold(0u64, |p, y| p | row << (8 * y));
+        let l = &mut self.leaves[cur as usize].0;
+        for z in z0..z0 + side {
+            l[z as usize] |= plane;
+        }
+        if l.iter().all(|&w| w == !0) {
+            self.collapse_full(cur, parent, u);
+        }
+    }
+
+    /// Deletes voxel `v`; returns `true` when it was there. A full octant around `v`
+    /// is instantiated on the way down; blocks and nodes left empty are released all
+    /// the way up, and the root contracts while its content fits one child (Libes §3,
+    /// §4). With face bookkeeping: for each direction 0..6, a black neighbour gains
+    /// its face towards `v` (push), otherwise `v`'s face there is removed
+    /// (`swap_remove`).
+    ///
+    /// O(depth) plus, with faces, six O(1) face updates.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// t.insert([1, 2, 3]);
+    /// assert!(t.remove([1, 2, 3]));
+    /// assert!(!t.remove([1, 2, 3]));
+    /// assert_eq!(t.voxel_count(), 0);
+    /// ```
+    pub fn remove(&mut self, v: Voxel) -> bool {
+        if self.root == EMPTY {
+            return false;
+        }
+        let u = self.offsets(v);
+        if !within(u, self.size_log2) || !self.clear_bit(u) {
+            return false;
+        }
+        self.voxels -= 1;
+        self.version += 1;
+        if self.voxels == 0 {
+            debug_assert_eq!(self.root, EMPTY);
+            self.root = EMPTY;
+            self.size_log2 = 0;
+            self.root_min = [0; 3];
+        } else {
+            self.contract();
+        }
+        if self.faces.is_some() {
+            self.faces_after_remove(v);
+        }
+        true
+    }
+
+    fn clear_bit(&mut self, u: [u64; 3]) -> bool {
+        let mut level = self.phys_log2();
+        let mut parent = NONE;
+        let mut ci = 0usize;
+        let mut cur = self.root;
+        while level > LEAF_LOG2 {
+            if cur == EMPTY {
+                return false;
+            }
+            if cur == FULL {
+                cur = self.alloc_node(parent, FULL);
+                self.set_slot(parent, ci, cur);
+            }
+            ci = child_index(u, level);
+            parent = cur;
+            cur = self.nodes[cur as usize].child[ci];
+            level -= 1;
+        }
+        if cur == EMPTY {
+            return false;
+        }
+        if cur == FULL {
+            cur = self.alloc_leaf(parent, !0);
+            self.set_slot(parent, ci, cur);
+        }
+        let (w, b) = leaf_bit(u);
+        let l = &mut self.leaves[cur as usize].0;
+        if l[w] & b == 0 {
+            return false;
+        }
+        l[w] &= !b;
+        if l[w] == 0 && l.iter().all(|&x| x == 0) {
+            self.free_leaf(cur);
+            let mut level = LEAF_LOG2 + 1;
+            self.set_slot(parent, child_index(u, level), EMPTY);
+            let mut node = parent;
+            while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == EMPTY) {
+                let p = self.node_parent[node as usize];
+                self.free_node(node);
+                level += 1;
+                let ci = if p != NONE { child_index(u, level) } else { 0 };
+                self.set_slot(p, ci, EMPTY);
+                node = p;
+            }
+        }
+        true
+    }
+
+    // ----- search (Libes §5) ----------------------------------------------------------
+
+    /// Whether voxel `v` is black. O(depth), no allocation.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// t.insert([-7, 0, 1 << 40]);
+    /// assert!(t.contains([-7, 0, 1 << 40]));
+    /// assert!(!t.contains([-7, 0, 0]));
+    /// ```
+    #[inline]
+    #[must_use]
+    pub fn contains(&self, v: Voxel) -> bool {
+        let u = self.offsets(v);
+        let mut level = self.phys_log2();
+        if !within(u, level) {
+            return false;
+        }
+        let mut cur = self.root;
+        while level > LEAF_LOG2 {
+            if cur == EMPTY || cur == FULL {
+                return cur == FULL;
+            }
+            cur = self.nodes[cur as usize].child[child_index(u, level)];
+            level -= 1;
+        }
+        if cur == EMPTY || cur == FULL {
+            return cur == FULL;
+        }
+        let (w, b) = leaf_bit(u);
+        self.leaves[cur as usize].0[w] & b != 0
+    }
+
+    /// Descends from slot `cur` at `level` towards offsets `t`, stopping at the first
+    /// empty or full slot, or at the block. Returns (slot, level, parent node).
+    #[inline]
+    fn descend(
+        &self,
+        mut cur: u32,
+        mut level: u32,
+        mut parent: u32,
+        t: [u64; 3],
+    ) -> (u32, u32, u32) {
+        while level > LEAF_LOG2 && is_index(cur) {
+            parent = cur;
+            cur = self.nodes[cur as usize].child[child_index(t, level)];
+            level -= 1;
+        }
+        (cur, level, parent)
+    }
+
+    /// From stored node `node` at `level`, which contains offsets `probe`, climbs
+    /// while `t` lies outside (Libes §5: "we would continue searching in the parent
+    /// of the current octant"). Returns the lowest ancestor that contains `t` and its
+    /// level; `t` must lie inside the root.
+    #[inline]
+    fn climb(&self, mut node: u32, mut level: u32, probe: [u64; 3], t: [u64; 3]) -> (u32, u32) {
+        while level < 64
+            && ((t[0] ^ probe[0]) | (t[1] ^ probe[1]) | (t[2] ^ probe[2])) >> level != 0
+        {
+            node = self.node_parent[node as usize];
+            level += 1;
+            debug_assert!(node != NONE, "climbed past the root");
+        }
+        (node, level)
+    }
+
+    fn octant_of(&self, t: [u64; 3], slot: u32, level: u32, parent: u32) -> Octant {
+        let (size_log2, full) = if level > LEAF_LOG2 || !is_index(slot) {
+            (level, slot == FULL)
+        } else {
+            let (w, b) = leaf_bit(t);
+            (0, self.leaves[slot as usize].0[w] & b != 0)
+        };
+        let mask = if size_log2 >= 64 {
+            0
+        } else {
+            !((1u64 << size_log2) - 1)
+        };
+        let min = self.world([t[0] & mask, t[1] & mask, t[2] & mask]);
+        Octant {
+            min,
+            size_log2,
+            full,
+            node: parent,
+            node_level: level + 1,
+            probe: t,
+            version: self.version,
+        }
+    }
+
+    /// `oct_find` from the root (Libes §5): the smallest uniform octant containing
+    /// `v`, or `None` when `v` lies outside the root. O(depth).
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// for x in 0..8 { for y in 0..8 { for z in 0..8 { t.insert([x, y, z]); } } }
+    /// t.insert([8, 0, 0]);
+    /// let o = t.find([3, 3, 3]).unwrap();
+    /// assert!(o.is_full());
+    /// assert_eq!((o.min(), o.size_log2()), ([0, 0, 0], 3)); // an implicit full octant
+    /// ```
+    #[must_use]
+    pub fn find(&self, v: Voxel) -> Option<Octant> {
+        let t = self.offsets(v);
+        let phys = self.phys_log2();
+        if self.root == EMPTY || !within(t, phys) {
+            return None;
+        }
+        let (slot, level, parent) = self.descend(self.root, phys, NONE, t);
+        Some(self.octant_of(t, slot, level, parent))
+    }
+
+    /// `oct_find` that starts at the node where an earlier search ended: it climbs
+    /// through parent links while `v` lies outside, then descends (Libes §5). Near
+    /// `start` this costs O(levels climbed) instead of O(depth). A handle from before
+    /// the latest change is not trusted: the search then starts at the root.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// t.insert([0, 0, 0]);
+    /// t.insert([100, 0, 0]);
+    /// let a = t.find([0, 0, 0]).unwrap();
+    /// let b = t.find_from(&a, [100, 0, 0]).unwrap();
+    /// assert!(b.is_full());
+    /// assert_eq!(t.find_from(&b, [99, 0, 0]), t.find([99, 0, 0]));
+    /// ```
+    #[must_use]
+    pub fn find_from(&self, start: &Octant, v: Voxel) -> Option<Octant> {
+        if start.version != self.version || start.node == NONE {
+            return self.find(v);
+        }
+        let t = self.offsets(v);
+        if !within(t, self.phys_log2()) {
+            return None;
+        }
+        let (node, level) = self.climb(start.node, start.node_level, start.probe, t);
+        let (slot, level, parent) = self.descend(node, level, NONE, t);
+        let parent = if parent == NONE { node } else { parent };
+        Some(self.octant_of(t, slot, level, parent))
+    }
+
+    /// The 3×3×3 occupancy around `v` as 27 bits: bit `(dx+1) + 3(dy+1) + 9(dz+1)`
+    /// for `dx, dy, dz` in −1..=1 (bit 13 is `v` itself).
+    ///
+    /// Finds `v`'s block once; when the 3×3×3 block lies inside it (or inside an
+    /// implicit empty or full octant), all 27 bits come from there. Otherwise the
+    /// neighbouring blocks are found from `v`'s own node by climbing to the nearest
+    /// common ancestor and descending (Libes §5), never from the root.
+    /// O(depth) worst case, O(1) after the descent in the common case.
+    ///
+    /// ```
+    /// use tesseral::dynamic::{DynamicOctree, CENTRE_BIT, NEIGHBOUR_BIT};
+    /// let mut t = DynamicOctree::new();
+    /// t.insert([0, 0, 0]);
+    /// t.insert([1, 0, 0]);
+    /// let n = t.neighbourhood([0, 0, 0]);
+    /// assert_eq!(n, 1 << CENTRE_BIT | 1 << NEIGHBOUR_BIT[1]);
+    /// ```
+    #[must_use]
+    pub fn neighbourhood(&self, v: Voxel) -> u32 {
+        if self.root == EMPTY {
+            return 0;
+        }
+        let u = self.offsets(v);
+        let phys = self.phys_log2();
+        if !within(u, phys) {
+            return self.neighbourhood_slow(u, NONE, 0);
+        }
+        let (cur, level, parent) = self.descend(self.root, phys, NONE, u);
+        let m = if level >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << level) - 1
+        };
+        let inner = |a: usize| {
+            let l = u[a] & m;
+            l >= 1 && l < m
+        };
+        if inner(0) && inner(1) && inner(2) {
+            return match cur {
+                EMPTY => 0,
+                FULL => NEIGHBOURHOOD_ALL,
+                _ => extract27(&self.leaves[cur as usize].0, u),
+            };
+        }
+        self.neighbourhood_slow(u, parent, level + 1)
+    }
+
+    /// The block (8³ voxels) whose minimum corner has offsets `t`, found from node
+    /// `start` at `start_level` (which contains offsets `u`), or from the root when
+    /// `start` is NONE.
+    fn block_bits(&self, t: [u64; 3], u: [u64; 3], start: u32, start_level: u32) -> &[u64; 8] {
+        let phys = self.phys_log2();
+        if !within(t, phys) {
+            return &ZERO_BLOCK;
+        }
+        let (cur, level) = if start == NONE {
+            (self.root, phys)
+        } else {
+            self.climb(start, start_level, u, t)
+        };
+        let (slot, _, _) = self.descend(cur, level, NONE, t);
+        match slot {
+            EMPTY => &ZERO_BLOCK,
+            FULL => &FULL_BLOCK,
+            _ => &self.leaves[slot as usize].0,
+        }
+    }
+
+    #[inline(never)]
+    fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32) -> u32 {
+        let lo = [
+            u[0].wrapping_sub(1) >> 3,
+            u[1].wrapping_sub(1) >> 3,
+            u[2].wrapping_sub(1) >> 3,
+        ];
+        let hi = [
+            u[0].wrapping_add(1) >> 3,
+            u[1].wrapping_add(1) >> 3,
+            u[2].wrapping_add(1) >> 3,
+        ];
+        let mut blocks: [&[u64; 8]; 8] = [&ZERO_BLOCK; 8];
+        for i in 0..8usize {
+            let sel = [i & 1, i >> 1 & 1, i >> 2 & 1];
+            if (0..3).any(|a| sel[a] == 1 && hi[a] == lo[a]) {
+                continue;
+            }
+            let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
+            blocks[i] = self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level);
+        }
+        // Row by row: the three cells (x−1, x, x+1) of a row come from one block
+        // word, or from two when the row crosses a block boundary in x.
+        let lx = u[0] & 7;
+        let mut r = 0u32;
+        for dz in 0..3u64 {
+            let cz = u[2].wrapping_add(dz).wrapping_sub(1);
+            let bz = usize::from(cz >> 3 != lo[2]) << 2;
+            let lz = (cz & 7) as usize;
+            for dy in 0..3u64 {
+                let cy = u[1].wrapping_add(dy).wrapping_sub(1);
+                let b = usize::from(cy >> 3 != lo[1]) << 1 | bz;
+                let sh = 8 * (cy & 7);
+                let row = if lo[0] == hi[0] {
+                    (blocks[b][lz] >> (sh + lx - 1)) & 7
+                } else {
+                    let wl = blocks[b][lz] >> sh;
+                    let wh = blocks[b | 1][lz] >> sh;
+                    if lx == 0 {
+                        (wl >> 7 & 1) | (wh & 3) << 1
+                    } else {
+                        (wl >> 6 & 3) | (wh & 1) << 2
+                    }
+                };
+                r |= (row as u32) << (3 * dy + 9 * dz);
+            }
+        }
+        r
+    }
+
+    /// The six face-neighbours of `v` as a mask: bit `dir` is set when the neighbour
+    /// in direction `dir` (0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z) is black.
+    /// O(depth), from `v`'s own node.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// t.insert([0, 0, 0]);
+    /// assert_eq!(t.face_neighbours([0, 0, 1]), 1 << 4);
+    /// ```
+    #[must_use]
+    pub fn face_neighbours(&self, v: Voxel) -> u8 {
+        let n = self.neighbourhood(v);
+        let mut m = 0u8;
+        for (dir, &bit) in NEIGHBOUR_BIT.iter().enumerate() {
+            m |= ((n >> bit & 1) as u8) << dir;
+        }
+        m
+    }
+
+    // ----- faces (Libes §4, §5) -------------------------------------------------------
+
+    fn faces_after_insert(&mut self, v: Voxel) {
+        let nb = self.face_neighbours(v);
+        let f = self.faces.as_mut().expect("face bookkeeping");
+        let mut own = None;
+        for dir in 0..6u8 {
+            if nb >> dir & 1 == 1 {
+                let n = step(v, dir);
+                let r = f.existing_record(n);
+                f.remove(r, n, opposite(dir));
+            } else {
+                let r = *own.get_or_insert_with(|| f.record_of(v));
+                f.push(r, v, dir);
+            }
+        }
+    }
+
+    fn faces_after_remove(&mut self, v: Voxel) {
+        let nb = self.face_neighbours(v);
+        let f = self.faces.as_mut().expect("face bookkeeping");
+        // A black voxel with a white neighbour has a record; one with six black
+        // neighbours has no face to remove.
+        let own = if nb & 0b11_1111 != 0b11_1111 {
+            f.existing_record(v)
+        } else {
+            0
+        };
+        for dir in 0..6u8 {
+            if nb >> dir & 1 == 1 {
+                let n = step(v, dir);
+                let r = f.record_of(n);
+                f.push(r, n, opposite(dir));
+            } else {
+                f.remove(own, v, dir);
+            }
+        }
+    }
+
+    /// The number of exposed faces (the surface area in unit squares); exact.
+    /// 0 without face bookkeeping. O(1).
+    #[must_use]
+    pub fn face_count(&self) -> usize {
+        self.faces.as_ref().map_or(0, |f| f.list.len())
+    }
+
+    /// The number of exposed faces (the surface area), whether or not the face list
+    /// is kept: `face_count()` with face bookkeeping, otherwise
+    /// `6·voxels − 2·(face-adjacent pairs)` counted now in O(voxels · depth).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[0, 0, 0], [0, 1, 0]]);
+    /// assert_eq!(t.exposed_faces(), 10);
+    /// ```
+    #[must_use]
+    pub fn exposed_faces(&self) -> u64 {
+        if let Some(f) = &self.faces {
+            return f.list.len() as u64;
+        }
+        let mut pairs = 0u64;
+        for v in self.voxels() {
+            pairs += u64::from((self.face_neighbours(v) & 0b10_1010).count_ones());
+        }
+        6 * self.voxels - 2 * pairs
+    }
+
+    /// The `i`-th face of the face list. O(1).
+    ///
+    /// # Panics
+    /// When `i >= face_count()`.
+    #[must_use]
+    pub fn face(&self, i: usize) -> Face {
+        let f = self.faces.as_ref().map_or(&[][..], |f| &f.list[..]);
+        assert!(
+            i < f.len(),
+            "face index {i} out of range (face_count {})",
+            f.len()
+        );
+        f[i].face()
+    }
+
+    /// The whole face list, in face-list order (empty without face bookkeeping).
+    /// O(faces).
+    #[must_use]
+    pub fn faces(&self) -> Vec<Face> {
+        self.faces
+            .as_ref()
+            .map_or_else(Vec::new, |f| f.list.iter().map(|e| e.face()).collect())
+    }
+
+    /// A uniformly random exposed face, or `None` when there is none. O(1).
+    ///
+    /// ```
+    /// use rand::SeedableRng;
+    /// let mut t = tesseral::dynamic::DynamicOctree::with_faces();
+    /// t.insert([0, 0, 0]);
+    /// let mut rng = rand_pcg::Pcg64::seed_from_u64(1);
+    /// assert_eq!(t.random_face(&mut rng).unwrap().voxel, [0, 0, 0]);
+    /// ```
+    pub fn random_face<R: rand::Rng + ?Sized>(&self, rng: &mut R) -> Option<Face> {
+        let n = self.face_count();
+        (n > 0).then(|| self.face(rng.random_range(0..n)))
+    }
+
+    // ----- counts -----------------------------------------------------------------------
+
+    /// The number of black voxels. O(1).
+    #[must_use]
+    pub fn voxel_count(&self) -> u64 {
+        self.voxels
+    }
+
+    /// Whether there are no voxels. O(1).
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.voxels == 0
+    }
+
+    /// log2 of the root's side.
+    #[must_use]
+    pub fn root_size_log2(&self) -> u32 {
+        self.size_log2
+    }
+
+    /// World coordinates of the root's minimum corner (`[0, 0, 0]` when empty).
+    #[must_use]
+    pub fn root_min(&self) -> Voxel {
+        self.root_min
+    }
+
+    /// How many times the root has grown ×8 since the tree was made.
+    #[must_use]
+    pub fn expansions(&self) -> u64 {
+        self.expansions
+    }
+
+    /// How many times the root has shrunk to one of its children.
+    #[must_use]
+    pub fn contractions(&self) -> u64 {
+        self.contractions
+    }
+
+    /// Stored nodes: interior nodes plus 8³ blocks. O(1).
+    #[must_use]
+    pub fn node_count(&self) -> usize {
+        (self.nodes.len() - 1 - self.node_free.len())
+            + (self.leaves.len() - 1 - self.leaf_free.len())
+    }
+
+    /// Bytes of memory held: the struct plus every heap allocation at its capacity
+    /// (node pool, block pool, parent links, free lists, and with faces the face list
+    /// and its back-pointer table). O(1).
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.nodes.capacity() * std::mem::size_of::<Node>()
+            + self.node_parent.capacity() * 4
+            + self.node_free.capacity() * 4
+            + self.leaves.capacity() * std::mem::size_of::<Leaf>()
+            + self.leaf_parent.capacity() * 4
+            + self.leaf_free.capacity() * 4
+            + self.faces.as_ref().map_or(0, FaceList::heap_bytes)
+    }
+
+    /// Releases unused pool capacity (after a bulk build or many deletions the
+    /// pools may hold up to twice what they need). O(size).
+    pub fn shrink_to_fit(&mut self) {
+        self.nodes.shrink_to_fit();
+        self.node_parent.shrink_to_fit();
+        self.node_free.shrink_to_fit();
+        self.leaves.shrink_to_fit();
+        self.leaf_parent.shrink_to_fit();
+        self.leaf_free.shrink_to_fit();
+        if let Some(f) = &mut self.faces {
+            f.list.shrink_to_fit();
+            f.owners.shrink_to_fit();
+            f.records.shrink_to_fit();
+            f.free.shrink_to_fit();
+        }
+    }
+
+    // ----- conversions ------------------------------------------------------------------
+
+    /// Calls `f(min_offsets, size_log2, full_block)` for every uniform full octant
+    /// (`full_block = None`) and every stored block (`Some(bits)`), in tesseral order.
+    fn visit<F: FnMut([u64; 3], u32, Option<&[u64; 8]>)>(&self, mut f: F) {
+        if self.root == EMPTY {
+            return;
+        }
+        let mut stack = vec![(self.root, self.phys_log2(), [0u64; 3])];
+        while let Some((slot, level, base)) = stack.pop() {
+            match slot {
+                EMPTY => {}
+                FULL => f(base, level, None),
+                _ if level > LEAF_LOG2 => {
+                    let ch = &self.nodes[slot as usize].child;
+                    let h = level - 1;
+                    for ci in (0..8).rev() {
+                        if ch[ci] != EMPTY {
+                            let b = [
+                                base[0] | ((ci as u64 & 1) << h),
+                                base[1] | ((ci as u64 >> 1 & 1) << h),
+                                base[2] | ((ci as u64 >> 2 & 1) << h),
+                            ];
+                            stack.push((ch[ci], h, b));
+                        }
+                    }
+                }
+                _ => f(base, LEAF_LOG2, Some(&self.leaves[slot as usize].0)),
+            }
+        }
+    }
+
+    /// Every black voxel, in tesseral (Morton) order relative to the root corner.
+    /// O(voxels + nodes).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[1, 0, 0], [0, 0, 0]]);
+    /// assert_eq!(t.voxels(), vec![[0, 0, 0], [1, 0, 0]]);
+    /// ```
+    #[must_use]
+    pub fn voxels(&self) -> Vec<Voxel> {
+        let mut out = Vec::with_capacity(usize::try_from(self.voxels).unwrap_or(0));
+        self.visit(|base, level, bits| match bits {
+            None => {
+                let side = 1u64 << level;
+                for ci in 0..side * side * side {
+                    let [x, y, z] = crate::code::decode(ci);
+                    out.push(self.world([
+                        base[0] + u64::from(x),
+                        base[1] + u64::from(y),
+                        base[2] + u64::from(z),
+                    ]));
+                }
+            }
+            Some(l) => {
+                for ci in 0..512u64 {
+                    let [x, y, z] = crate::code::decode(ci);
+                    if l[z as usize] >> (x + 8 * y) & 1 == 1 {
+                        out.push(self.world([
+                            base[0] + u64::from(x),
+                            base[1] + u64::from(y),
+                            base[2] + u64::from(z),
+                        ]));
+                    }
+                }
+            }
+        });
+        out
+    }
+
+    /// Builds a tree (without face bookkeeping) from a linear octree: each black leaf
+    /// becomes a full slot (or bits of a block), so a solid costs its surface, not its
+    /// volume. O(leaves · depth).
+    ///
+    /// ```
+    /// use tesseral::{dynamic::DynamicOctree, linear::LinearOctree};
+    /// let cube = (0..4).flat_map(|x| (0..4).flat_map(move |y| (0..4).map(move |z| [x, y, z])));
+    /// let lin = LinearOctree::from_voxels(5, [-8, -8, -8], cube).unwrap();
+    /// let t = DynamicOctree::from_linear(&lin);
+    /// assert_eq!(t.voxel_count(), 64);
+    /// assert_eq!((t.root_min(), t.root_size_log2()), ([0, 0, 0], 2));
+    /// t.assert_valid();
+    /// ```
+    #[must_use]
+    pub fn from_linear(lin: &LinearOctree) -> Self {
+        let mut t = Self::new();
+        let count = lin.voxel_count();
+        if count == 0 {
+            return t;
+        }
+        t.root_min = lin.origin();
+        t.size_log2 = u32::from(lin.depth());
+        for leaf in lin.leaves() {
+            let [x, y, z] = crate::code::decode(leaf.code());
+            t.fill_aligned(
+                [u64::from(x), u64::from(y), u64::from(z)],
+                u32::from(leaf.size_log2()),
+            );
+        }
+        t.voxels = count;
+        t.contract();
+        t
+    }
+
+    /// The voxels of this tree inside the window `[origin, origin + 2^depth)³` as a
+    /// linear octree. Built top-down with [`LinearOctree::from_classifier`], each cell
+    /// classified by [`DynamicOctree::classify`], so the cost follows the surface.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when `depth` exceeds [`crate::linear::MAX_DEPTH`].
+    ///
+    /// ```
+    /// use tesseral::dynamic::DynamicOctree;
+    /// let t = DynamicOctree::from_voxels([[0, 0, 0], [1, 0, 0], [100, 0, 0]]);
+    /// let lin = t.to_linear(2, [-1, -1, -1]).unwrap(); // a 4³ window: [100, 0, 0] is cut
+    /// assert_eq!(lin.voxel_count(), 2);
+    /// ```
+    pub fn to_linear(&self, depth: u8, origin: Voxel) -> Result<LinearOctree, OctreeError> {
+        LinearOctree::from_classifier(depth, origin, self)
+    }
+
+    /// Whether the cube `[min, min + 2^size_log2)³` (any alignment) is all black
+    /// (`Inside`), all white (`Outside`) or mixed (`Partial`). A stored node always
+    /// holds both colours, so the search stops at every node that lies wholly inside
+    /// the cube: the cost follows the cube's boundary. A single voxel is never
+    /// `Partial`.
+    ///
+    /// ```
+    /// use tesseral::{dynamic::DynamicOctree, linear::CellClass};
+    /// let t = DynamicOctree::from_voxels([[0, 0, 0], [1, 0, 0]]);
+    /// assert_eq!(t.classify([0, 0, 0], 0), CellClass::Inside);
+    /// assert_eq!(t.classify([0, 0, 0], 1), CellClass::Partial);
+    /// assert_eq!(t.classify([2, 0, 0], 1), CellClass::Outside);
+    /// ```
+    #[must_use]
+    pub fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
+        if self.root == EMPTY {
+            return CellClass::Outside;
+        }
+        let side = 1i128 << size_log2.min(64);
+        let k = self.size_log2;
+        let modulus = 1i128 << 64;
+        // Per axis: the cube's intervals in root offsets, clipped to the root
+        // (a k = 64 root wraps, so an interval may split in two).
+        let mut spans: [[(u128, u128); 2]; 3] = [[(0, 0); 2]; 3];
+        let mut nspans = [0usize; 3];
+        let mut outside = false;
+        for a in 0..3 {
+            let lo = i128::from(min[a]) - i128::from(self.root_min[a]);
+            let hi = lo + side;
+            if k >= 64 {
+                let lo = lo.rem_euclid(modulus);
+                let hi = lo + side.min(modulus);
+                if hi <= modulus {
+                    spans[a][0] = (lo as u128, hi as u128);
+                    nspans[a] = 1;
+                } else {
+                    spans[a][0] = (lo as u128, modulus as u128);
+                    spans[a][1] = (0, (hi - modulus) as u128);
+                    nspans[a] = 2;
+                }
+            } else {
+                let root = 1i128 << k;
+                let (clo, chi) = (lo.max(0), hi.min(root));
+                if lo < 0 || hi > root {
+                    outside = true;
+                }
+                if clo < chi {
+                    spans[a][0] = (clo as u128, chi as u128);
+                    nspans[a] = 1;
+                }
+            }
+        }
+        let (mut black, mut white) = (false, outside);
+        'boxes: for i in 0..nspans[0] {
+            for j in 0..nspans[1] {
+                for l in 0..nspans[2] {
+                    let b = [spans[0][i], spans[1][j], spans[2][l]];
+                    let (bl, wh) = self.probe(self.root, self.phys_log2(), [0; 3], b);
+                    black |= bl;
+                    white |= wh;
+                    if black && white {
+                        break 'boxes;
+                    }
+                }
+            }
+        }
+        match (black, white) {
+            (true, false) => CellClass::Inside,
+            (false, _) => CellClass::Outside,
+            (true, true) => CellClass::Partial,
+        }
+    }
+
+    /// (any black, any white) in the intersection of cell (`slot`, `level`, `base`)
+    /// with the box `b` (half-open offset intervals per axis).
+    fn probe(&self, slot: u32, level: u32, base: [u128; 3], b: [(u128, u128); 3]) -> (bool, bool) {
+        let size = 1u128 << level;
+        let mut inside = true;
+        for a in 0..3 {
+            let (lo, hi) = (b[a].0.max(base[a]), b[a].1.min(base[a] + size));
+            if lo >= hi {
+                return (false, false);
+            }
+            inside &= lo == base[a] && hi == base[a] + size;
+        }
+        match slot {
+            EMPTY => (false, true),
+            FULL => (true, false),
+            // A stored node or block holds both colours (checked by assert_valid).
+            _ if inside => (true, true),
+            _ if level > LEAF_LOG2 => {
+                let ch = &self.nodes[slot as usize].child;
+                let h = size >> 1;
+                let (mut black, mut white) = (false, false);
+                for (ci, &c) in ch.iter().enumerate() {
+                    let cb = [
+                        base[0] + (ci as u128 & 1) * h,
+                        base[1] + (ci as u128 >> 1 & 1) * h,
+                        base[2] + (ci as u128 >> 2 & 1) * h,
+                    ];
+                    let (bl, wh) = self.probe(c, level - 1, cb, b);
+                    black |= bl;
+                    white |= wh;
+                    if black && white {
+                        break;
+                    }
+                }
+                (black, white)
+            }
+            _ => {
+                let l = &self.leaves[slot as usize].0;
+                let r: [(u128, u128); 3] = std::array::from_fn(|a| {
+                    (
+                        b[a].0.max(base[a]) - base[a],
+                        b[a].1.min(base[a] + 8) - base[a],
+                    )
+                });
+                let row = ((1u64 << (r[0].1 - r[0].0)) - 1) << r[0].0;
+                let plane = (r[1].0..r[1].1).fold(0u64, |p, y| p | row << (8 * y));
+                let (mut black, mut white) = (false, false);
+                for z in r[2].0..r[2].1 {
+                    let w = l[z as usize] & plane;
+                    black |= w != 0;
+                    white |= w != plane;
+                }
+                (black, white)
+            }
+        }
+    }
+
+    // ----- invariants -------------------------------------------------------------------
+
+    /// Checks every invariant and panics with a message naming the first broken one:
+    /// counts (voxels, live nodes), parent links, free lists, that no stored node or
+    /// block is all-empty or all-full, that the root cannot contract, and with faces
+    /// that every listed face is exposed, its back-pointer is right, and the count is
+    /// `6·voxels − 2·(face-adjacent pairs)`. O(voxels · depth).
+    pub fn assert_valid(&self) {
+        let nfree: std::collections::HashSet<u32> = self.node_free.iter().copied().collect();
+        let lfree: std::collections::HashSet<u32> = self.leaf_free.iter().copied().collect();
+        assert_eq!(
+            nfree.len(),
+            self.node_free.len(),
+            "node free list has duplicates"
+        );
+        assert_eq!(
+            lfree.len(),
+            self.leaf_free.len(),
+            "block free list has duplicates"
+        );
+        for &i in &self.node_free {
+            assert_eq!(
+                self.node_parent[i as usize], FREED,
+                "free node {i} not marked"
+            );
+        }
+        for &i in &self.leaf_free {
+            assert_eq!(
+                self.leaf_parent[i as usize], FREED,
+                "free block {i} not marked"
+            );
+        }
+        assert_eq!(
+            self.leaves.len(),
+            self.leaf_parent.len(),
+            "block parent array length"
+        );
+        assert_eq!(
+            self.nodes.len(),
+            self.node_parent.len(),
+            "node parent array length"
+        );
+        if self.root == EMPTY {
+            assert_eq!(self.voxels, 0, "empty root with voxels");
+            assert_eq!(self.size_log2, 0, "empty tree has root size 1");
+            assert_eq!(self.node_count(), 0, "empty tree holds nodes");
+            assert_eq!(self.face_count(), 0, "empty tree has faces");
+            return;
+        }
+        assert!(self.size_log2 <= 64, "root size 2^{}", self.size_log2);
+        let phys = self.phys_log2();
+        if self.size_log2 < LEAF_LOG2 {
+            assert!(is_index(self.root), "small root must be a block");
+            let m = leaf_axis_masks(&self.leaves[self.root as usize].0);
+            for (a, &mask) in m.iter().enumerate() {
+                assert_eq!(
+                    u32::from(mask) >> (1u32 << self.size_log2),
+                    0,
+                    "bits outside the logical root on axis {a}"
+                );
+            }
+        }
+        let mut count: u128 = 0;
+        let mut seen_nodes = 0usize;
+        let mut seen_leaves = 0usize;
+        let mut stack = vec![(self.root, phys, NONE)];
+        while let Some((slot, level, parent)) = stack.pop() {
+            match slot {
+                EMPTY => {}
+                FULL => count = count.saturating_add(1u128 << (3 * level.min(42))),
+                _ if level > LEAF_LOG2 => {
+                    let n = &self.nodes[slot as usize];
+                    assert!(!nfree.contains(&slot), "node {slot} is live and free");
+                    assert_eq!(
+                        self.node_parent[slot as usize], parent,
+                        "parent link of node {slot}"
+                    );
+                    assert!(n.child.iter().any(|&c| c != EMPTY), "node {slot} is empty");
+                    assert!(n.child.iter().any(|&c| c != FULL), "node {slot} is full");
+                    seen_nodes += 1;
+                    for &c in &n.child {
+                        stack.push((c, level - 1, slot));
+                    }
+                }
+                _ => {
+                    let l = &self.leaves[slot as usize].0;
+                    assert!(!lfree.contains(&slot), "block {slot} is live and free");
+                    assert_eq!(
+                        self.leaf_parent[slot as usize], parent,
+                        "parent link of block {slot}"
+                    );
+                    assert!(l.iter().any(|&w| w != 0), "block {slot} is empty");
+                    assert!(l.iter().any(|&w| w != !0), "block {slot} is full");
+                    seen_leaves += 1;
+                    count += u128::from(l.iter().map(|w| w.count_ones()).sum::<u32>());
+                }
+            }
+        }
+        assert_eq!(count, u128::from(self.voxels), "voxel count");
+        assert_eq!(
+            seen_nodes,
+            self.nodes.len() - 1 - self.node_free.len(),
+            "live node count"
+        );
+        assert_eq!(
+            seen_leaves,
+            self.leaves.len() - 1 - self.leaf_free.len(),
+            "live block count"
+        );
+        // The root cannot contract.
+        if self.size_log2 > LEAF_LOG2 && self.root != FULL {
+            let ch = &self.nodes[self.root as usize].child;
+            assert!(
+                ch.iter().filter(|&&c| c != EMPTY).count() >= 2,
+                "root could contract"
+            );
+        } else if self.size_log2 > 0 && self.root != FULL {
+            let half = 1u32 << (self.size_log2 - 1);
+            let m = leaf_axis_masks(&self.leaves[self.root as usize].0);
+            let splits = m.iter().any(|&mask| {
+                u32::from(mask) & ((1 << half) - 1) != 0 && u32::from(mask) >> half != 0
+            });
+            assert!(splits, "root block could contract");
+        }
+        if let Some(f) = &self.faces {
+            f.assert_valid();
+            for (i, e) in f.list.iter().enumerate() {
+                assert!(self.contains(e.voxel), "face {i} on a white voxel");
+                assert!(!self.contains(e.face().outside()), "face {i} is covered");
+            }
+            let all = self.voxels();
+            let pairs: u64 = all
+                .iter()
+                .map(|&v| {
+                    (0..3u8)
+                        .filter(|&a| self.contains(step(v, 2 * a + 1)))
+                        .count() as u64
+                })
+                .sum();
+            assert_eq!(
+                f.list.len() as u64,
+                6 * self.voxels - 2 * pairs,
+                "face count is not 6·voxels − 2·pairs"
+            );
+        }
+    }
+}
+
+/// A dynamic octree classifies cells for [`LinearOctree::from_classifier`] (and so for
+/// CSG scenes) through [`DynamicOctree::classify`].
+impl Classifier for DynamicOctree {
+    fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
+        DynamicOctree::classify(self, min, size_log2)
+    }
+}
+
+impl Extend<Voxel> for DynamicOctree {
+    fn extend<I: IntoIterator<Item = Voxel>>(&mut self, iter: I) {
+        for v in iter {
+            self.insert(v);
+        }
+    }
+}
+
+impl FromIterator<Voxel> for DynamicOctree {
+    fn from_iter<I: IntoIterator<Item = Voxel>>(iter: I) -> Self {
+        Self::from_voxels(iter)
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,154 @@
+//! Moving a linear octree into another space (depth and origin), for formats whose
+//! grid is fixed (OctoMap's 2^16 keys centred at 32768) or fitted to the data.
+
+use crate::code;
+use crate::linear::{Leaf, LinearOctree, OctreeError};
+use crate::Voxel;
+
+/// The same black voxels in the space of side `2^depth` whose lowest corner is
+/// `origin`.
+///
+/// # Runtime
+/// O(n log n) for n leaves when the offset between the two origins is a multiple of
+/// every block's size (each block then maps to one block); otherwise each block is
+/// cut into aligned cubes, O(its surface) each.
+///
+/// # Errors
+/// [`OctreeError::OutOfBounds`] naming a voxel that does not fit the new space;
+/// [`OctreeError::DepthTooLarge`].
+///
+/// ```
+/// use tesseral::io::reframe;
+/// use tesseral::linear::LinearOctree;
+/// let t = LinearOctree::full(1, [0, 0, 0]).unwrap();
+/// let moved = reframe(&t, 3, [-1, -1, -1]).unwrap(); // no longer aligned: 8 voxels
+/// assert_eq!((moved.voxel_count(), moved.leaf_count()), (8, 8));
+/// ```
+pub fn reframe(tree: &LinearOctree, depth: u8, origin: Voxel) -> Result<LinearOctree, OctreeError> {
+    if depth == tree.depth() && origin == tree.origin() {
+        return Ok(tree.clone());
+    }
+    LinearOctree::empty(depth, origin)?;
+    let side = 1i64 << depth;
+    let mut leaves = Vec::with_capacity(tree.leaf_count());
+    for b in tree.blocks() {
+        let s = b.size();
+        let mut rel = [0i64; 3];
+        for a in 0..3 {
+            let r = b.min[a].checked_sub(origin[a]);
+            match r {
+                Some(r) if r >= 0 && r.checked_add(s).is_some_and(|e| e <= side) => rel[a] = r,
+                _ => {
+                    // Name the first voxel of the block that falls outside.
+                    let mut v = b.min;
+                    if !matches!(r, Some(r) if r >= 0) {
+                        v[a] = b.min[a];
+                    } else {
+                        v[a] = origin[a].saturating_add(side);
+                    }
+                    return Err(OctreeError::OutOfBounds(v));
+                }
+            }
+        }
+        if rel.iter().all(|r| r % s == 0) {
+            leaves.push(Leaf::new(
+                code::encode(rel[0] as u32, rel[1] as u32, rel[2] as u32),
+                b.size_log2,
+            ));
+        } else {
+            cut_box(rel, s, &mut leaves);
+        }
+    }
+    leaves.sort_unstable();
+    LinearOctree::from_sorted_leaves(depth, origin, leaves)
+}
+
+/// Cuts the cube `[lo, lo + s)` per axis into maximal aligned cubes.
+fn cut_box(lo: [i64; 3], s: i64, out: &mut Vec<Leaf>) {
+    // The cube overlaps at most eight aligned cells of size s.
+    let k = s.trailing_zeros() as u8;
+    let base = lo.map(|l| l & !(s - 1));
+    for d in 0..8 {
+        let cell = [
+            base[0] + (d & 1) * s,
+            base[1] + ((d >> 1) & 1) * s,
+            base[2] + ((d >> 2) & 1) * s,
+        ];
+        cut_cell(cell, k, lo, s, out);
+    }
+}
+
+fn cut_cell(cell: [i64; 3], k: u8, lo: [i64; 3], s: i64, out: &mut Vec<Leaf>) {
+    let c = 1i64 << k;
+    let mut inside = true;
+    for a in 0..3 {
+        let (c0, c1, b0, b1) = (cell[a], cell[a] + c, lo[a], lo[a] + s);
+        if c1 <= b0 || c0 >= b1 {
+            return;
+        }
+        if c0 < b0 || c1 > b1 {
+            inside = false;
+        }
+    }
+    if inside {
+        out.push(Leaf::new(
+            code::encode(cell[0] as u32, cell[1] as u32, cell[2] as u32),
+            k,
+        ));
+        return;
+    }
+    let h = c / 2;
+    for d in 0..8 {
+        let child = [
+            cell[0] + (d & 1) * h,
+            cell[1] + ((d >> 1) & 1) * h,
+            cell[2] + ((d >> 2) & 1) * h,
+        ];
+        cut_cell(child, k - 1, lo, s, out);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use std::collections::HashSet;
+
+    #[test]
+    fn reframe_keeps_voxels_for_random_offsets() {
+        for seed in 0..60u64 {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let origin = [
+                rng.random_range(-5..5),
+                rng.random_range(-5..5),
+                rng.random_range(-5..5),
+            ];
+            let voxels: Vec<Voxel> = (0..rng.random_range(0..400))
+                .map(|_| {
+                    [
+                        origin[0] + rng.random_range(0..8),
+                        origin[1] + rng.random_range(0..8),
+                        origin[2] + rng.random_range(0..8),
+                    ]
+                })
+                .collect();
+            let tree = LinearOctree::from_voxels(3, origin, voxels.iter().copied()).unwrap();
+            let new_origin = [
+                origin[0] - rng.random_range(0..8),
+                origin[1] - rng.random_range(0..8),
+                origin[2] - 4,
+            ];
+            let moved = reframe(&tree, 4, new_origin).unwrap();
+            moved.assert_valid();
+            let a: HashSet<Voxel> = tree.voxels().collect();
+            let b: HashSet<Voxel> = moved.voxels().collect();
+            assert_eq!(a, b, "seed {seed}");
+            if !tree.is_empty() {
+                assert!(
+                    reframe(&tree, 3, [origin[0] + 8, origin[1], origin[2]]).is_err()
+                        || a.iter().all(|v| v[0] >= origin[0] + 8)
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,596 @@
+//! Rays through a linear octree: the parametric traversal of Revelles, Ureña and
+//! Lastra ("An efficient parametric algorithm for octree traversal", WSCG 2000), with
+//! octant mirroring, over the gray nodes of the linear octree.
+
+use crate::linear::{Leaf, LinearOctree};
+
+/// One gray node: which children are gray and which are black (the rest are white),
+/// and where the gray children's nodes start (they are stored together, in label
+/// order).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    first: u32,
+    gray: u8,
+    black: u8,
+}
+
+/// The colour of the root.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Root {
+    White,
+    Black,
+    Gray,
+}
+
+/// The gray nodes of a linear octree, in a form rays can descend quickly.
+///
+/// The linear octree keeps only its black leaves, sorted; a node of the implicit tree
+/// is a code range, white when no leaf falls in it, black when one leaf covers it,
+/// gray otherwise. This index records, for each gray node, the colours of its eight
+/// children: 8 bytes per gray node (about a seventh of the leaves' 8 bytes each). It
+/// is derived from the leaves in one pass, never from the solid: rendering an octree
+/// file never rebuilds the solid.
+///
+/// ```
+/// use tesseral::linear::LinearOctree;
+/// use tesseral::render::{Ray, RayTree};
+/// let tree = LinearOctree::from_voxels(2, [0, 0, 0], [[1, 1, 1]]).unwrap();
+/// let rt = RayTree::new(&tree);
+/// let hit = rt.cast(&Ray::new([-5.0, 1.5, 1.5], [1.0, 0.0, 0.0]), 0.0, f64::INFINITY).unwrap();
+/// assert!((hit.t - 6.0).abs() < 1e-9 && hit.axis == 0 && hit.block_min == [1, 1, 1]);
+/// ```
+#[derive(Debug, Clone)]
+pub struct RayTree {
+    depth: u8,
+    origin: [i64; 3],
+    root: Root,
+    nodes: Vec<Node>,
+    bbox: Option<([i64; 3], [i64; 3])>,
+}
+
+/// A ray `origin + t · dir`, in the voxel coordinates of the tree.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ray {
+    /// The start point.
+    pub origin: [f64; 3],
+    /// The direction (any non-zero length).
+    pub dir: [f64; 3],
+}
+
+impl Ray {
+    /// A ray from `origin` along `dir`.
+    #[must_use]
+    pub fn new(origin: [f64; 3], dir: [f64; 3]) -> Self {
+        Self { origin, dir }
+    }
+
+    /// The point at parameter `t`.
+    #[must_use]
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        [
+            self.origin[0] + t * self.dir[0],
+            self.origin[1] + t * self.dir[1],
+            self.origin[2] + t * self.dir[2],
+        ]
+    }
+}
+
+/// Where a ray first meets a black block.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    /// The ray parameter of the hit.
+    pub t: f64,
+    /// The axis of the face entered (0 x, 1 y, 2 z); the outward normal is minus the
+    /// sign of the ray's direction on that axis. When the ray starts inside a block (or
+    /// at the near end of its interval) this is the axis whose slab it entered last.
+    pub axis: usize,
+    /// The lowest voxel of the black block hit.
+    pub block_min: [i64; 3],
+    /// The side of that block, as a power of two.
+    pub size_log2: u8,
+    /// Whether the hit lies at the start of the ray's interval (the ray began inside a
+    /// black block: a cut face of a cross-section).
+    pub at_start: bool,
+}
+
+impl RayTree {
+    /// Indexes the gray nodes of `tree`.
+    ///
+    /// # Runtime
+    /// O(g log n) for g gray nodes and n leaves.
+    #[must_use]
+    pub fn new(tree: &LinearOctree) -> Self {
+        let depth = tree.depth();
+        let leaves = tree.leaves();
+        let mut rt = RayTree {
+            depth,
+            origin: tree.origin(),
+            root: Root::White,
+            nodes: Vec::new(),
+            bbox: tree.bbox(),
+        };
+        rt.root = match colour_of(leaves, 0, depth) {
+            Colour::White => Root::White,
+            Colour::Black => Root::Black,
+            Colour::Gray => {
+                rt.nodes.push(Node {
+                    first: 0,
+                    gray: 0,
+                    black: 0,
+                });
+                rt.index(0, 0, depth, leaves);
+                Root::Gray
+            }
+        };
+        rt
+    }
+
+    fn index(&mut self, at: usize, code: u64, k: u8, leaves: &[Leaf]) {
+        let child_cells = 1u64 << (3 * u32::from(k - 1));
+        let mut ranges = [(0usize, 0usize); 8];
+        let (mut gray, mut black) = (0u8, 0u8);
+        let mut lo = 0;
+        for d in 0..8u64 {
+            let end_code = code + (d + 1) * child_cells;
+            let hi = lo + leaves[lo..].partition_point(|l| l.code() < end_code);
+            ranges[d as usize] = (lo, hi);
+            match colour_of(&leaves[lo..hi], code + d * child_cells, k - 1) {
+                Colour::White => {}
+                Colour::Black => black |= 1 << d,
+                Colour::Gray => gray |= 1 << d,
+            }
+            lo = hi;
+        }
+        let first = self.nodes.len();
+        self.nodes[at] = Node {
+            first: first as u32,
+            gray,
+            black,
+        };
+        for _ in 0..gray.count_ones() {
+            self.nodes.push(Node {
+                first: 0,
+                gray: 0,
+                black: 0,
+            });
+        }
+        let mut j = first;
+        for d in 0..8u64 {
+            if gray & (1 << d) != 0 {
+                let (a, b) = ranges[d as usize];
+                self.index(j, code + d * child_cells, k - 1, &leaves[a..b]);
+                j += 1;
+            }
+        }
+    }
+
+    /// The number of gray nodes indexed.
+    #[must_use]
+    pub fn gray_nodes(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// The inclusive bounding box of the black voxels (as [`LinearOctree::bbox`]).
+    #[must_use]
+    pub fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.bbox
+    }
+
+    /// The tree's depth.
+    #[must_use]
+    pub fn depth(&self) -> u8 {
+        self.depth
+    }
+
+    /// The lowest corner of the tree's space.
+    #[must_use]
+    pub fn origin(&self) -> [i64; 3] {
+        self.origin
+    }
+
+    /// Whether the voxel `v` is black: a descent from the root.
+    ///
+    /// # Runtime
+    /// O(depth).
+    #[must_use]
+    pub fn contains(&self, v: [i64; 3]) -> bool {
+        let side = 1i64 << self.depth;
+        let rel = [
+            v[0] - self.origin[0],
+            v[1] - self.origin[1],
+            v[2] - self.origin[2],
+        ];
+        if rel.iter().any(|&c| c < 0 || c >= side) {
+            return false;
+        }
+        match self.root {
+            Root::White => return false,
+            Root::Black => return true,
+            Root::Gray => {}
+        }
+        let mut node = self.nodes[0];
+        let mut k = self.depth;
+        loop {
+            k -= 1;
+            let d = ((rel[0] >> k) & 1) | (((rel[1] >> k) & 1) << 1) | (((rel[2] >> k) & 1) << 2);
+            let bit = 1u8 << d;
+            if node.black & bit != 0 {
+                return true;
+            }
+            if node.gray & bit == 0 {
+                return false;
+            }
+            let j = (node.gray & (bit - 1)).count_ones();
+            node = self.nodes[(node.first + j) as usize];
+        }
+    }
+
+    /// The first black block along `ray` with parameter in `[tmin, tmax]`.
+    ///
+    /// Revelles et al.: the ray is mirrored so that every direction component is
+    /// positive (the mirrored axes are kept in the mask `a`, and a child's true label
+    /// is its mirrored label xor `a`); each node's entry and exit parameters per axis
+    /// give its children's without division, and the next child follows from the exit
+    /// plane. The ray stops at the first black block, whatever its size.
+    ///
+    /// # Runtime
+    /// O(nodes visited): about the depth plus the white and gray siblings crossed.
+    #[must_use]
+    pub fn cast(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+        self.cast_with(ray, tmin, tmax, &mut TraversalStack::default())
+    }
+
+    /// As [`RayTree::cast`], reusing a traversal stack: for many rays in a row.
+    #[must_use]
+    pub fn cast_with(
+        &self,
+        ray: &Ray,
+        tmin: f64,
+        tmax: f64,
+        stack: &mut TraversalStack,
+    ) -> Option<Hit> {
+        if self.root == Root::White {
+            return None;
+        }
+        let side = f64::from(1u32 << self.depth);
+        let lo = self.origin.map(|v| v as f64);
+        let mut o = ray.origin;
+        let mut d = ray.dir;
+        let mut a = 0u8;
+        for ax in 0..3 {
+            if d[ax] < 0.0 {
+                o[ax] = 2.0 * lo[ax] + side - o[ax];
+                d[ax] = -d[ax];
+                a |= 1 << ax;
+            }
+            if d[ax] < 1e-12 {
+                d[ax] = 1e-12;
+            }
+        }
+        let mut t0 = [0.0; 3];
+        let mut t1 = [0.0; 3];
+        for ax in 0..3 {
+            t0[ax] = (lo[ax] - o[ax]) / d[ax];
+            t1[ax] = (lo[ax] + side - o[ax]) / d[ax];
+        }
+        let enter = t0[0].max(t0[1]).max(t0[2]);
+        let exit = t1[0].min(t1[1]).min(t1[2]);
+        if enter >= exit || exit < tmin || enter > tmax {
+            return None;
+        }
+        if self.root == Root::Black {
+            let (axis, t) = argmax(t0);
+            let at_start = t < tmin;
+            return Some(Hit {
+                t: if at_start { tmin } else { t },
+                axis,
+                block_min: self.origin,
+                size_log2: self.depth,
+                at_start,
+            });
+        }
+        self.walk(t0, t1, a, tmin, tmax, &mut stack.levels)
+    }
+
+    /// The iterative traversal below a gray root: an explicit stack of nodes, each
+    /// with its slab parameters (mirrored space) and the child being visited.
+    #[inline]
+    fn walk(
+        &self,
+        t0: [f64; 3],
+        t1: [f64; 3],
+        a: u8,
+        tmin: f64,
+        tmax: f64,
+        stack: &mut [Level; 22],
+    ) -> Option<Hit> {
+        if lt(t1[0], tmin) || lt(t1[1], tmin) || lt(t1[2], tmin) {
+            return None;
+        }
+        let mut sp = 0usize;
+        stack[0] = Level::new(0, t0, t1, self.origin, self.depth);
+        loop {
+            let lv = &mut stack[sp];
+            let cur = lv.cur;
+            let (c0, c1) = lv.child(cur);
+            let entry = max3(c0);
+            let mut descended = false;
+            if entry <= tmax {
+                let node = self.nodes[lv.node as usize];
+                let label = cur ^ a;
+                let bit = 1u8 << label;
+                if (node.black | node.gray) & bit != 0 {
+                    let exit = min3(c1);
+                    if exit >= tmin {
+                        let half = 1i64 << (lv.k - 1);
+                        let cmin = [
+                            lv.min[0] + half * i64::from(label & 1),
+                            lv.min[1] + half * i64::from((label >> 1) & 1),
+                            lv.min[2] + half * i64::from((label >> 2) & 1),
+                        ];
+                        if node.black & bit != 0 {
+                            let (axis, t) = argmax(c0);
+                            let at_start = t < tmin;
+                            return Some(Hit {
+                                t: if at_start { tmin } else { t },
+                                axis,
+                                block_min: cmin,
+                                size_log2: lv.k - 1,
+                                at_start,
+                            });
+                        }
+                        let j = (node.gray & (bit - 1)).count_ones();
+                        let k = lv.k - 1;
+                        sp += 1;
+                        stack[sp] = Level::new(node.first + j, c0, c1, cmin, k);
+                        descended = true;
+                    }
+                }
+            } else {
+                // Every later child of this node starts later still: leave it.
+                stack[sp].cur = 8;
+            }
+            if descended {
+                continue;
+            }
+            // Advance: across the nearest exit plane, popping finished nodes.
+            loop {
+                let lv = &mut stack[sp];
+                if lv.cur < 8 {
+                    let (_, c1) = lv.child(lv.cur);
+                    let ax = argmin(c1).0;
+                    if lv.cur & (1 << ax) == 0 {
+                        lv.cur |= 1 << ax;
+                        break;
+                    }
+                }
+                if sp == 0 {
+                    return None;
+                }
+                sp -= 1;
+            }
+        }
+    }
+}
+
+impl RayTree {
+    /// A lower bound on where a bundle of rays first meets the solid (ESVO-style beam
+    /// optimization, Laine & Karras 2010). `near(min, max)` returns, for a box, `None`
+    /// when no ray of the bundle can enter it, else a lower bound on the ray parameter
+    /// of its points. Nodes of side `2^stop_log2` or less count as solid, so the search
+    /// stays coarse. Returns infinity when no ray of the bundle meets a black block.
+    ///
+    /// # Runtime
+    /// O(nodes whose boxes the bundle meets, down to the stop size).
+    #[must_use]
+    pub fn beam_start(
+        &self,
+        stop_log2: u8,
+        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
+    ) -> f64 {
+        let side = f64::from(1u32 << self.depth);
+        let lo = self.origin.map(|v| v as f64);
+        let hi = lo.map(|v| v + side);
+        match self.root {
+            Root::White => f64::INFINITY,
+            Root::Black => near(lo, hi).unwrap_or(f64::INFINITY),
+            Root::Gray => {
+                if near(lo, hi).is_none() {
+                    return f64::INFINITY;
+                }
+                let mut best = f64::INFINITY;
+                self.beam_rec(0, self.origin, self.depth, stop_log2, near, &mut best);
+                best
+            }
+        }
+    }
+
+    fn beam_rec(
+        &self,
+        n: u32,
+        min: [i64; 3],
+        k: u8,
+        stop: u8,
+        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
+        best: &mut f64,
+    ) {
+        let node = self.nodes[n as usize];
+        let half = 1i64 << (k - 1);
+        let mut kids: [(f64, u8, [i64; 3]); 8] = [(0.0, 0, [0; 3]); 8];
+        let mut count = 0;
+        for label in 0..8u8 {
+            let bit = 1u8 << label;
+            if (node.black | node.gray) & bit == 0 {
+                continue;
+            }
+            let cmin = [
+                min[0] + half * i64::from(label & 1),
+                min[1] + half * i64::from((label >> 1) & 1),
+                min[2] + half * i64::from((label >> 2) & 1),
+            ];
+            let lo = cmin.map(|v| v as f64);
+            let hi = lo.map(|v| v + half as f64);
+            if let Some(t) = near(lo, hi) {
+                // Insertion by t: nearer children first prune the rest sooner.
+                let mut i = count;
+                while i > 0 && kids[i - 1].0 > t {
+                    kids[i] = kids[i - 1];
+                    i -= 1;
+                }
+                kids[i] = (t, label, cmin);
+                count += 1;
+            }
+        }
+        for &(t, label, cmin) in &kids[..count] {
+            if t >= *best {
+                break;
+            }
+            let bit = 1u8 << label;
+            if node.black & bit != 0 || k - 1 <= stop {
+                *best = t;
+            } else {
+                let j = (node.gray & (bit - 1)).count_ones();
+                self.beam_rec(node.first + j, cmin, k - 1, stop, near, best);
+            }
+        }
+    }
+}
+
+/// Scratch space for [`RayTree::cast_with`]: one entry per tree depth.
+#[derive(Debug, Clone)]
+pub struct TraversalStack {
+    levels: [Level; 22],
+}
+
+impl Default for TraversalStack {
+    fn default() -> Self {
+        Self {
+            levels: [Level::default(); 22],
+        }
+    }
+}
+
+/// One node on the traversal stack.
+#[derive(Debug, Clone, Copy, Default)]
+struct Level {
+    t0: [f64; 3],
+    tm: [f64; 3],
+    t1: [f64; 3],
+    min: [i64; 3],
+    node: u32,
+    k: u8,
+    cur: u8,
+}
+
+impl Level {
+    #[inline]
+    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], min: [i64; 3], k: u8) -> Self {
+        let tm = [
+            0.5 * (t0[0] + t1[0]),
+            0.5 * (t0[1] + t1[1]),
+            0.5 * (t0[2] + t1[2]),
+        ];
+        Level {
+            t0,
+            tm,
+            t1,
+            min,
+            node,
+            k,
+            cur: first_child(t0, tm),
+        }
+    }
+
+    /// The slab parameters of child `cur` (mirrored label).
+    #[inline]
+    fn child(&self, cur: u8) -> ([f64; 3], [f64; 3]) {
+        let (x, y, z) = (cur & 1 != 0, cur & 2 != 0, cur & 4 != 0);
+        (
+            [
+                if x { self.tm[0] } else { self.t0[0] },
+                if y { self.tm[1] } else { self.t0[1] },
+                if z { self.tm[2] } else { self.t0[2] },
+            ],
+            [
+                if x { self.t1[0] } else { self.tm[0] },
+                if y { self.t1[1] } else { self.tm[1] },
+                if z { self.t1[2] } else { self.tm[2] },
+            ],
+        )
+    }
+}
+
+#[inline]
+fn lt(a: f64, b: f64) -> bool {
+    a < b
+}
+
+#[inline]
+fn max3(t: [f64; 3]) -> f64 {
+    let m = if t[0] > t[1] { t[0] } else { t[1] };
+    if m > t[2] {
+        m
+    } else {
+        t[2]
+    }
+}
+
+#[inline]
+fn min3(t: [f64; 3]) -> f64 {
+    let m = if t[0] < t[1] { t[0] } else { t[1] };
+    if m < t[2] {
+        m
+    } else {
+        t[2]
+    }
+}
+
+/// The first child a ray enters (Revelles Table 1, in our labels `x + 2y + 4z`).
+#[inline]
+fn first_child(t0: [f64; 3], tm: [f64; 3]) -> u8 {
+    let (entry_axis, t) = argmax(t0);
+    let mut c = 0u8;
+    for ax in 0..3 {
+        if ax != entry_axis && tm[ax] < t {
+            c |= 1 << ax;
+        }
+    }
+    c
+}
+
+#[inline]
+fn argmax(t: [f64; 3]) -> (usize, f64) {
+    if t[0] >= t[1] && t[0] >= t[2] {
+        (0, t[0])
+    } else if t[1] >= t[2] {
+        (1, t[1])
+    } else {
+        (2, t[2])
+    }
+}
+
+#[inline]
+fn argmin(t: [f64; 3]) -> (usize, f64) {
+    if t[0] <= t[1] && t[0] <= t[2] {
+        (0, t[0])
+    } else if t[1] <= t[2] {
+        (1, t[1])
+    } else {
+        (2, t[2])
+    }
+}
+
+enum Colour {
+    White,
+    Black,
+    Gray,
+}
+
+/// The colour of the node `(code, k)` whose leaves are `leaves` (all inside it).
+fn colour_of(leaves: &[Leaf], code: u64, k: u8) -> Colour {
+    match leaves {
+        [] => Colour::White,
+        [l] if l.code() == code && l.size_log2() == k => Colour::Black,
+        _ => Colour::Gray,
+    }
+}
