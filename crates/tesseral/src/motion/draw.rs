@@ -82,14 +82,7 @@ pub fn render_frame(
         }
         ENVIRONMENT_COLOUR
     };
-    Ok(render(
-        &all,
-        Surface {
-            colour: Some(&shader),
-            normal: None,
-        },
-        opts,
-    ))
+    Ok(render(&all, Surface { colour: Some(&shader), normal: None }, opts))
 }
 
 /// Renders a planned path: the environment in grey, the object at the start in
@@ -142,12 +135,5 @@ pub fn render_plan(
             ENVIRONMENT_COLOUR
         }
     };
-    Ok(render(
-        &all,
-        Surface {
-            colour: Some(&shader),
-            normal: None,
-        },
-        opts,
-    ))
+    Ok(render(&all, Surface { colour: Some(&shader), normal: None }, opts))
 }
