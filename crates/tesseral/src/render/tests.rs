@@ -137,10 +137,10 @@ fn traversal_equals_brute_force_over_blocks() {
                     // The hit point lies in the block reported.
                     let p = ray.at(h.t);
                     let s = (1i64 << h.size_log2) as f64;
-                    for a in 0..3 {
-                        let lo = h.block_min[a] as f64;
+                    for (&pa, &b) in p.iter().zip(&h.block_min) {
+                        let lo = b as f64;
                         assert!(
-                            p[a] >= lo - 1e-6 && p[a] <= lo + s + 1e-6,
+                            pa >= lo - 1e-6 && pa <= lo + s + 1e-6,
                             "trial {trial} ray {i}"
                         );
                     }
