@@ -22,6 +22,7 @@ mod draw;
 mod plan;
 mod sweep;
 mod traverse;
+mod view;
 mod world;
 mod world_file;
 
@@ -29,6 +30,7 @@ pub use interfere::{
     clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
     intersects_placed, Aabb, Interference, Placed, Placement,
 };
+pub use view::{BoxTree, Traversable};
 pub use orient::{Rotation, RotationError};
 pub use draw::{
     render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
