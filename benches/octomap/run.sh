@@ -35,11 +35,14 @@ echo "running the tesseral summary..." >&2
   | grep '^RESULT' | tee "$build/tesseral.txt" >&2
 
 awk '
-  $1 == "RESULT" { v[$2 " " $3 " " $4] = $5 }
+  $1 == "RESULT" { k = $2 " " $3 " " $4; if (!(k in v)) order[++n] = k; v[k] = $5 }
   function row(w, label, tm, om,   t, o) {
     t = v["tesseral " w " " tm]; o = v["octomap " w " " om]
     if (t == "" || o == "") return
-    printf "| %-7s | %-34s | %12.2f | %12.2f | %8.1fx |\n", w, label, t, o, (t > 0 ? o / t : 0)
+    if (t > 0 && o > 0)
+      printf "| %-7s | %-34s | %12.2f | %12.2f | %8.1fx |\n", w, label, t, o, o / t
+    else
+      printf "| %-7s | %-34s | %12.2f | %12.2f |      n/a |\n", w, label, t, o
   }
   END {
     print "| work    | measure                            |     tesseral |      OctoMap | OctoMap/tesseral |"
@@ -54,4 +57,12 @@ awk '
       row(w, "bytes per stored voxel (own count)", "bytes_per_voxel", "bytes_per_voxel")
       row(w, "bytes per stored voxel (RSS delta)", "rss_bytes_per_voxel", "rss_bytes_per_voxel")
     }
+    print ""
+    print "tesseral only (same run):"
+    for (i = 1; i <= n; i++) {
+      split(order[i], p, " ")
+      if (p[1] == "tesseral") printf "  %s %s = %s\n", p[2], p[3], v[order[i]]
+    }
+    print "OctoMap bytes per leaf (memoryUsage / getNumLeafNodes):"
+    printf "  random %s, shell %s\n", v["octomap random bytes_per_leaf"], v["octomap shell bytes_per_leaf"]
   }' "$build/octomap.txt" "$build/tesseral.txt"

@@ -33,6 +33,24 @@ enum Command {
     Simulate(cmd::simulate::Args),
     /// A collision-free path for an object through an environment.
     Plan(cmd::plan::Args),
+    /// Prints what an octree file holds (--json for programs).
+    Info(cmd::info::Args),
+    /// Translates an octree by an integer vector.
+    Translate(cmd::transform::TranslateArgs),
+    /// Rotates an octree by quarter turns about an axis.
+    Rotate(cmd::transform::RotateArgs),
+    /// Mirrors an octree in an axis.
+    Mirror(cmd::transform::MirrorArgs),
+    /// Scales an octree by 2^K.
+    Scale(cmd::transform::ScaleArgs),
+    /// Set operations: union, intersection, difference, xor.
+    Op(cmd::op::Args),
+    /// The complement of an octree within its space.
+    Complement(cmd::transform::ComplementArgs),
+    /// Draws a scene or an octree file as a PNG image.
+    Render(cmd::render::Args),
+    /// Builds a scene's octree and writes it to a file.
+    Build(cmd::build::Args),
 }
 
 fn main() -> ExitCode {
@@ -46,6 +64,15 @@ fn main() -> ExitCode {
         Command::Collide(args) => cmd::collide::run(args),
         Command::Simulate(args) => cmd::simulate::run(args),
         Command::Plan(args) => cmd::plan::run(args),
+        Command::Info(args) => cmd::info::run(args),
+        Command::Translate(args) => cmd::transform::translate(args),
+        Command::Rotate(args) => cmd::transform::rotate(args),
+        Command::Mirror(args) => cmd::transform::mirror(args),
+        Command::Scale(args) => cmd::transform::scale(args),
+        Command::Op(args) => cmd::op::run(args),
+        Command::Complement(args) => cmd::transform::complement(args),
+        Command::Render(args) => cmd::render::run(args),
+        Command::Build(args) => cmd::build::run(args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -37,7 +37,10 @@ fn fails(out: &Output, needle: &str) {
     let err = String::from_utf8_lossy(&out.stderr);
     // The message is on the first line (clap adds a hint line after its own).
     let first = err.lines().next().unwrap_or("");
-    assert!(first.starts_with("error: ") && first.contains(needle), "stderr {err:?} lacks {needle:?}");
+    assert!(
+        first.starts_with("error: ") && first.contains(needle),
+        "stderr {err:?} lacks {needle:?}"
+    );
     assert!(!err.contains("panicked"), "{err}");
 }
 
@@ -55,7 +58,13 @@ fn write_xyz(dir: &Path, name: &str, voxels: impl IntoIterator<Item = [i64; 3]>)
 
 fn cube(side: i64, at: [i64; 3]) -> Vec<[i64; 3]> {
     (0..side * side * side)
-        .map(|i| [at[0] + i % side, at[1] + i / side % side, at[2] + i / side / side])
+        .map(|i| {
+            [
+                at[0] + i % side,
+                at[1] + i / side % side,
+                at[2] + i / side / side,
+            ]
+        })
         .collect()
 }
 
@@ -103,13 +112,30 @@ fn collide_reports_overlap_and_clearance_as_brute_force_does() {
     }
     // Text output, rotation and contacts.
     let text = ok(&tesseral(
-        &["collide", "a.xyz", "b.xyz", "--offset", "3,3,3", "--rotate", "z90", "--contacts"],
+        &[
+            "collide",
+            "a.xyz",
+            "b.xyz",
+            "--offset",
+            "3,3,3",
+            "--rotate",
+            "z90",
+            "--contacts",
+        ],
         dir.path(),
     ));
     assert!(text.contains("intersects: yes"), "{text}");
     assert!(text.contains("contact: "), "{text}");
     let v = json(&tesseral(
-        &["collide", "a.xyz", "b.xyz", "--offset=4,0,0", "--rotate", "z90", "--json"],
+        &[
+            "collide",
+            "a.xyz",
+            "b.xyz",
+            "--offset=4,0,0",
+            "--rotate",
+            "z90",
+            "--json",
+        ],
         dir.path(),
     ));
     // z90 turns (1, 0, 0) into (-1, 1, 0) as a voxel: at offset 4 it lands on x = 3.
@@ -122,14 +148,26 @@ fn collide_errors_are_one_line_with_exit_code_2() {
     let dir = tempfile::tempdir().unwrap();
     write_xyz(dir.path(), "a.xyz", cube(2, [0, 0, 0]));
     std::fs::write(dir.path().join("bad.xyz"), "0 0 0\n1 x 0\n").unwrap();
-    fails(&tesseral(&["collide", "a.xyz", "bad.xyz"], dir.path()), "bad.xyz:2:");
-    fails(&tesseral(&["collide", "a.xyz", "missing.xyz"], dir.path()), "missing.xyz");
     fails(
-        &tesseral(&["collide", "a.xyz", "a.xyz", "--offset", "1,2"], dir.path()),
+        &tesseral(&["collide", "a.xyz", "bad.xyz"], dir.path()),
+        "bad.xyz:2:",
+    );
+    fails(
+        &tesseral(&["collide", "a.xyz", "missing.xyz"], dir.path()),
+        "missing.xyz",
+    );
+    fails(
+        &tesseral(
+            &["collide", "a.xyz", "a.xyz", "--offset", "1,2"],
+            dir.path(),
+        ),
         "X,Y,Z",
     );
     fails(
-        &tesseral(&["collide", "a.xyz", "a.xyz", "--rotate", "x45"], dir.path()),
+        &tesseral(
+            &["collide", "a.xyz", "a.xyz", "--rotate", "x45"],
+            dir.path(),
+        ),
         "rotation",
     );
 }
@@ -137,7 +175,9 @@ fn collide_errors_are_one_line_with_exit_code_2() {
 #[test]
 fn simulate_reports_a_tunnelling_contact_and_writes_frames() {
     let dir = tempfile::tempdir().unwrap();
-    let thin: Vec<[i64; 3]> = (0..16).flat_map(|y| (0..16).map(move |z| [30, y, z])).collect();
+    let thin: Vec<[i64; 3]> = (0..16)
+        .flat_map(|y| (0..16).map(move |z| [30, y, z]))
+        .collect();
     write_xyz(dir.path(), "wall.xyz", thin);
     write_xyz(dir.path(), "bullet.xyz", cube(2, [0, 0, 0]));
     write_xyz(dir.path(), "box.xyz", cube(3, [0, 0, 0]));
@@ -181,12 +221,23 @@ fn simulate_reports_a_tunnelling_contact_and_writes_frames() {
     // Linear translation gives the same contacts.
     std::fs::write(
         dir.path().join("world2.json"),
-        world.replace("\"steps\": 3,", "\"steps\": 3, \"translation\": \"linear\","),
+        world.replace(
+            "\"steps\": 3,",
+            "\"steps\": 3, \"translation\": \"linear\",",
+        ),
     )
     .unwrap();
-    let w = json(&tesseral(&["simulate", "world2.json", "--json"], dir.path()));
+    let w = json(&tesseral(
+        &["simulate", "world2.json", "--json"],
+        dir.path(),
+    ));
     let times = |v: &Value| -> Vec<String> {
-        v["contacts"].as_array().unwrap().iter().map(|c| format!("{} {} {}", c["time"], c["a"], c["b"])).collect()
+        v["contacts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| format!("{} {} {}", c["time"], c["a"], c["b"]))
+            .collect()
     };
     assert_eq!(times(&w), times(&v));
 }
@@ -195,20 +246,33 @@ fn simulate_reports_a_tunnelling_contact_and_writes_frames() {
 fn simulate_errors_name_the_file_and_place() {
     let dir = tempfile::tempdir().unwrap();
     write_xyz(dir.path(), "wall.xyz", wall());
-    std::fs::write(dir.path().join("w1.json"), "{\n  \"environment\": \"wall.xyz\",\n  \"steps\": -1\n}").unwrap();
-    fails(&tesseral(&["simulate", "w1.json"], dir.path()), "w1.json:3:");
+    std::fs::write(
+        dir.path().join("w1.json"),
+        "{\n  \"environment\": \"wall.xyz\",\n  \"steps\": -1\n}",
+    )
+    .unwrap();
+    fails(
+        &tesseral(&["simulate", "w1.json"], dir.path()),
+        "w1.json:3:",
+    );
     std::fs::write(
         dir.path().join("w2.json"),
         r#"{"environment": "wall.xyz", "steps": 2, "objects": [{"name": "p", "octree": "wall.xyz", "rotate": "q1"}]}"#,
     )
     .unwrap();
-    fails(&tesseral(&["simulate", "w2.json"], dir.path()), "object \"p\", rotate");
+    fails(
+        &tesseral(&["simulate", "w2.json"], dir.path()),
+        "object \"p\", rotate",
+    );
     std::fs::write(
         dir.path().join("w3.json"),
         r#"{"environment": "nowhere.xyz", "steps": 2}"#,
     )
     .unwrap();
-    fails(&tesseral(&["simulate", "w3.json"], dir.path()), "nowhere.xyz");
+    fails(
+        &tesseral(&["simulate", "w3.json"], dir.path()),
+        "nowhere.xyz",
+    );
     std::fs::write(
         dir.path().join("w4.json"),
         r#"{"environment": "wall.xyz", "steps": 99999999999}"#,
@@ -224,7 +288,10 @@ fn plan_goes_through_the_hole_and_draws_it() {
     write_xyz(dir.path(), "wall.xyz", w.clone());
     write_xyz(dir.path(), "cube.xyz", cube(2, [0, 0, 0]));
     let v = json(&tesseral(
-        &["plan", "wall.xyz", "cube.xyz", "--from", "0,0,0", "--to", "14,0,0", "--json", "-o", "path.png"],
+        &[
+            "plan", "wall.xyz", "cube.xyz", "--from", "0,0,0", "--to", "14,0,0", "--json", "-o",
+            "path.png",
+        ],
         dir.path(),
     ));
     assert_eq!(v["found"], Value::Bool(true));
@@ -250,14 +317,19 @@ fn plan_goes_through_the_hole_and_draws_it() {
             while p[k] != pair[1][k] {
                 p[k] += (pair[1][k] - p[k]).signum();
                 moves += 1;
-                assert!(cube(2, p).iter().all(|q| !walls.contains(q)), "blocked at {p:?}");
+                assert!(
+                    cube(2, p).iter().all(|q| !walls.contains(q)),
+                    "blocked at {p:?}"
+                );
             }
         }
     }
     assert_eq!(moves, 34);
     assert!(v["length"].as_f64().unwrap() < 34.0);
     let text = ok(&tesseral(
-        &["plan", "wall.xyz", "cube.xyz", "--from", "0,0,0", "--to", "14,0,0", "--margin", "2"],
+        &[
+            "plan", "wall.xyz", "cube.xyz", "--from", "0,0,0", "--to", "14,0,0", "--margin", "2",
+        ],
         dir.path(),
     ));
     // With room around the wall's edge the path is shorter.
@@ -271,27 +343,55 @@ fn plan_says_no_path_and_why() {
     write_xyz(dir.path(), "big.xyz", cube(4, [0, 0, 0]));
     // The 4-cube does not fit through the 3x3 hole, and there is no margin.
     let out = tesseral(
-        &["plan", "wall.xyz", "big.xyz", "--from", "0,0,0", "--to", "12,0,0"],
+        &[
+            "plan", "wall.xyz", "big.xyz", "--from", "0,0,0", "--to", "12,0,0",
+        ],
         dir.path(),
     );
     assert_eq!(out.status.code(), Some(1));
     let text = String::from_utf8_lossy(&out.stdout);
-    assert!(text.starts_with("no path: the goal is not reachable"), "{text}");
+    assert!(
+        text.starts_with("no path: the goal is not reachable"),
+        "{text}"
+    );
     let out = tesseral(
-        &["plan", "wall.xyz", "big.xyz", "--from", "6,0,0", "--to", "12,0,0", "--json"],
+        &[
+            "plan", "wall.xyz", "big.xyz", "--from", "6,0,0", "--to", "12,0,0", "--json",
+        ],
         dir.path(),
     );
     assert_eq!(out.status.code(), Some(1));
     let v: Value = serde_json::from_slice(&out.stdout).unwrap();
     assert_eq!(v["found"], Value::Bool(false));
-    assert!(v["reason"].as_str().unwrap().contains("at the start the object overlaps"), "{v}");
+    assert!(
+        v["reason"]
+            .as_str()
+            .unwrap()
+            .contains("at the start the object overlaps"),
+        "{v}"
+    );
     fails(
-        &tesseral(&["plan", "wall.xyz", "big.xyz", "--from", "0,0", "--to", "1,1,1"], dir.path()),
+        &tesseral(
+            &[
+                "plan", "wall.xyz", "big.xyz", "--from", "0,0", "--to", "1,1,1",
+            ],
+            dir.path(),
+        ),
         "X,Y,Z",
     );
     fails(
         &tesseral(
-            &["plan", "wall.xyz", "big.xyz", "--from", "0,0,0", "--to", "1,1,1", "--region", "5,0,0,1,1,1"],
+            &[
+                "plan",
+                "wall.xyz",
+                "big.xyz",
+                "--from",
+                "0,0,0",
+                "--to",
+                "1,1,1",
+                "--region",
+                "5,0,0,1,1,1",
+            ],
             dir.path(),
         ),
         "region",

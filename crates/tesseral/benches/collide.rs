@@ -27,8 +27,8 @@ use std::time::Instant;
 use criterion::Criterion;
 use tesseral::linear::LinearOctree;
 use tesseral::motion::{
-    clearance, clearance_squared, first_contact, interference, intersects, plan, BoxTree, Placed, Placement,
-    PlanOptions,
+    clearance, clearance_squared, first_contact, interference, intersects, plan, BoxTree, Placed,
+    Placement, PlanOptions,
 };
 use tesseral::Voxel;
 
@@ -47,7 +47,9 @@ fn ball(r: i64) -> Vec<Voxel> {
     for x in 0..2 * r {
         for y in 0..2 * r {
             for z in 0..2 * r {
-                let d = (2 * x + 1 - 2 * r).pow(2) + (2 * y + 1 - 2 * r).pow(2) + (2 * z + 1 - 2 * r).pow(2);
+                let d = (2 * x + 1 - 2 * r).pow(2)
+                    + (2 * y + 1 - 2 * r).pow(2)
+                    + (2 * z + 1 - 2 * r).pow(2);
                 if d < r2 {
                     v.push([x, y, z]);
                 }
@@ -75,7 +77,10 @@ fn terrain() -> Vec<Voxel> {
     let mut v = Vec::new();
     for x in 0..128i64 {
         for y in 0..128i64 {
-            let h = 20.0 + 8.0 * (x as f64 / 9.0).sin() + 6.0 * (y as f64 / 7.0).cos() + 3.0 * ((x + y) as f64 / 4.0).sin();
+            let h = 20.0
+                + 8.0 * (x as f64 / 9.0).sin()
+                + 6.0 * (y as f64 / 7.0).cos()
+                + 3.0 * ((x + y) as f64 / 4.0).sin();
             for z in 0..h as i64 {
                 v.push([x, y, z]);
             }
@@ -98,18 +103,39 @@ impl SplitMix64 {
 
 fn porous(seed: u64) -> Vec<Voxel> {
     let mut r = SplitMix64(seed);
-    cube(64)
-        .into_iter()
-        .filter(|_| r.next() % 10 < 3)
-        .collect()
+    cube(64).into_iter().filter(|_| r.next() % 10 < 3).collect()
 }
 
 fn pairs() -> Vec<Pair> {
     vec![
-        Pair { name: "spheres", a: ball(32), b: ball(32), start: [0, 0, 0], dir: [1, 1, 0] },
-        Pair { name: "room", a: room(), b: cube(16), start: [56, 56, 56], dir: [1, 0, 0] },
-        Pair { name: "terrain", a: terrain(), b: ball(16), start: [48, 48, 0], dir: [0, 0, 1] },
-        Pair { name: "porous", a: porous(1), b: porous(2), start: [0, 0, 0], dir: [1, 1, 1] },
+        Pair {
+            name: "spheres",
+            a: ball(32),
+            b: ball(32),
+            start: [0, 0, 0],
+            dir: [1, 1, 0],
+        },
+        Pair {
+            name: "room",
+            a: room(),
+            b: cube(16),
+            start: [56, 56, 56],
+            dir: [1, 0, 0],
+        },
+        Pair {
+            name: "terrain",
+            a: terrain(),
+            b: ball(16),
+            start: [48, 48, 0],
+            dir: [0, 0, 1],
+        },
+        Pair {
+            name: "porous",
+            a: porous(1),
+            b: porous(2),
+            start: [0, 0, 0],
+            dir: [1, 1, 1],
+        },
     ]
 }
 
@@ -126,7 +152,11 @@ struct Prepared {
 
 impl Prepared {
     fn states(&self) -> [(&'static str, Voxel, bool); 3] {
-        [("touching", self.touching, true), ("near", self.near, false), ("apart", self.apart, false)]
+        [
+            ("touching", self.touching, true),
+            ("near", self.near, false),
+            ("apart", self.apart, false),
+        ]
     }
 }
 
@@ -147,14 +177,27 @@ fn prepare(p: Pair) -> Prepared {
     let touching = if first { k } else { k + 1 };
     let mut free = touching + away;
     let (pa, pb) = (BoxTree::new(&a), BoxTree::new(&b));
-    while clearance_squared(Placed::fixed(&pa), Placed::new(&pb, Placement::at(at(free)))) == Some(0) {
+    while clearance_squared(
+        Placed::fixed(&pa),
+        Placed::new(&pb, Placement::at(at(free))),
+    ) == Some(0)
+    {
         free += away;
     }
     let (touching, near, apart) = (at(touching), at(free), at(free + 3 * away));
     assert!(intersects(&a, &b, Placement::at(touching)));
     assert!(!intersects(&a, &b, Placement::at(near)));
     assert!(!intersects(&a, &b, Placement::at(apart)));
-    Prepared { name: p.name, a, b, va: p.a, vb: p.b, touching, near, apart }
+    Prepared {
+        name: p.name,
+        a,
+        b,
+        va: p.a,
+        vb: p.b,
+        touching,
+        near,
+        apart,
+    }
 }
 
 /// Mean nanoseconds per call, best of 5 batches of at least 0.2 s.
@@ -186,7 +229,16 @@ fn write_pairs(dir: &Path, prepared: &[Prepared]) {
             std::fs::write(dir.join(format!("{}_{side}.xyz", p.name)), s).unwrap();
         }
         for (state, o, hit) in p.states() {
-            writeln!(manifest, "{} {state} {} {} {} {}", p.name, o[0], o[1], o[2], u8::from(hit)).unwrap();
+            writeln!(
+                manifest,
+                "{} {state} {} {} {} {}",
+                p.name,
+                o[0],
+                o[1],
+                o[2],
+                u8::from(hit)
+            )
+            .unwrap();
         }
     }
     std::fs::write(dir.join("pairs.txt"), manifest).unwrap();
@@ -278,7 +330,16 @@ fn main() {
     let env = LinearOctree::from_voxels_fitted(&room_voxels).unwrap();
     let crate16 = LinearOctree::from_voxels_fitted(&cube(16)).unwrap();
     c.bench_function("plan/room_door", |b| {
-        b.iter(|| plan(&env, &crate16, [8, 8, 8], [100, 100, 8], &PlanOptions::default()).unwrap())
+        b.iter(|| {
+            plan(
+                &env,
+                &crate16,
+                [8, 8, 8],
+                [100, 100, 8],
+                &PlanOptions::default(),
+            )
+            .unwrap()
+        })
     });
     c.final_summary();
 }

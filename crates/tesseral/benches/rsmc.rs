@@ -1,7 +1,7 @@
 //! RS/MC throughput and memory at areas 10^4 to 10^5, dense baseline against the
 //! other lattice backends, measured in the same run.
 //!
-//! Each surface is grown from one voxel with Libes's rule (seeded), then the chain
+//! Areas of about 1e4, 3e4 and 1e5. Each surface is grown from one voxel with Libes's rule (seeded), then the chain
 //! runs with the Hastings factor, β = 0 and `max_area` at the target, so the area
 //! stays within a few percent below the target while the steps are timed. Memory is
 //! the live heap of the lattice, counted by a wrapping global allocator.
@@ -72,7 +72,13 @@ fn chain_on<L: Lattice>(voxels: &[Voxel], cap: u64) -> (Chain<L>, isize) {
 
 fn bench_backend<L: Lattice>(c: &mut Criterion, name: &str, voxels: &[Voxel], cap: u64) -> f64 {
     let (mut chain, bytes) = chain_on::<L>(voxels, cap);
-    let target = if cap < 50_000 { "1e4" } else { "1e5" };
+    let target = if cap < 20_000 {
+        "1e4"
+    } else if cap < 50_000 {
+        "3e4"
+    } else {
+        "1e5"
+    };
     eprintln!(
         "rsmc {name} area {}: {} heap bytes, {:.1} bytes per plaquette",
         chain.area(),
@@ -103,7 +109,7 @@ fn bench_backend<L: Lattice>(c: &mut Criterion, name: &str, voxels: &[Voxel], ca
 }
 
 fn bench_rsmc(c: &mut Criterion) {
-    for target in [10_000u64, 100_000] {
+    for target in [10_000u64, 30_000, 100_000] {
         let (voxels, area) = grow(target);
         let dense = bench_backend::<DenseLattice>(c, "dense", &voxels, area);
         let octree = bench_backend::<DynamicOctree>(c, "octree", &voxels, area);

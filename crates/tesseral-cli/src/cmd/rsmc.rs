@@ -9,6 +9,8 @@ use anyhow::{bail, ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::{Deserialize, Serialize};
 use tesseral::dynamic::DynamicOctree;
+use tesseral::linear::LinearOctree;
+use tesseral::render::{self, RenderOptions};
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -57,6 +59,10 @@ pub struct Args {
     /// Mesh format of the final surface.
     #[arg(long, value_enum, default_value_t = MeshFormat::Obj)]
     mesh: MeshFormat,
+    /// Width in pixels of surface.png, the rendered final surface (height 3/4 of it);
+    /// 0: no picture.
+    #[arg(long, default_value_t = 800)]
+    render_width: usize,
     /// Continue the run saved in OUT/checkpoint.json.
     #[arg(long)]
     resume: bool,
@@ -187,6 +193,11 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
+    ensure!(
+        args.render_width == 0 || (16..=8192).contains(&args.render_width),
+        "--render-width {} is outside 16..=8192 (or 0 for no picture)",
+        args.render_width
+    );
     ensure!(
         args.steps / args.sample_every <= MAX_ROWS,
         "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
@@ -369,6 +380,18 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         MeshFormat::Obj => mesh::write_obj(&faces, w),
         MeshFormat::Ply => mesh::write_ply(&faces, w),
     })?;
+    if args.render_width > 0 {
+        let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
+            .context("building the octree to render")?;
+        let opts = RenderOptions {
+            width: args.render_width,
+            height: args.render_width * 3 / 4,
+            ao_samples: 4,
+            ..RenderOptions::default()
+        };
+        let image = render::render(&tree, render::Surface::default(), &opts);
+        write_file(&args.out.join("surface.png"), |w| image.encode_png(w))?;
+    }
     let k = chain.counters();
     let ran = k.steps - start_steps;
     let per_second = if seconds > 0.0 {

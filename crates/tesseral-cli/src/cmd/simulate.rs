@@ -72,7 +72,13 @@ pub fn run(args: Args) -> Result<()> {
         .simulate(wf.time_step, wf.steps)
         .context("keeping the objects' octrees current")?;
     if let Some(dir) = &args.frames {
-        write_frames(dir, world, &sim, args.view, (args.width as usize, args.height as usize))?;
+        write_frames(
+            dir,
+            world,
+            &sim,
+            args.view,
+            (args.width as usize, args.height as usize),
+        )?;
     }
     let contacts: Vec<ContactOut> = sim
         .contacts

@@ -323,6 +323,21 @@ proptest! {
     }
 }
 
+proptest! {
+    #[test]
+    fn prop_u128_space_matches_model(a: u128, b: u128, depth in 0u32..=42, axis in 0usize..3) {
+        let s = Space::<u128>::new(depth).unwrap();
+        let (a, b) = (a & s.mask(), b & s.mask());
+        prop_assert_eq!(s.overflowing_add(a, b), model_op(&s, a, b, |x, y| x + y));
+        prop_assert_eq!(s.overflowing_add(a, b), add_by_table(a, b, depth));
+        prop_assert_eq!(s.overflowing_sub(a, b), model_op(&s, a, b, |x, y| x - y));
+        prop_assert_eq!(padic_sub(&s, a, b, true).result, s.sub(a, b));
+        let axis = Axis::ALL[axis];
+        prop_assert_eq!(s.cmp_axis(a, b, axis), naive_decode(a)[axis as usize].cmp(&naive_decode(b)[axis as usize]));
+        prop_assert_eq!(s.dec(s.inc(a, axis), axis), a);
+    }
+}
+
 #[test]
 fn space_limits() {
     assert_eq!(

@@ -199,19 +199,23 @@ impl VoxelModel {
 
 /// How to read formats that need a choice (meshes need a resolution).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[non_exhaustive]
-pub struct ReadOptions {}
+pub struct ReadOptions {
+    /// How meshes are voxelized.
+    pub mesh: crate::mesh::VoxelizeOptions,
+}
 
 /// How to write formats that need a choice (meshes can be blocky or smooth).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[non_exhaustive]
-pub struct WriteOptions {}
+pub struct WriteOptions {
+    /// How meshes are made from the octree.
+    pub mesh: crate::mesh::MeshOptions,
+}
 
 /// The extensions [`read_octree`] understands.
-pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot";
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply";
 
 /// The extensions [`write_octree`] understands.
-pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot";
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply, glb";
 
 /// Reads an octree from `path`, choosing the format by its extension. Meshes are
 /// voxelized with [`ReadOptions::default`].
@@ -234,13 +238,14 @@ pub fn read_model(path: &Path) -> Result<VoxelModel, FormatError> {
 ///
 /// # Errors
 /// [`FormatError`] naming the file, and the line and column or field at fault.
-pub fn read_model_with(path: &Path, _options: &ReadOptions) -> Result<VoxelModel, FormatError> {
+pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<VoxelModel, FormatError> {
     match extension(path).as_str() {
         "tess" => native::read(path),
         "xyz" => xyz::read(path).map(VoxelModel::new),
         "binvox" => binvox::read(path),
         "vox" => vox::read(path),
         "bt" | "ot" => octomap::read(path),
+        "stl" | "obj" | "ply" => crate::mesh::read_voxelized(path, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -273,7 +278,7 @@ pub fn write_model(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
 pub fn write_model_with(
     path: &Path,
     model: &VoxelModel,
-    _options: &WriteOptions,
+    options: &WriteOptions,
 ) -> Result<(), FormatError> {
     match extension(path).as_str() {
         "tess" => write_atomic(path, |w| native::write(w, model)),
@@ -281,6 +286,7 @@ pub fn write_model_with(
         "binvox" => binvox::write_file(path, model),
         "vox" => vox::write_file(path, model),
         "bt" | "ot" => octomap::write_file(path, model),
+        "stl" | "obj" | "ply" | "glb" => crate::mesh::write_meshed(path, model, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,
@@ -362,6 +368,11 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatErr
         ));
     }
     fs::read(path).map_err(|e| FormatError::io(path, e))
+}
+
+/// Reads a whole file up to the reader limit (for the mesh parsers).
+pub(crate) fn read_limited_pub(path: &Path) -> Result<Vec<u8>, FormatError> {
+    read_limited(path, MAX_FILE_BYTES)
 }
 
 /// The largest file the whole-file readers load (4 GiB).

@@ -2,6 +2,9 @@
 //! eight children of a new root of twice the side, so every old block keeps its
 //! alignment in the new lattice.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use super::{OctreeError, MAX_DEPTH};
 use crate::Voxel;
 

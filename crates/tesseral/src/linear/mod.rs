@@ -232,17 +232,31 @@ impl LinearOctree {
     /// The inclusive bounding box `(min, max)` of the black voxels, or `None` when empty.
     #[must_use]
     pub fn bbox(&self) -> Option<(Voxel, Voxel)> {
-        let mut blocks = self.blocks();
-        let first = blocks.next()?;
-        let (mut lo, mut hi) = (first.min, first.max());
-        for b in blocks {
-            let bmax = b.max();
+        // Dilated integers compare as the integers do, so the extremes are taken on
+        // the dilated axis components of the codes and undilated once at the end.
+        self.leaves.first()?;
+        let mut lo = [u64::MAX; 3];
+        let mut hi = [0u64; 3];
+        for l in &self.leaves {
+            // First and last code of the leaf, straight off the packed form.
+            let p = l.packed();
+            let m = p ^ p.wrapping_add(1);
+            let (c, last) = ((p & !m) >> 1, (p | m) >> 1);
             for a in 0..3 {
-                lo[a] = lo[a].min(b.min[a]);
-                hi[a] = hi[a].max(bmax[a]);
+                let (l, h) = ((c >> a) & arith::MASK_X, (last >> a) & arith::MASK_X);
+                if l < lo[a] {
+                    lo[a] = l;
+                }
+                if h > hi[a] {
+                    hi[a] = h;
+                }
             }
         }
-        Some((lo, hi))
+        let world = |d: u64, a: usize| self.origin[a] + i64::from(code::undilate3(d));
+        Some((
+            std::array::from_fn(|a| world(lo[a], a)),
+            std::array::from_fn(|a| world(hi[a], a)),
+        ))
     }
 
     /// Whether world voxel `v` is black.
@@ -371,6 +385,12 @@ fn completes_parent(run: &[Leaf]) -> bool {
 /// octets bottom-up, so that `out` stays canonical.
 pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
     out.push(leaf);
+    // Only the last child (label 7) of a parent can complete it: skip the check
+    // for the other seven (read the label straight off the packed leaf).
+    let p = leaf.packed();
+    if p.checked_shr(p.trailing_ones() + 1).unwrap_or(0) & 7 != 7 {
+        return;
+    }
     while out.len() >= 8 && completes_parent(&out[out.len() - 8..]) {
         let first = out[out.len() - 8];
         out.truncate(out.len() - 8);

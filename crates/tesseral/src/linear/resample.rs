@@ -20,6 +20,9 @@
 //! the displacement is aligned to every leaf the codes are moved directly by tesseral
 //! addition (Ahuja & Nash §3.1, Table 2 carries in parallel over all digits).
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 
 use super::{arith, grow, push_merging, Leaf, LinearOctree, OctreeError};
@@ -33,6 +36,11 @@ const FULL: u32 = 1;
 /// (`EMPTY`, `FULL`, or `2 + index` of a gray child).
 struct Index {
     nodes: Vec<[u32; 8]>,
+    /// The side (log2) of each gray node's cell.
+    levels: Vec<u8>,
+    /// For gray nodes of side 4: the occupancy of their 4 × 4 × 4 voxels, bit
+    /// `x + 4y + 16z` (filled by [`Index::fill_masks`]).
+    masks: Vec<u64>,
     root: u32,
 }
 
@@ -43,18 +51,24 @@ impl Index {
         let Some(first) = leaves.first() else {
             return Self {
                 nodes: Vec::new(),
+                levels: Vec::new(),
+                masks: Vec::new(),
                 root: EMPTY,
             };
         };
         if first.size_log2() >= depth {
             return Self {
                 nodes: Vec::new(),
+                levels: Vec::new(),
+                masks: Vec::new(),
                 root: FULL,
             };
         }
         let d = u32::from(depth);
         let mut nodes: Vec<[u32; 8]> = Vec::with_capacity(leaves.len() / 3 + 1);
+        let mut levels: Vec<u8> = Vec::with_capacity(leaves.len() / 3 + 1);
         nodes.push([EMPTY; 8]);
+        levels.push(depth);
         let mut stack: Vec<u32> = Vec::with_capacity(usize::from(depth) + 1);
         stack.push(0);
         let mut prev = first.code();
@@ -74,6 +88,7 @@ impl Index {
                 let digit = (c >> (3 * (d - stack.len() as u32))) & 7;
                 let id = nodes.len() as u32;
                 nodes.push([EMPTY; 8]);
+                levels.push(depth - stack.len() as u8);
                 nodes[parent][digit as usize] = id + 2;
                 stack.push(id);
             }
@@ -82,7 +97,45 @@ impl Index {
             nodes[parent][digit as usize] = FULL;
             prev = c;
         }
-        Self { nodes, root: 2 }
+        Self {
+            nodes,
+            levels,
+            masks: Vec::new(),
+            root: 2,
+        }
+    }
+
+    /// Computes the 64-bit occupancy of every gray node of side 4.
+    fn fill_masks(&mut self) {
+        self.masks = vec![0; self.nodes.len()];
+        for id in 0..self.nodes.len() {
+            if self.levels[id] != 2 {
+                continue;
+            }
+            let mut mask = 0u64;
+            for (d, &c) in self.nodes[id].iter().enumerate() {
+                let base = octant_shift(d);
+                if c == FULL {
+                    mask |= OCTANT << base;
+                } else if c >= 2 {
+                    for (e, &g) in self.nodes[(c - 2) as usize].iter().enumerate() {
+                        if g == FULL {
+                            mask |= 1 << (base + octant_shift(e) / 2);
+                        }
+                    }
+                }
+            }
+            self.masks[id] = mask;
+        }
+    }
+
+    #[inline]
+    fn mask(&self, slot: u32) -> u64 {
+        match slot {
+            EMPTY => 0,
+            FULL => u64::MAX,
+            _ => self.masks[(slot - 2) as usize],
+        }
     }
 
     #[inline]
@@ -116,6 +169,59 @@ impl Index {
     }
 }
 
+/// The voxels of the 2 × 2 × 2 octant 0 of a 4 × 4 × 4 block, bit `x + 4y + 16z`.
+const OCTANT: u64 = 0x0033_0033;
+
+/// The bit offset of octant `d` (label `x + 2y + 4z`) in a 4 × 4 × 4 block; half of
+/// it is the offset of voxel `d` within an octant.
+#[inline]
+fn octant_shift(d: usize) -> u32 {
+    (2 * (d & 1) + 8 * ((d >> 1) & 1) + 32 * ((d >> 2) & 1)) as u32
+}
+
+/// `n` copies of a `width`-bit pattern, every `width` bits of a u64.
+const fn repeat(pattern: u64, width: u32) -> u64 {
+    let mut out = 0;
+    let mut i = 0;
+    while i < 64 {
+        out |= pattern << i;
+        i += width;
+    }
+    out
+}
+
+/// The 4 × 4 × 4 block at offset `r` (each in 0..4) inside the 8 × 8 × 8 region
+/// made of the eight blocks `m` (index `x + 2y + 4z`), all in layout `x + 4y + 16z`.
+#[inline]
+fn extract(m: [u64; 8], r: [i64; 3]) -> u64 {
+    let sx = |a: u64, b: u64| -> u64 {
+        let r = r[0] as u32;
+        if r == 0 {
+            return a;
+        }
+        let low = repeat((1 << (4 - r)) - 1, 4);
+        ((a >> r) & low) | ((b << (4 - r)) & !low)
+    };
+    let sy = |a: u64, b: u64| -> u64 {
+        let r = r[1] as u32;
+        if r == 0 {
+            return a;
+        }
+        let low = repeat((1 << (4 * (4 - r))) - 1, 16);
+        ((a >> (4 * r)) & low) | ((b << (4 * (4 - r))) & !low)
+    };
+    let sz = |a: u64, b: u64| -> u64 {
+        let r = r[2] as u32;
+        if r == 0 {
+            return a;
+        }
+        (a >> (16 * r)) | (b << (16 * (4 - r)))
+    };
+    let p0 = sy(sx(m[0], m[1]), sx(m[2], m[3]));
+    let p1 = sy(sx(m[4], m[5]), sx(m[6], m[7]));
+    sz(p0, p1)
+}
+
 /// For one depth: which parent-window entry and which child digit each of the eight
 /// window entries of each of the eight children reads.
 type ChildTable = [[(u8, u8); 8]; 8];
@@ -144,33 +250,62 @@ fn child_table(r: [i64; 3], k: u8) -> ChildTable {
     t
 }
 
-/// Below this output cell size (log2) the recursion runs on one thread.
-const PARALLEL_MIN_SIZE_LOG2: u8 = 5;
+/// Below this output cell size (log2) the recursion runs on one thread (the top
+/// three levels of a depth-9 space give 73 tasks).
+const PARALLEL_MIN_SIZE_LOG2: u8 = 7;
 
 struct Resampler<'a> {
     index: &'a Index,
+    /// The offset of the preimage in its window at side 4.
+    r2: [i64; 3],
     /// `tables[k]` serves the children of an output cell of side `2^k`.
     tables: Vec<ChildTable>,
 }
 
 impl Resampler<'_> {
     fn cell(&self, k: u8, window: [u32; 8], code: u64, out: &mut Vec<Leaf>) {
-        if window.iter().all(|&s| s == FULL) {
+        if window == [FULL; 8] {
             out.push(Leaf::new(code, k));
             return;
         }
-        if window.iter().all(|&s| s == EMPTY) {
+        if window == [EMPTY; 8] {
             return;
         }
         debug_assert!(k > 0, "a voxel's window is always full or empty");
+        if k == 2 {
+            // The last two levels at once, on 64-bit occupancy masks.
+            let mut m = [0u64; 8];
+            for (mask, &slot) in m.iter_mut().zip(window.iter()) {
+                *mask = self.index.mask(slot);
+            }
+            let block = extract(m, self.r2);
+            if block == u64::MAX {
+                out.push(Leaf::new(code, 2));
+            } else if block != 0 {
+                for d in 0..8usize {
+                    let oct = OCTANT << octant_shift(d);
+                    let c = code + 8 * d as u64;
+                    if block & oct == oct {
+                        out.push(Leaf::new(c, 1));
+                    } else if block & oct != 0 {
+                        for e in 0..8usize {
+                            if block >> (octant_shift(d) + octant_shift(e) / 2) & 1 == 1 {
+                                out.push(Leaf::new(c + e as u64, 0));
+                            }
+                        }
+                    }
+                }
+            }
+            return;
+        }
         let table = &self.tables[usize::from(k)];
         let child_cells = 1u64 << (3 * u32::from(k - 1));
-        let windows: [[u32; 8]; 8] = std::array::from_fn(|d| {
-            std::array::from_fn(|e| {
-                let (p, digit) = table[d][e];
-                self.index.child(window[usize::from(p)], usize::from(digit))
-            })
-        });
+        let mut windows = [[EMPTY; 8]; 8];
+        for (row, w) in table.iter().zip(windows.iter_mut()) {
+            for (&(p, digit), slot) in row.iter().zip(w.iter_mut()) {
+                *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+            }
+        }
         if k >= PARALLEL_MIN_SIZE_LOG2 {
             let parts: Vec<Vec<Leaf>> = (0..8usize)
                 .into_par_iter()
@@ -222,21 +357,54 @@ impl LinearOctree {
         if depth == self.depth && origin == self.origin {
             return Ok((self.clone(), 0));
         }
+        self.resample_moved(self.origin, None, depth, origin)
+    }
+
+    /// [`LinearOctree::resample`] of this tree's leaves taken as if its origin were
+    /// `src_origin`; `bbox` is their bounding box there when the caller knows it.
+    fn resample_moved(
+        &self,
+        src_origin: Voxel,
+        bbox: Option<(Voxel, Voxel)>,
+        depth: u8,
+        origin: Voxel,
+    ) -> Result<(Self, u64), OctreeError> {
         let mut delta = [0i64; 3];
         for a in 0..3 {
             delta[a] = origin[a]
-                .checked_sub(self.origin[a])
+                .checked_sub(src_origin[a])
                 .ok_or(OctreeError::Overflow)?;
         }
-        let leaves = if self.is_empty() {
-            Vec::new()
-        } else if let Some(leaves) = self.aligned_shift(depth, delta) {
+        let Some((blo, bhi)) = bbox.or_else(|| {
+            let (lo, hi) = self.bbox()?;
+            let mv = |v: Voxel| -> Voxel {
+                std::array::from_fn(|a| {
+                    (i128::from(v[a]) - i128::from(self.origin[a]) + i128::from(src_origin[a]))
+                        .clamp(i128::from(i64::MIN), i128::from(i64::MAX))
+                        as i64
+                })
+            };
+            Some((mv(lo), mv(hi)))
+        }) else {
+            return Ok((Self::from_parts(depth, origin, Vec::new()), 0));
+        };
+        // Does the whole input land inside the new space?
+        let side = 1i128 << depth;
+        let all_inside = (0..3).all(|a| {
+            i128::from(blo[a]) >= i128::from(origin[a])
+                && i128::from(bhi[a]) < i128::from(origin[a]) + side
+        });
+        let leaves = if let Some(leaves) = self.aligned_shift(depth, delta, all_inside) {
             leaves
         } else {
             self.resample_general(depth, delta)
         };
         let out = Self::from_parts(depth, origin, leaves);
-        let dropped = self.voxel_count() - out.voxel_count();
+        let dropped = if all_inside {
+            0
+        } else {
+            self.voxel_count() - out.voxel_count()
+        };
         Ok((out, dropped))
     }
 
@@ -251,9 +419,11 @@ impl LinearOctree {
             let mut node = [EMPTY; 8];
             node[0] = index.root;
             index.nodes.push(node);
+            index.levels.push(src_depth + 1);
             index.root = index.nodes.len() as u32 + 1;
             src_depth += 1;
         }
+        index.fill_masks();
         let side = |k: u8| 1i64 << k;
         let r = |k: u8| -> [i64; 3] { delta.map(|v| v.rem_euclid(side(k))) };
         let tables = (0..=depth)
@@ -278,6 +448,7 @@ impl LinearOctree {
         });
         let resampler = Resampler {
             index: &index,
+            r2: r(2.min(depth)),
             tables,
         };
         let mut out = Vec::with_capacity(self.leaves.len());
@@ -289,7 +460,12 @@ impl LinearOctree {
     /// leaf moves whole: its code is moved by tesseral addition, the leaves outside
     /// the new space are dropped, and the rest are sorted and merged. Returns `None`
     /// when the fast path does not apply.
-    pub(super) fn aligned_shift(&self, depth: u8, delta: [i64; 3]) -> Option<Vec<Leaf>> {
+    pub(super) fn aligned_shift(
+        &self,
+        depth: u8,
+        delta: [i64; 3],
+        all_inside: bool,
+    ) -> Option<Vec<Leaf>> {
         let max_k = self.leaves.iter().map(|l| l.size_log2()).max().unwrap_or(0);
         if delta.iter().any(|&v| v.rem_euclid(1 << max_k) != 0) {
             return None;
@@ -311,12 +487,18 @@ impl LinearOctree {
                 c >= 0 && c < side
             })
         };
-        let mut moved: Vec<Leaf> = self
-            .leaves
-            .iter()
-            .filter(|l| inside(l))
-            .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
-            .collect();
+        let mut moved: Vec<Leaf> = if all_inside {
+            self.leaves
+                .iter()
+                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
+                .collect()
+        } else {
+            self.leaves
+                .iter()
+                .filter(|l| inside(l))
+                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
+                .collect()
+        };
         if !moved.is_sorted() {
             super::sort::sort_leaves(&mut moved);
         }
@@ -367,8 +549,7 @@ impl LinearOctree {
         let moved_origin = add_voxel(self.origin, by)?;
         let (lo, hi) = (add_voxel(lo, by)?, add_voxel(hi, by)?);
         let (depth, origin) = grow::grown_space(self.depth, self.origin, lo, hi)?;
-        let moved = Self::from_parts(self.depth, moved_origin, self.leaves.clone());
-        let (out, dropped) = moved.resample(depth, origin)?;
+        let (out, dropped) = self.resample_moved(moved_origin, Some((lo, hi)), depth, origin)?;
         debug_assert_eq!(dropped, 0);
         Ok(out)
     }
@@ -390,8 +571,7 @@ impl LinearOctree {
     /// ```
     pub fn translate_clipped(&self, by: [i64; 3]) -> Result<(Self, u64), OctreeError> {
         let moved_origin = add_voxel(self.origin, by)?;
-        let moved = Self::from_parts(self.depth, moved_origin, self.leaves.clone());
-        moved.resample(self.depth, self.origin)
+        self.resample_moved(moved_origin, None, self.depth, self.origin)
     }
 }
 

@@ -5,11 +5,11 @@
 use std::collections::HashSet;
 
 use super::interfere::Aabb;
-use super::plan::rotated;
 use super::orient::Rotation;
+use super::plan::rotated;
 use super::world::{Frame, World};
 use crate::linear::{LinearOctree, OctreeError};
-use crate::render::{render, Image, RenderOptions};
+use crate::render::{render, Image, RenderOptions, Surface};
 use crate::Voxel;
 
 /// The colour of the static environment.
@@ -57,7 +57,12 @@ pub fn render_frame(
         all = all.union(&t)?;
         placed.push(t);
     }
-    let touching: HashSet<usize> = frame.overlaps.iter().map(|&(_, j, _)| j).chain(frame.overlaps.iter().filter_map(|o| o.0)).collect();
+    let touching: HashSet<usize> = frame
+        .overlaps
+        .iter()
+        .map(|&(_, j, _)| j)
+        .chain(frame.overlaps.iter().filter_map(|o| o.0))
+        .collect();
     let shader = |p: [f64; 3]| {
         let v = voxel_at(p);
         if frame.contact_boxes.iter().any(|b| in_box(b, v)) {
@@ -77,7 +82,14 @@ pub fn render_frame(
         }
         ENVIRONMENT_COLOUR
     };
-    Ok(render(&all, Some(&shader), opts))
+    Ok(render(
+        &all,
+        Surface {
+            colour: Some(&shader),
+            normal: None,
+        },
+        opts,
+    ))
 }
 
 /// Renders a planned path: the environment in grey, the object at the start in
@@ -103,11 +115,15 @@ pub fn render_plan(
     if let (Some(w), Some((lo, hi))) = (waypoints, turned.bbox()) {
         let c = [0, 1, 2].map(|a| (lo[a] + hi[a]) as f64 / 2.0);
         for pair in w.windows(2) {
-            let len = (0..3).map(|a| pair[0][a].abs_diff(pair[1][a])).max().unwrap_or(0);
+            let len = (0..3)
+                .map(|a| pair[0][a].abs_diff(pair[1][a]))
+                .max()
+                .unwrap_or(0);
             let n = (4 * len).max(1);
             for k in 0..=n {
                 let s = k as f64 / n as f64;
-                let p = [0, 1, 2].map(|a| pair[0][a] as f64 + (pair[1][a] - pair[0][a]) as f64 * s + c[a]);
+                let p = [0, 1, 2]
+                    .map(|a| pair[0][a] as f64 + (pair[1][a] - pair[0][a]) as f64 * s + c[a]);
                 track.insert(voxel_at(p));
             }
         }
@@ -126,5 +142,12 @@ pub fn render_plan(
             ENVIRONMENT_COLOUR
         }
     };
-    Ok(render(&all, Some(&shader), opts))
+    Ok(render(
+        &all,
+        Surface {
+            colour: Some(&shader),
+            normal: None,
+        },
+        opts,
+    ))
 }

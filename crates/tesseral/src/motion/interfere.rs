@@ -407,7 +407,11 @@ pub fn clearance_squared<A: Traversable + ?Sized, B: Traversable + ?Sized>(
 ) -> Option<u128> {
     let ra = a.tree.root_node()?;
     let rb = b.tree.root_node()?;
-    let mut c = Clearance { a, b, best: u128::MAX };
+    let mut c = Clearance {
+        a,
+        b,
+        best: u128::MAX,
+    };
     c.visit(ra, rb);
     Some(c.best)
 }

@@ -157,8 +157,16 @@ fn interference_matches_brute_force() {
         pb.assert_valid();
         assert_eq!(pa.voxel_count(), a.voxel_count());
         // Prepared trees, alone or mixed with plain ones, give the same answers.
-        assert_eq!(intersects(&pa, &pb, place), !shared.is_empty(), "seed {seed}");
-        assert_eq!(intersects(&a, &pb, place), !shared.is_empty(), "seed {seed}");
+        assert_eq!(
+            intersects(&pa, &pb, place),
+            !shared.is_empty(),
+            "seed {seed}"
+        );
+        assert_eq!(
+            intersects(&a, &pb, place),
+            !shared.is_empty(),
+            "seed {seed}"
+        );
         let prepared = interference(&pa, &pb, place, true);
         assert_eq!(prepared.overlap_voxels, shared.len() as u64, "seed {seed}");
         let mut cells: Vec<Aabb> = prepared.contacts.clone();
@@ -166,7 +174,10 @@ fn interference_matches_brute_force() {
         cells.sort_by_key(|b| (b.min, b.max));
         plain.sort_by_key(|b| (b.min, b.max));
         assert_eq!(cells, plain, "seed {seed}");
-        assert_eq!(interference(&pa, &b, place, false).overlap_voxels, shared.len() as u64);
+        assert_eq!(
+            interference(&pa, &b, place, false).overlap_voxels,
+            shared.len() as u64
+        );
         assert_eq!(
             clearance_squared(Placed::fixed(&pa), Placed::new(&pb, place)),
             clearance_squared(Placed::fixed(&a), Placed::new(&b, place)),

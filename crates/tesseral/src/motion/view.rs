@@ -218,13 +218,28 @@ impl BoxTree {
                 continue;
             }
             let (f, c) = (n.first as usize, usize::from(n.count));
-            assert!(f > i && f + c <= self.nodes.len(), "node {i}: children out of place");
+            assert!(
+                f > i && f + c <= self.nodes.len(),
+                "node {i}: children out of place"
+            );
             let kids = &self.nodes[f..f + c];
             for a in 0..3 {
-                assert_eq!(n.lo[a], kids.iter().map(|k| k.lo[a]).min().unwrap(), "node {i}: box not tight");
-                assert_eq!(n.hi[a], kids.iter().map(|k| k.hi[a]).max().unwrap(), "node {i}: box not tight");
+                assert_eq!(
+                    n.lo[a],
+                    kids.iter().map(|k| k.lo[a]).min().unwrap(),
+                    "node {i}: box not tight"
+                );
+                assert_eq!(
+                    n.hi[a],
+                    kids.iter().map(|k| k.hi[a]).max().unwrap(),
+                    "node {i}: box not tight"
+                );
             }
-            assert_eq!(n.voxels, kids.iter().map(|k| k.voxels).sum::<u64>(), "node {i}: voxel count");
+            assert_eq!(
+                n.voxels,
+                kids.iter().map(|k| k.voxels).sum::<u64>(),
+                "node {i}: voxel count"
+            );
         }
     }
 }

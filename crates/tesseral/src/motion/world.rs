@@ -379,7 +379,8 @@ impl World {
                     }
                 }
                 TranslationMethod::Labels => {
-                    for ((ptr, tree), mv) in pointers.iter_mut().zip(current.iter_mut()).zip(&moves) {
+                    for ((ptr, tree), mv) in pointers.iter_mut().zip(current.iter_mut()).zip(&moves)
+                    {
                         if *mv != [0; 3] {
                             ptr.translate(*mv)?;
                             *tree = ptr.to_linear();

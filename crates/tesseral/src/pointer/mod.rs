@@ -13,6 +13,9 @@
 //! carry out of the top digit, the tree first grows its root (Libes §3) until the
 //! moved object fits, so a translation never loses or wraps voxels.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use crate::linear::{LinearOctree, OctreeError, MAX_DEPTH};
 use crate::Voxel;
 

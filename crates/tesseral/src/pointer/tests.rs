@@ -1,5 +1,8 @@
 //! The pointer octree against the linear octree and a `HashSet` model.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use std::collections::HashSet;
 
 use proptest::prelude::*;

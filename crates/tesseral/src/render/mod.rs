@@ -17,7 +17,7 @@ mod trace;
 #[cfg(test)]
 mod tests;
 
-pub use trace::{Hit, Ray, RayTree};
+pub use trace::{Hit, Ray, RayTree, TraversalStack};
 
 use std::io::Write;
 use std::path::Path;
@@ -219,6 +219,8 @@ pub struct RenderOptions {
     pub clip: Option<Clip>,
     /// The background colour.
     pub background: [u8; 3],
+    /// How surfaces are shaded.
+    pub normals: Normals,
 }
 
 impl Default for RenderOptions {
@@ -232,6 +234,7 @@ impl Default for RenderOptions {
             ao_samples: 0,
             clip: None,
             background: [250, 250, 252],
+            normals: Normals::Auto,
         }
     }
 }
@@ -239,6 +242,34 @@ impl Default for RenderOptions {
 /// The colour of the solid at a point (voxel coordinates), e.g. a scene's
 /// per-object colours.
 pub type Shader<'a> = &'a (dyn Fn([f64; 3]) -> [u8; 3] + Sync);
+
+/// An outward unit normal of the solid near a point (voxel coordinates), when known:
+/// e.g. [`crate::csg::Csg::normal_at`].
+pub type NormalFn<'a> = &'a (dyn Fn([f64; 3]) -> Option<[f64; 3]> + Sync);
+
+/// What the renderer may ask about the solid beyond its octree: colours and normals.
+/// Both are optional; an octree file alone is drawn in [`DEFAULT_COLOUR`] with normals
+/// estimated from the octree.
+#[derive(Clone, Copy, Default)]
+pub struct Surface<'a> {
+    /// The colour at a point inside the solid.
+    pub colour: Option<Shader<'a>>,
+    /// The normal at a point on the surface.
+    pub normal: Option<NormalFn<'a>>,
+}
+
+/// How surfaces are shaded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Normals {
+    /// Smooth where voxels are smaller than two pixels, block faces otherwise.
+    #[default]
+    Auto,
+    /// The faces of the blocks: the octree as it is.
+    Faces,
+    /// Smooth: the surface's own normal when given, else the gradient of the octree's
+    /// occupancy around the hit.
+    Smooth,
+}
 
 /// The colour used when no shader is given.
 pub const DEFAULT_COLOUR: [u8; 3] = [150, 165, 185];
@@ -280,12 +311,12 @@ fn normalize(a: [f64; 3]) -> [f64; 3] {
 }
 
 impl Frame {
-    fn new(tree: &LinearOctree, opts: &RenderOptions) -> Frame {
-        let (lo, hi) = match tree.bbox() {
+    fn new(rt: &RayTree, opts: &RenderOptions) -> Frame {
+        let (lo, hi) = match rt.bbox() {
             Some((lo, hi)) => (lo.map(|v| v as f64), hi.map(|v| v as f64 + 1.0)),
             None => {
-                let o = tree.origin().map(|v| v as f64);
-                (o, o.map(|v| v + tree.side() as f64))
+                let o = rt.origin().map(|v| v as f64);
+                (o, o.map(|v| v + f64::from(1u32 << rt.depth())))
             }
         };
         let centre = [
@@ -378,6 +409,63 @@ impl Frame {
     }
 }
 
+/// The side of a beam tile, in pixels.
+const BEAM: usize = 8;
+
+impl Frame {
+    /// A lower bound on the first hit of every primary ray of pixels
+    /// `[x0, x1) × [y0, y1)` (see [`RayTree::beam_start`]).
+    fn beam(&self, rt: &RayTree, w: usize, h: usize, x: [usize; 2], y: [usize; 2]) -> f64 {
+        let sx = |px: usize| px as f64 / w as f64 * 2.0 - 1.0;
+        let sy = |py: usize| 1.0 - py as f64 / h as f64 * 2.0;
+        let (sx0, sx1, sy0, sy1) = (sx(x[0]), sx(x[1]), sy(y[1]), sy(y[0]));
+        let footprint = (sx1 - sx0).max(sy1 - sy0) * self.half_w.max(self.half_h);
+        if !self.perspective {
+            // Parallel rays: t = (p − eye) · forward for every ray; the tile is a
+            // rectangle of the image plane.
+            let (rx0, rx1) = (sx0 * self.half_w, sx1 * self.half_w);
+            let (ry0, ry1) = (sy0 * self.half_h, sy1 * self.half_h);
+            let stop = footprint.max(1.0).log2().floor() as u8;
+            let (eye, f, r, u) = (self.eye, self.forward, self.right, self.up);
+            let near = move |lo: [f64; 3], hi: [f64; 3]| {
+                let c = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]) - eye[i]);
+                let e = [0, 1, 2].map(|i| 0.5 * (hi[i] - lo[i]));
+                let spread =
+                    |v: [f64; 3]| v[0].abs() * e[0] + v[1].abs() * e[1] + v[2].abs() * e[2];
+                let (cx, hx) = (dot(c, r), spread(r));
+                let (cy, hy) = (dot(c, u), spread(u));
+                if cx + hx < rx0 || cx - hx > rx1 || cy + hy < ry0 || cy - hy > ry1 {
+                    return None;
+                }
+                Some(dot(c, f) - spread(f))
+            };
+            return rt.beam_start(stop, &near);
+        }
+        // Rays from the eye: the tile is a cone around its centre ray.
+        let axis = self.ray(0.5 * (sx0 + sx1), 0.5 * (sy0 + sy1)).dir;
+        let half_angle = [(sx0, sy0), (sx0, sy1), (sx1, sy0), (sx1, sy1)]
+            .iter()
+            .map(|&(a, b)| dot(self.ray(a, b).dir, axis).clamp(-1.0, 1.0).acos())
+            .fold(0.0f64, f64::max);
+        let eye = self.eye;
+        let stop = 0u8;
+        let near = move |lo: [f64; 3], hi: [f64; 3]| {
+            let v = [0, 1, 2].map(|i| 0.5 * (lo[i] + hi[i]) - eye[i]);
+            let rn = 0.5 * (hi[0] - lo[0]) * 3f64.sqrt();
+            let dist = dot(v, v).sqrt();
+            if dist <= rn {
+                return Some(0.0);
+            }
+            let angle = (dot(v, axis) / dist).clamp(-1.0, 1.0).acos();
+            if angle > half_angle + (rn / dist).asin() + 1e-9 {
+                return None;
+            }
+            Some(dist - rn)
+        };
+        rt.beam_start(stop, &near)
+    }
+}
+
 /// The parameter interval of `ray` inside the clip's kept half-space.
 fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
     let Some(c) = clip else {
@@ -401,8 +489,8 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
     }
 }
 
-/// Renders `tree` as seen by `opts.camera`. `shader` gives the colour at a point
-/// inside the solid (voxel coordinates); `None` paints [`DEFAULT_COLOUR`].
+/// Renders `tree` as seen by `opts.camera`. `surface` gives colours and normals when
+/// known (a scene's); by default the solid is [`DEFAULT_COLOUR`].
 ///
 /// # Runtime
 /// O(pixels × nodes visited per ray), in parallel over 32 × 32 tiles; plus
@@ -412,25 +500,20 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
 /// use tesseral::linear::LinearOctree;
 /// use tesseral::render::{render, RenderOptions};
 /// let tree = LinearOctree::full(3, [0, 0, 0]).unwrap();
-/// let img = render(&tree, None, &RenderOptions { width: 64, height: 48, ..Default::default() });
+/// let img = render(&tree, Default::default(), &RenderOptions { width: 64, height: 48, ..Default::default() });
 /// assert_eq!((img.width, img.height), (64, 48));
 /// assert_ne!(img.get(32, 24), RenderOptions::default().background);
 /// ```
 #[must_use]
-pub fn render(tree: &LinearOctree, shader: Option<Shader<'_>>, opts: &RenderOptions) -> Image {
+pub fn render(tree: &LinearOctree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
     let rt = RayTree::new(tree);
-    render_with(&rt, tree, shader, opts)
+    render_with(&rt, surface, opts)
 }
 
 /// As [`render`], with the ray index already built (for several views of one tree).
 #[must_use]
-pub fn render_with(
-    rt: &RayTree,
-    tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
-    opts: &RenderOptions,
-) -> Image {
-    let frame = Frame::new(tree, opts);
+pub fn render_with(rt: &RayTree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
+    let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
@@ -438,12 +521,15 @@ pub fn render_with(
         .into_par_iter()
         .map(|ti| {
             let (tx, ty) = (ti % tiles_x, ti / tiles_x);
-            let mut buf = Vec::with_capacity(TILE * TILE);
-            for y in ty * TILE..((ty + 1) * TILE).min(h) {
-                for x in tx * TILE..((tx + 1) * TILE).min(w) {
-                    buf.push(shade_pixel(rt, &frame, shader, opts, x, y));
-                }
-            }
+            let xr = [tx * TILE, ((tx + 1) * TILE).min(w)];
+            let yr = [ty * TILE, ((ty + 1) * TILE).min(h)];
+            let tw = xr[1] - xr[0];
+            let mut buf = vec![opts.background; tw * (yr[1] - yr[0])];
+            let mut stack = TraversalStack::default();
+            trace_block(rt, &frame, opts, xr, yr, &mut stack, |x, y, ray, hit| {
+                buf[(y - yr[0]) * tw + (x - xr[0])] =
+                    shade_pixel(rt, &frame, surface, opts, ray, hit);
+            });
             (ti, buf)
         })
         .collect();
@@ -459,22 +545,65 @@ pub fn render_with(
     img
 }
 
+/// Casts the primary rays of the pixels `xr × yr`, beam tile by beam tile: each
+/// 8 × 8 tile first finds a lower bound on its rays' first hits
+/// ([`RayTree::beam_start`]), so its rays skip the empty space in front, and a tile
+/// whose beam meets nothing casts no ray at all.
+fn trace_block(
+    rt: &RayTree,
+    frame: &Frame,
+    opts: &RenderOptions,
+    xr: [usize; 2],
+    yr: [usize; 2],
+    stack: &mut TraversalStack,
+    mut each: impl FnMut(usize, usize, &Ray, Option<Hit>),
+) {
+    let (w, h) = (opts.width, opts.height);
+    for by in (yr[0]..yr[1]).step_by(BEAM) {
+        for bx in (xr[0]..xr[1]).step_by(BEAM) {
+            let (bx1, by1) = ((bx + BEAM).min(xr[1]), (by + BEAM).min(yr[1]));
+            let start = frame.beam(rt, w, h, [bx, bx1], [by, by1]);
+            let margin = 1e-6 * (1.0 + start.abs());
+            for y in by..by1 {
+                for x in bx..bx1 {
+                    let ray = pixel_ray(frame, w, h, x, y);
+                    let (t0, t1) = clip_interval(&ray, opts.clip);
+                    let from = t0.max(start - margin);
+                    let mut hit = if start.is_finite() && from <= t1 {
+                        rt.cast_with(&ray, from, t1, stack)
+                    } else {
+                        None
+                    };
+                    if hit.is_some_and(|h| h.at_start) && from > t0 {
+                        // Only rounding can put a hit at the beam's start: cast again.
+                        hit = rt.cast_with(&ray, t0, t1, stack);
+                    }
+                    each(x, y, &ray, hit);
+                }
+            }
+        }
+    }
+}
+
 /// Casts the primary rays of every pixel and returns how many hit the solid: the
 /// traversal alone, without shading (for benchmarks and coverage tests).
 #[must_use]
-pub fn primary_hits(rt: &RayTree, tree: &LinearOctree, opts: &RenderOptions) -> usize {
-    let frame = Frame::new(tree, opts);
+pub fn primary_hits(rt: &RayTree, opts: &RenderOptions) -> usize {
+    let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
-    (0..h)
+    let tiles_x = w.div_ceil(TILE);
+    (0..tiles_x * h.div_ceil(TILE))
         .into_par_iter()
-        .map(|y| {
-            (0..w)
-                .filter(|&x| {
-                    let ray = pixel_ray(&frame, w, h, x, y);
-                    let (t0, t1) = clip_interval(&ray, opts.clip);
-                    rt.cast(&ray, t0, t1).is_some()
-                })
-                .count()
+        .map(|ti| {
+            let (tx, ty) = (ti % tiles_x, ti / tiles_x);
+            let xr = [tx * TILE, ((tx + 1) * TILE).min(w)];
+            let yr = [ty * TILE, ((ty + 1) * TILE).min(h)];
+            let mut stack = TraversalStack::default();
+            let mut n = 0;
+            trace_block(rt, &frame, opts, xr, yr, &mut stack, |_, _, _, hit| {
+                n += usize::from(hit.is_some());
+            });
+            n
         })
         .sum()
 }
@@ -488,18 +617,11 @@ fn pixel_ray(frame: &Frame, w: usize, h: usize, x: usize, y: usize) -> Ray {
 fn shade_pixel(
     rt: &RayTree,
     frame: &Frame,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
-    x: usize,
-    y: usize,
+    ray: &Ray,
+    hit: Option<Hit>,
 ) -> [u8; 3] {
-    let ray = pixel_ray(frame, opts.width, opts.height, x, y);
-    let (t0, t1) = clip_interval(&ray, opts.clip);
-    let hit = if t0 <= t1 {
-        rt.cast(&ray, t0, t1)
-    } else {
-        None
-    };
     let ground_t = if opts.shadows && ray.dir[2] < -1e-9 {
         let t = (frame.ground_z - ray.origin[2]) / ray.dir[2];
         (t > 0.0).then_some(t)
@@ -508,10 +630,10 @@ fn shade_pixel(
     };
     match hit {
         Some(h) if ground_t.is_none_or(|g| h.t <= g) => {
-            shade_hit(rt, frame, shader, opts, &ray, &h)
+            shade_hit(rt, frame, surface, opts, ray, &h)
         }
         _ => match ground_t {
-            Some(g) => shade_ground(rt, frame, opts, &ray, g),
+            Some(g) => shade_ground(rt, frame, opts, ray, g),
             None => opts.background,
         },
     }
@@ -520,7 +642,7 @@ fn shade_pixel(
 fn shade_hit(
     rt: &RayTree,
     frame: &Frame,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
     ray: &Ray,
     h: &Hit,
@@ -536,10 +658,22 @@ fn shade_hit(
     }
     // Sample the colour half a voxel inside the surface.
     let inside = add(p, scale(n, -0.5));
-    let base = match shader {
-        Some(f) => f(inside),
-        None => DEFAULT_COLOUR,
+    let face = n;
+    let smooth = match opts.normals {
+        Normals::Faces => false,
+        Normals::Smooth => true,
+        Normals::Auto => frame.pixel_size(h.t, opts.height) > 0.5,
     };
+    if smooth && !opts.outline && !cut {
+        let given = surface
+            .normal
+            .and_then(|f| f(p))
+            .filter(|m| dot(*m, face) > 0.05);
+        n = given.unwrap_or_else(|| smooth_normal(rt, inside, face));
+    }
+    // The centre of the voxel hit: the solid's predicate holds there exactly.
+    let centre = inside.map(|c| c.floor() + 0.5);
+    let base = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
     let base = if cut {
         // Cut faces: the object's colour, darker, hatched, so the section reads.
         let stripe = ((p[0] + p[1] + p[2]) / 3.0).rem_euclid(6.0) < 3.0;
@@ -549,9 +683,10 @@ fn shade_hit(
         base
     };
     let mut light = dot(n, frame.light).max(0.0);
-    let lit_side = dot(n, frame.light) > 0.0;
-    if opts.shadows && lit_side {
-        let from = add(p, scale(n, 1e-3));
+    if opts.shadows && light > 0.0 {
+        // From a smooth surface, start the shadow ray clear of the voxel staircase.
+        let lift = if smooth { 1.5 } else { 0.0 };
+        let from = add(add(p, scale(face, 1e-3)), scale(n, lift));
         if rt
             .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
             .is_some()
@@ -586,6 +721,42 @@ fn shade_hit(
         }
     }
     rgb.map(|c| c.round() as u8)
+}
+
+/// A smooth normal at the surface voxel holding `inside`: minus the gradient of the
+/// occupancy of its 26 neighbours at distances 1 and 2, blended with the face normal
+/// so flat faces stay flat. Any octree gets it; no solid is needed.
+fn smooth_normal(rt: &RayTree, inside: [f64; 3], face: [f64; 3]) -> [f64; 3] {
+    let v = inside.map(|c| c.floor() as i64);
+    let mut g = [0.0; 3];
+    for step in [1i64, 2] {
+        for dz in -1..=1i64 {
+            for dy in -1..=1i64 {
+                for dx in -1..=1i64 {
+                    if dx == 0 && dy == 0 && dz == 0 {
+                        continue;
+                    }
+                    let o = [dx * step, dy * step, dz * step];
+                    if rt.contains([v[0] + o[0], v[1] + o[1], v[2] + o[2]]) {
+                        let w = 1.0 / ((dx * dx + dy * dy + dz * dz) as f64).sqrt();
+                        g = add(g, scale([dx as f64, dy as f64, dz as f64], w));
+                    }
+                }
+            }
+        }
+    }
+    let len = dot(g, g).sqrt();
+    if len < 1e-9 {
+        return face;
+    }
+    let m = add(scale(g, -0.8 / len), scale(face, 0.35));
+    let n = normalize(m);
+    // Never turn further than a right angle from the face actually seen.
+    if dot(n, face) > 0.05 {
+        n
+    } else {
+        face
+    }
 }
 
 fn ambient_occlusion(
@@ -635,9 +806,9 @@ fn shade_ground(rt: &RayTree, frame: &Frame, opts: &RenderOptions, ray: &Ray, t:
         return opts.background;
     }
     // A soft-edged disc with a faint grid, 16 cells across the solid.
-    let cell = (frame.radius / 8.0).max(1.0);
+    let cell = (frame.radius / 6.0).max(1.0);
     let grid = ((p[0] / cell).floor() + (p[1] / cell).floor()).rem_euclid(2.0) == 0.0;
-    let mut k = if grid { 0.93 } else { 0.97 };
+    let mut k = if grid { 0.955 } else { 0.98 };
     let from = [p[0], p[1], p[2] + 1e-3];
     if rt
         .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
@@ -656,7 +827,7 @@ fn shade_ground(rt: &RayTree, frame: &Frame, opts: &RenderOptions, ray: &Ray, t:
 #[must_use]
 pub fn contact_sheet(
     tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     opts: &RenderOptions,
     views: &[View],
     columns: usize,
@@ -675,7 +846,7 @@ pub fn contact_sheet(
         let (az, el) = v.angles();
         o.camera.azimuth_deg = az;
         o.camera.elevation_deg = el;
-        let img = render_with(&rt, tree, shader, &o);
+        let img = render_with(&rt, surface, &o);
         let (c, r) = (i % columns, i / columns);
         sheet.blit(
             &img,
@@ -687,7 +858,7 @@ pub fn contact_sheet(
 }
 
 /// A 2-D slice of the tree: the layer of voxels with coordinate `at` on `axis`, one
-/// square of `pixels` pixels per voxel, black voxels coloured by `shader`, and the
+/// square of `pixels` pixels per voxel, black voxels coloured by `surface`, and the
 /// outlines of the octree blocks the layer crosses drawn in dark grey.
 ///
 /// The image's horizontal axis is the next axis after `axis` (cyclically) and its
@@ -698,7 +869,7 @@ pub fn contact_sheet(
 #[must_use]
 pub fn section(
     tree: &LinearOctree,
-    shader: Option<Shader<'_>>,
+    surface: Surface<'_>,
     axis: usize,
     at: i64,
     pixels: usize,
@@ -718,7 +889,7 @@ pub fn section(
             v[v_ax] += vy as i64;
             if rt.contains(v) {
                 let centre = v.map(|c| c as f64 + 0.5);
-                let colour = shader.map_or(DEFAULT_COLOUR, |f| f(centre));
+                let colour = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
                 for dy in 0..px {
                     for dx in 0..px {
                         let (x, y) = (ux * px + dx, size - 1 - (vy * px + dy));

@@ -192,8 +192,8 @@ fn ray_tree_contains_equals_the_linear_octree() {
 
 fn coverage(tree: &LinearOctree, opts: &RenderOptions) -> (f64, f64) {
     let rt = RayTree::new(tree);
-    let hits = primary_hits(&rt, tree, opts) as f64;
-    let frame = Frame::new(tree, opts);
+    let hits = primary_hits(&rt, opts) as f64;
+    let frame = Frame::new(&rt, opts);
     let pixel_area =
         (2.0 * frame.half_w / opts.width as f64) * (2.0 * frame.half_h / opts.height as f64);
     (hits, pixel_area)
@@ -297,8 +297,8 @@ fn perspective_sphere_silhouette() {
         ..Default::default()
     };
     let rt = RayTree::new(&tree);
-    let hits = primary_hits(&rt, &tree, &opts) as f64;
-    let frame = Frame::new(&tree, &opts);
+    let hits = primary_hits(&rt, &opts) as f64;
+    let frame = Frame::new(&rt, &opts);
     let dist = dot(
         add(frame.eye, scale([64.0, 64.0, 64.0], -1.0)),
         add(frame.eye, scale([64.0, 64.0, 64.0], -1.0)),
@@ -345,8 +345,8 @@ fn perspective_box_silhouette_matches_projected_hull() {
             ..Default::default()
         };
         let rt = RayTree::new(&tree);
-        let hits = primary_hits(&rt, &tree, &opts) as f64;
-        let f = Frame::new(&tree, &opts);
+        let hits = primary_hits(&rt, &opts) as f64;
+        let f = Frame::new(&rt, &opts);
         let mut pts: Vec<(f64, f64)> = (0..8)
             .map(|c| {
                 let q =
@@ -411,13 +411,23 @@ fn images_modes_and_png() {
         height: 64,
         ..Default::default()
     };
-    let plain = render(&tree, Some(&red), &base);
+    let plain = render(
+        &tree,
+        Surface {
+            colour: Some(&red),
+            normal: None,
+        },
+        &base,
+    );
     // The centre pixel shows the solid in a shade of red.
     let c = plain.get(48, 32);
     assert!(c[0] > c[1] && c[0] > c[2], "{c:?}");
     let outlined = render(
         &tree,
-        Some(&red),
+        Surface {
+            colour: Some(&red),
+            normal: None,
+        },
         &RenderOptions {
             outline: true,
             ..base.clone()
@@ -435,7 +445,10 @@ fn images_modes_and_png() {
     );
     let ao = render(
         &tree,
-        Some(&red),
+        Surface {
+            colour: Some(&red),
+            normal: None,
+        },
         &RenderOptions {
             ao_samples: 8,
             ..base.clone()
@@ -445,7 +458,10 @@ fn images_modes_and_png() {
     // A cut through the middle shows hatched cut faces.
     let cut = render(
         &tree,
-        Some(&red),
+        Surface {
+            colour: Some(&red),
+            normal: None,
+        },
         &RenderOptions {
             clip: Some(Clip {
                 axis: 1,
@@ -458,7 +474,10 @@ fn images_modes_and_png() {
     );
     let front = render(
         &tree,
-        Some(&red),
+        Surface {
+            colour: Some(&red),
+            normal: None,
+        },
         &RenderOptions {
             camera: Camera::view(View::Front),
             ..base.clone()
@@ -475,10 +494,10 @@ fn images_modes_and_png() {
         shadows: false,
         ..base.clone()
     };
-    assert_eq!(primary_hits(&RayTree::new(&tree), &tree, &none), 0);
+    assert_eq!(primary_hits(&RayTree::new(&tree), &none), 0);
     let persp = render(
         &tree,
-        None,
+        Surface::default(),
         &RenderOptions {
             camera: Camera {
                 projection: Projection::Perspective { fov_deg: 35.0 },
@@ -487,9 +506,9 @@ fn images_modes_and_png() {
             ..base.clone()
         },
     );
-    assert!(persp != render(&tree, None, &base));
+    assert!(persp != render(&tree, Surface::default(), &base));
     // Contact sheet: four views with gutters.
-    let sheet = contact_sheet(&tree, None, &base, &View::ALL, 2);
+    let sheet = contact_sheet(&tree, Surface::default(), &base, &View::ALL, 2);
     assert_eq!((sheet.width, sheet.height), (2 * 96 + 12, 2 * 64 + 12));
     // PNG round trip.
     let mut bytes = Vec::new();
@@ -513,13 +532,13 @@ fn section_shows_the_layer_and_its_blocks() {
         .unwrap()
         .build(4, [0, 0, 0])
         .unwrap();
-    let img = section(&tree, None, 2, 8, 3);
+    let img = section(&tree, Surface::default(), 2, 8, 3);
     assert_eq!((img.width, img.height), (48, 48));
     let filled = img.pixels.iter().filter(|&&p| p == DEFAULT_COLOUR).count();
     let lines = img.pixels.iter().filter(|&&p| p == [60, 60, 70]).count();
     // 64 voxels of 9 pixels each, less the outline pixels drawn over them.
     assert_eq!(filled + lines, 64 * 9);
     assert!(lines > 0);
-    let empty = section(&tree, None, 2, 15, 1);
+    let empty = section(&tree, Surface::default(), 2, 15, 1);
     assert!(empty.pixels.iter().all(|&p| p == [255, 255, 255]));
 }

@@ -45,6 +45,7 @@ pub struct RayTree {
     origin: [i64; 3],
     root: Root,
     nodes: Vec<Node>,
+    bbox: Option<([i64; 3], [i64; 3])>,
 }
 
 /// A ray `origin + t · dir`, in the voxel coordinates of the tree.
@@ -106,6 +107,7 @@ impl RayTree {
             origin: tree.origin(),
             root: Root::White,
             nodes: Vec::new(),
+            bbox: tree.bbox(),
         };
         rt.root = match colour_of(leaves, 0, depth) {
             Colour::White => Root::White,
@@ -166,6 +168,12 @@ impl RayTree {
     #[must_use]
     pub fn gray_nodes(&self) -> usize {
         self.nodes.len()
+    }
+
+    /// The inclusive bounding box of the black voxels (as [`LinearOctree::bbox`]).
+    #[must_use]
+    pub fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.bbox
     }
 
     /// The tree's depth.
@@ -229,6 +237,18 @@ impl RayTree {
     /// O(nodes visited): about the depth plus the white and gray siblings crossed.
     #[must_use]
     pub fn cast(&self, ray: &Ray, tmin: f64, tmax: f64) -> Option<Hit> {
+        self.cast_with(ray, tmin, tmax, &mut TraversalStack::default())
+    }
+
+    /// As [`RayTree::cast`], reusing a traversal stack: for many rays in a row.
+    #[must_use]
+    pub fn cast_with(
+        &self,
+        ray: &Ray,
+        tmin: f64,
+        tmax: f64,
+        stack: &mut TraversalStack,
+    ) -> Option<Hit> {
         if self.root == Root::White {
             return None;
         }
@@ -258,100 +278,270 @@ impl RayTree {
         if enter >= exit || exit < tmin || enter > tmax {
             return None;
         }
-        let walk = Walk {
-            rt: self,
-            a,
-            tmin,
-            tmax,
-        };
         if self.root == Root::Black {
-            return walk.black(t0, self.origin, self.depth);
+            let (axis, t) = argmax(t0);
+            let at_start = t < tmin;
+            return Some(Hit {
+                t: if at_start { tmin } else { t },
+                axis,
+                block_min: self.origin,
+                size_log2: self.depth,
+                at_start,
+            });
         }
-        walk.node(0, t0, t1, self.origin, self.depth)
+        self.walk(t0, t1, a, tmin, tmax, &mut stack.levels)
     }
-}
 
-struct Walk<'a> {
-    rt: &'a RayTree,
-    a: u8,
-    tmin: f64,
-    tmax: f64,
-}
-
-impl Walk<'_> {
+    /// The iterative traversal below a gray root: an explicit stack of nodes, each
+    /// with its slab parameters (mirrored space) and the child being visited.
     #[inline]
-    fn black(&self, t0: [f64; 3], min: [i64; 3], k: u8) -> Option<Hit> {
-        let (axis, t) = argmax(t0);
-        if t > self.tmax {
+    fn walk(
+        &self,
+        t0: [f64; 3],
+        t1: [f64; 3],
+        a: u8,
+        tmin: f64,
+        tmax: f64,
+        stack: &mut [Level; 22],
+    ) -> Option<Hit> {
+        if lt(t1[0], tmin) || lt(t1[1], tmin) || lt(t1[2], tmin) {
             return None;
         }
-        let at_start = t < self.tmin;
-        Some(Hit {
-            t: if at_start { self.tmin } else { t },
-            axis,
-            block_min: min,
-            size_log2: k,
-            at_start,
-        })
+        let mut sp = 0usize;
+        stack[0] = Level::new(0, t0, t1, self.origin, self.depth);
+        loop {
+            let lv = &mut stack[sp];
+            let cur = lv.cur;
+            let (c0, c1) = lv.child(cur);
+            let entry = max3(c0);
+            let mut descended = false;
+            if entry <= tmax {
+                let node = self.nodes[lv.node as usize];
+                let label = cur ^ a;
+                let bit = 1u8 << label;
+                if (node.black | node.gray) & bit != 0 {
+                    let exit = min3(c1);
+                    if exit >= tmin {
+                        let half = 1i64 << (lv.k - 1);
+                        let cmin = [
+                            lv.min[0] + half * i64::from(label & 1),
+                            lv.min[1] + half * i64::from((label >> 1) & 1),
+                            lv.min[2] + half * i64::from((label >> 2) & 1),
+                        ];
+                        if node.black & bit != 0 {
+                            let (axis, t) = argmax(c0);
+                            let at_start = t < tmin;
+                            return Some(Hit {
+                                t: if at_start { tmin } else { t },
+                                axis,
+                                block_min: cmin,
+                                size_log2: lv.k - 1,
+                                at_start,
+                            });
+                        }
+                        let j = (node.gray & (bit - 1)).count_ones();
+                        let k = lv.k - 1;
+                        sp += 1;
+                        stack[sp] = Level::new(node.first + j, c0, c1, cmin, k);
+                        descended = true;
+                    }
+                }
+            } else {
+                // Every later child of this node starts later still: leave it.
+                stack[sp].cur = 8;
+            }
+            if descended {
+                continue;
+            }
+            // Advance: across the nearest exit plane, popping finished nodes.
+            loop {
+                let lv = &mut stack[sp];
+                if lv.cur < 8 {
+                    let (_, c1) = lv.child(lv.cur);
+                    let ax = argmin(c1).0;
+                    if lv.cur & (1 << ax) == 0 {
+                        lv.cur |= 1 << ax;
+                        break;
+                    }
+                }
+                if sp == 0 {
+                    return None;
+                }
+                sp -= 1;
+            }
+        }
+    }
+}
+
+impl RayTree {
+    /// A lower bound on where a bundle of rays first meets the solid (ESVO-style beam
+    /// optimization, Laine & Karras 2010). `near(min, max)` returns, for a box, `None`
+    /// when no ray of the bundle can enter it, else a lower bound on the ray parameter
+    /// of its points. Nodes of side `2^stop_log2` or less count as solid, so the search
+    /// stays coarse. Returns infinity when no ray of the bundle meets a black block.
+    ///
+    /// # Runtime
+    /// O(nodes whose boxes the bundle meets, down to the stop size).
+    #[must_use]
+    pub fn beam_start(
+        &self,
+        stop_log2: u8,
+        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
+    ) -> f64 {
+        let side = f64::from(1u32 << self.depth);
+        let lo = self.origin.map(|v| v as f64);
+        let hi = lo.map(|v| v + side);
+        match self.root {
+            Root::White => f64::INFINITY,
+            Root::Black => near(lo, hi).unwrap_or(f64::INFINITY),
+            Root::Gray => {
+                if near(lo, hi).is_none() {
+                    return f64::INFINITY;
+                }
+                let mut best = f64::INFINITY;
+                self.beam_rec(0, self.origin, self.depth, stop_log2, near, &mut best);
+                best
+            }
+        }
     }
 
-    /// Visits the children of a gray node of size `2^k` at `min` (true coordinates),
-    /// whose mirrored slab parameters are `t0`, `t1`.
-    fn node(&self, n: u32, t0: [f64; 3], t1: [f64; 3], min: [i64; 3], k: u8) -> Option<Hit> {
-        if t1[0] < self.tmin || t1[1] < self.tmin || t1[2] < self.tmin {
-            return None;
+    fn beam_rec(
+        &self,
+        n: u32,
+        min: [i64; 3],
+        k: u8,
+        stop: u8,
+        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
+        best: &mut f64,
+    ) {
+        let node = self.nodes[n as usize];
+        let half = 1i64 << (k - 1);
+        let mut kids: [(f64, u8, [i64; 3]); 8] = [(0.0, 0, [0; 3]); 8];
+        let mut count = 0;
+        for label in 0..8u8 {
+            let bit = 1u8 << label;
+            if (node.black | node.gray) & bit == 0 {
+                continue;
+            }
+            let cmin = [
+                min[0] + half * i64::from(label & 1),
+                min[1] + half * i64::from((label >> 1) & 1),
+                min[2] + half * i64::from((label >> 2) & 1),
+            ];
+            let lo = cmin.map(|v| v as f64);
+            let hi = lo.map(|v| v + half as f64);
+            if let Some(t) = near(lo, hi) {
+                // Insertion by t: nearer children first prune the rest sooner.
+                let mut i = count;
+                while i > 0 && kids[i - 1].0 > t {
+                    kids[i] = kids[i - 1];
+                    i -= 1;
+                }
+                kids[i] = (t, label, cmin);
+                count += 1;
+            }
         }
-        let node = self.rt.nodes[n as usize];
+        for &(t, label, cmin) in &kids[..count] {
+            if t >= *best {
+                break;
+            }
+            let bit = 1u8 << label;
+            if node.black & bit != 0 || k - 1 <= stop {
+                *best = t;
+            } else {
+                let j = (node.gray & (bit - 1)).count_ones();
+                self.beam_rec(node.first + j, cmin, k - 1, stop, near, best);
+            }
+        }
+    }
+}
+
+/// Scratch space for [`RayTree::cast_with`]: one entry per tree depth.
+#[derive(Debug, Clone)]
+pub struct TraversalStack {
+    levels: [Level; 22],
+}
+
+impl Default for TraversalStack {
+    fn default() -> Self {
+        Self {
+            levels: [Level::default(); 22],
+        }
+    }
+}
+
+/// One node on the traversal stack.
+#[derive(Debug, Clone, Copy, Default)]
+struct Level {
+    t0: [f64; 3],
+    tm: [f64; 3],
+    t1: [f64; 3],
+    min: [i64; 3],
+    node: u32,
+    k: u8,
+    cur: u8,
+}
+
+impl Level {
+    #[inline]
+    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], min: [i64; 3], k: u8) -> Self {
         let tm = [
             0.5 * (t0[0] + t1[0]),
             0.5 * (t0[1] + t1[1]),
             0.5 * (t0[2] + t1[2]),
         ];
-        let half = 1i64 << (k - 1);
-        let mut cur = first_child(t0, tm);
-        loop {
-            // The child's slab parameters, in mirrored space.
-            let mut c0 = [0.0; 3];
-            let mut c1 = [0.0; 3];
-            for ax in 0..3 {
-                if cur & (1 << ax) != 0 {
-                    c0[ax] = tm[ax];
-                    c1[ax] = t1[ax];
-                } else {
-                    c0[ax] = t0[ax];
-                    c1[ax] = tm[ax];
-                }
-            }
-            let entry = c0[0].max(c0[1]).max(c0[2]);
-            if entry > self.tmax {
-                return None;
-            }
-            let label = cur ^ self.a;
-            let bit = 1u8 << label;
-            if (node.black | node.gray) & bit != 0 {
-                let exit = c1[0].min(c1[1]).min(c1[2]);
-                if exit >= self.tmin {
-                    let cmin = [
-                        min[0] + half * i64::from(label & 1),
-                        min[1] + half * i64::from((label >> 1) & 1),
-                        min[2] + half * i64::from((label >> 2) & 1),
-                    ];
-                    if node.black & bit != 0 {
-                        return self.black(c0, cmin, k - 1);
-                    }
-                    let j = (node.gray & (bit - 1)).count_ones();
-                    if let Some(h) = self.node(node.first + j, c0, c1, cmin, k - 1) {
-                        return Some(h);
-                    }
-                }
-            }
-            // The next child: across the exit plane nearest along the ray.
-            let (ax, _) = argmin(c1);
-            if cur & (1 << ax) != 0 {
-                return None;
-            }
-            cur |= 1 << ax;
+        Level {
+            t0,
+            tm,
+            t1,
+            min,
+            node,
+            k,
+            cur: first_child(t0, tm),
         }
+    }
+
+    /// The slab parameters of child `cur` (mirrored label).
+    #[inline]
+    fn child(&self, cur: u8) -> ([f64; 3], [f64; 3]) {
+        let (x, y, z) = (cur & 1 != 0, cur & 2 != 0, cur & 4 != 0);
+        (
+            [
+                if x { self.tm[0] } else { self.t0[0] },
+                if y { self.tm[1] } else { self.t0[1] },
+                if z { self.tm[2] } else { self.t0[2] },
+            ],
+            [
+                if x { self.t1[0] } else { self.tm[0] },
+                if y { self.t1[1] } else { self.tm[1] },
+                if z { self.t1[2] } else { self.tm[2] },
+            ],
+        )
+    }
+}
+
+#[inline]
+fn lt(a: f64, b: f64) -> bool {
+    a < b
+}
+
+#[inline]
+fn max3(t: [f64; 3]) -> f64 {
+    let m = if t[0] > t[1] { t[0] } else { t[1] };
+    if m > t[2] {
+        m
+    } else {
+        t[2]
+    }
+}
+
+#[inline]
+fn min3(t: [f64; 3]) -> f64 {
+    let m = if t[0] < t[1] { t[0] } else { t[1] };
+    if m < t[2] {
+        m
+    } else {
+        t[2]
     }
 }
 

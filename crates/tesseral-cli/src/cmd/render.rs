@@ -1,0 +1,260 @@
+//! `tesseral render INPUT -o OUT.png`: draws a scene or any octree file.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use tesseral::csg::{Colour, Csg, Scene};
+use tesseral::io;
+use tesseral::linear::LinearOctree;
+use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
+
+/// Arguments of `tesseral render`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// A scene (`.tss`) or an octree file in any format `tesseral` reads. An octree
+    /// file is drawn as it is, never rebuilt.
+    input: PathBuf,
+    /// The PNG file to write.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Image size, WIDTHxHEIGHT (for a contact sheet: of each view).
+    #[arg(long, default_value = "800x600")]
+    size: String,
+    /// A named view: iso, front, top or side.
+    #[arg(long, default_value = "iso")]
+    view: String,
+    /// Azimuth in degrees (from +x towards +y), overriding the view's.
+    #[arg(long, allow_negative_numbers = true)]
+    azimuth: Option<f64>,
+    /// Elevation in degrees above the horizontal, overriding the view's.
+    #[arg(long, allow_negative_numbers = true)]
+    elevation: Option<f64>,
+    /// Magnification; 1 frames the whole solid.
+    #[arg(long, default_value_t = 1.0)]
+    zoom: f64,
+    /// Perspective projection instead of orthographic.
+    #[arg(long)]
+    perspective: bool,
+    /// Vertical field of view of the perspective camera, degrees.
+    #[arg(long, default_value_t = 40.0)]
+    fov: f64,
+    /// Draw the outlines of the octree blocks (the decomposition).
+    #[arg(long)]
+    outline: bool,
+    /// No ground plane and no shadows.
+    #[arg(long)]
+    no_shadows: bool,
+    /// Ambient-occlusion rays per pixel (0: none).
+    #[arg(long, default_value_t = 0)]
+    ao: u32,
+    /// Cross-section: `x<C`, `y>C`, ... keeps the part on that side of the plane
+    /// (scene units for a scene, voxels for an octree file) and draws the cut faces.
+    #[arg(long)]
+    cut: Option<String>,
+    /// A 2-D slice instead of a 3-D view: `z=C` draws the layer of voxels at C
+    /// (scene units for a scene, voxels for an octree file) with its block outlines.
+    #[arg(long)]
+    slice: Option<String>,
+    /// Pixels per voxel of a slice.
+    #[arg(long, default_value_t = 4)]
+    slice_scale: usize,
+    /// A contact sheet of the four named views (iso, front, top, side), 2 x 2.
+    #[arg(long)]
+    sheet: bool,
+    /// Background colour, a name or #rrggbb.
+    #[arg(long, default_value = "#fafafc")]
+    background: String,
+    /// Colour of an octree file's solid (a scene's objects carry their own).
+    #[arg(long, default_value = "#96a5b9")]
+    colour: String,
+    /// Shading: `faces` shows the blocks' faces, `smooth` the surface's normals (a
+    /// scene's own, else estimated from the octree), `auto` picks smooth where voxels
+    /// are smaller than two pixels.
+    #[arg(long, default_value = "auto")]
+    normals: String,
+    /// Print sizes and timings as JSON on stdout.
+    #[arg(long)]
+    json: bool,
+}
+
+/// The largest image side we draw.
+const MAX_SIDE: usize = 16384;
+
+fn parse_size(s: &str) -> Result<(usize, usize)> {
+    let (w, h) = s
+        .split_once('x')
+        .with_context(|| format!("--size {s:?}: expected WIDTHxHEIGHT, e.g. 800x600"))?;
+    let w: usize = w
+        .trim()
+        .parse()
+        .with_context(|| format!("--size {s:?}: bad width"))?;
+    let h: usize = h
+        .trim()
+        .parse()
+        .with_context(|| format!("--size {s:?}: bad height"))?;
+    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
+        bail!("--size {s:?}: each side must be from 1 to {MAX_SIDE}");
+    }
+    Ok((w, h))
+}
+
+/// Parses `x<C`, `x>C` or `x=C`: the axis, the comparison and the value.
+fn parse_plane(flag: &str, s: &str) -> Result<(usize, char, f64)> {
+    let mut chars = s.trim().chars();
+    let axis = match chars.next() {
+        Some('x') => 0,
+        Some('y') => 1,
+        Some('z') => 2,
+        _ => bail!(
+            "--{flag} {s:?}: expected an axis x, y or z, then <, > or =, then a number (e.g. z<40)"
+        ),
+    };
+    let op = chars.next().unwrap_or(' ');
+    if !"<>=".contains(op) {
+        bail!("--{flag} {s:?}: expected <, > or = after the axis (e.g. z<40)");
+    }
+    let value: f64 = chars
+        .as_str()
+        .trim()
+        .parse()
+        .with_context(|| format!("--{flag} {s:?}: bad number after {op}"))?;
+    if !value.is_finite() {
+        bail!("--{flag} {s:?}: the number must be finite");
+    }
+    Ok((axis, op, value))
+}
+
+fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
+    Colour::parse(s)
+        .map(|c| c.0)
+        .with_context(|| format!("--{flag} {s:?}: expected a colour name or #rrggbb"))
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let (width, height) = parse_size(&args.size)?;
+    let view = View::parse(&args.view)
+        .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
+    if !(args.zoom.is_finite() && args.zoom > 0.0) {
+        bail!("--zoom {}: must be a positive number", args.zoom);
+    }
+    if !(args.fov > 0.0 && args.fov < 180.0) {
+        bail!("--fov {}: must lie between 0 and 180 degrees", args.fov);
+    }
+    if args.ao > 256 {
+        bail!("--ao {}: at most 256 rays per pixel", args.ao);
+    }
+    let background = parse_colour("background", &args.background)?;
+    let solid_colour = parse_colour("colour", &args.colour)?;
+    let cut = args
+        .cut
+        .as_deref()
+        .map(|s| parse_plane("cut", s))
+        .transpose()?;
+    let slice = args
+        .slice
+        .as_deref()
+        .map(|s| parse_plane("slice", s))
+        .transpose()?;
+    if let Some((_, op, _)) = slice {
+        if op != '=' {
+            bail!("--slice: write AXIS=C, e.g. z=40");
+        }
+    }
+    if cut.is_some_and(|c| c.1 == '=') {
+        bail!("--cut: write AXIS<C or AXIS>C, e.g. z<40");
+    }
+    // Load: a scene is built; an octree file is read as it is.
+    let start = Instant::now();
+    let is_scene = io::extension(&args.input) == "tss";
+    let (tree, csg, to_voxel): (LinearOctree, Option<Csg>, Box<dyn Fn(usize, f64) -> f64>) =
+        if is_scene {
+            let scene = Scene::read(&args.input)?;
+            let csg = scene.csg()?;
+            let tree = scene.build()?;
+            let (v, lo) = (scene.voxel, scene.bounds_min);
+            (tree, Some(csg), Box::new(move |a, c| (c - lo[a]) / v))
+        } else {
+            let tree = io::read_octree(&args.input)
+                .with_context(|| format!("reading {}", args.input.display()))?;
+            (tree, None, Box::new(|_, c| c))
+        };
+    let load_ms = start.elapsed().as_secs_f64() * 1e3;
+    let shader = csg
+        .as_ref()
+        .map(|c| move |p: [f64; 3]| c.colour_at(p).map_or(solid_colour, |k| k.0));
+    let fixed = move |_: [f64; 3]| solid_colour;
+    let shader_ref: &(dyn Fn([f64; 3]) -> [u8; 3] + Sync) = match &shader {
+        Some(s) => s,
+        None => &fixed,
+    };
+    let normal_fn = csg.as_ref().map(|c| move |p: [f64; 3]| c.normal_at(p));
+    let surface = render::Surface {
+        colour: Some(shader_ref),
+        normal: normal_fn
+            .as_ref()
+            .map(|f| f as &(dyn Fn([f64; 3]) -> Option<[f64; 3]> + Sync)),
+    };
+    let normals = match args.normals.as_str() {
+        "auto" => render::Normals::Auto,
+        "faces" => render::Normals::Faces,
+        "smooth" => render::Normals::Smooth,
+        other => bail!("--normals {other:?}: expected auto, faces or smooth"),
+    };
+    let (az, el) = view.angles();
+    let opts = RenderOptions {
+        width,
+        height,
+        camera: Camera {
+            azimuth_deg: args.azimuth.unwrap_or(az),
+            elevation_deg: args.elevation.unwrap_or(el),
+            zoom: args.zoom,
+            projection: if args.perspective {
+                Projection::Perspective { fov_deg: args.fov }
+            } else {
+                Projection::Orthographic
+            },
+        },
+        outline: args.outline,
+        shadows: !args.no_shadows,
+        ao_samples: args.ao,
+        clip: cut.map(|(axis, op, c)| Clip {
+            axis,
+            at: to_voxel(axis, c),
+            keep_above: op == '>',
+        }),
+        background,
+        normals,
+    };
+    let start = Instant::now();
+    let image = if let Some((axis, _, c)) = slice {
+        let layer = to_voxel(axis, c).floor() as i64;
+        let side = tree.side() as usize;
+        let scale = args.slice_scale.clamp(1, (MAX_SIDE / side.max(1)).max(1));
+        render::section(&tree, surface, axis, layer, scale)
+    } else if args.sheet {
+        render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)
+    } else {
+        render::render(&tree, surface, &opts)
+    };
+    let render_ms = start.elapsed().as_secs_f64() * 1e3;
+    image
+        .write_png(&args.output)
+        .with_context(|| format!("writing {}", args.output.display()))?;
+    if args.json {
+        let out = serde_json::json!({
+            "input": args.input,
+            "output": args.output,
+            "width": image.width,
+            "height": image.height,
+            "depth": tree.depth(),
+            "leaves": tree.leaf_count(),
+            "voxels": tree.voxel_count(),
+            "rebuilt_from_scene": is_scene,
+            "load_ms": load_ms,
+            "render_ms": render_ms,
+        });
+        println!("{out}");
+    }
+    Ok(())
+}
