@@ -344,7 +344,7 @@ impl RayTree {
             if node.gray & bit == 0 {
                 return false;
             }
-            let j = (node.gray & (bit - 1)).count_ones();
+            let j = rank(node.gray, bit);
             node = self.nodes[(node.first + j) as usize];
         }
     }
@@ -394,8 +394,9 @@ impl RayTree {
         let mut t0 = [0.0; 3];
         let mut t1 = [0.0; 3];
         for ax in 0..3 {
-            t0[ax] = (lo[ax] - o[ax]) / d[ax];
-            t1[ax] = (lo[ax] + side - o[ax]) / d[ax];
+            let inv = 1.0 / d[ax];
+            t0[ax] = (lo[ax] - o[ax]) * inv;
+            t1[ax] = (lo[ax] + side - o[ax]) * inv;
         }
         let enter = t0[0].max(t0[1]).max(t0[2]);
         let exit = t1[0].min(t1[1]).min(t1[2]);
@@ -432,7 +433,7 @@ impl RayTree {
             return None;
         }
         let mut sp = 0usize;
-        stack[0] = Level::new(self.root_node, t0, t1, self.origin, self.depth);
+        stack[0] = Level::new(self.root_node, t0, t1, 0, self.depth);
         loop {
             let lv = &mut stack[sp];
             let cur = lv.cur;
@@ -446,27 +447,23 @@ impl RayTree {
                 if (node.black | node.gray) & bit != 0 {
                     let exit = min3(c1);
                     if exit >= tmin {
-                        let half = 1i64 << (lv.k - 1);
-                        let cmin = [
-                            lv.min[0] + half * i64::from(label & 1),
-                            lv.min[1] + half * i64::from((label >> 1) & 1),
-                            lv.min[2] + half * i64::from((label >> 2) & 1),
-                        ];
+                        let path = (lv.path << 3) | u64::from(label);
+                        let k = lv.k - 1;
                         if node.black & bit != 0 {
                             let (axis, t) = argmax(c0);
                             let at_start = t < tmin;
+                            let rel = crate::code::decode(path << (3 * u32::from(k)));
                             return Some(Hit {
                                 t: if at_start { tmin } else { t },
                                 axis,
-                                block_min: cmin,
-                                size_log2: lv.k - 1,
+                                block_min: [0, 1, 2].map(|i| self.origin[i] + i64::from(rel[i])),
+                                size_log2: k,
                                 at_start,
                             });
                         }
-                        let j = (node.gray & (bit - 1)).count_ones();
-                        let k = lv.k - 1;
+                        let j = rank(node.gray, bit);
                         sp += 1;
-                        stack[sp] = Level::new(node.first + j, c0, c1, cmin, k);
+                        stack[sp] = Level::new(node.first + j, c0, c1, path, k);
                         descended = true;
                     }
                 }
@@ -580,7 +577,7 @@ impl RayTree {
             if node.black & bit != 0 || k - 1 <= stop {
                 *best = t;
             } else {
-                let j = (node.gray & (bit - 1)).count_ones();
+                let j = rank(node.gray, bit);
                 self.beam_rec(node.first + j, cmin, k - 1, stop, near, best);
             }
         }
@@ -599,7 +596,8 @@ struct Level {
     t0: [f64; 3],
     tm: [f64; 3],
     t1: [f64; 3],
-    min: [i64; 3],
+    /// The node's path from the root, one octal digit per level.
+    path: u64,
     node: u32,
     k: u8,
     cur: u8,
@@ -607,7 +605,7 @@ struct Level {
 
 impl Level {
     #[inline]
-    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], min: [i64; 3], k: u8) -> Self {
+    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
         let tm = [
             0.5 * (t0[0] + t1[0]),
             0.5 * (t0[1] + t1[1]),
@@ -617,7 +615,7 @@ impl Level {
             t0,
             tm,
             t1,
-            min,
+            path,
             node,
             k,
             cur: first_child(t0, tm),
@@ -666,6 +664,24 @@ fn min3(t: [f64; 3]) -> f64 {
     } else {
         t[2]
     }
+}
+
+/// Bit counts of the bytes: `x.count_ones()` without relying on the POPCNT
+/// instruction, which the baseline x86-64 target lacks.
+const POPCOUNT: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).count_ones() as u8;
+        i += 1;
+    }
+    t
+};
+
+/// The index of the gray child `bit` among its gray siblings.
+#[inline]
+fn rank(gray: u8, bit: u8) -> u32 {
+    u32::from(POPCOUNT[usize::from(gray & (bit - 1))])
 }
 
 /// The first child a ray enters (Revelles Table 1, in our labels `x + 2y + 4z`).
