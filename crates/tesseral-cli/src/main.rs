@@ -19,10 +19,34 @@ struct Cli {
 enum Command {
     /// Tesseral code arithmetic: encode, decode, add, sub, neg.
     Calc(cmd::calc::Args),
+    /// Applies an operations log (+ x y z, - x y z, ? x y z) to an unbounded octree.
+    Replay(cmd::replay::Args),
     /// The papers' digit tables, computed; misprints marked and footnoted.
     Tables(cmd::tables::Args),
     /// Monte Carlo of self-avoiding random surfaces (Libes §6).
     Rsmc(cmd::rsmc::Args),
+    /// Converts between file formats, chosen by extension.
+    Convert(cmd::convert::Args),
+    /// Interference of two octrees: overlap, overlap volume, clearance.
+    Collide(cmd::collide::Args),
+    /// Run a world of moving objects; report every contact, with exact times.
+    Simulate(cmd::simulate::Args),
+    /// A collision-free path for an object through an environment.
+    Plan(cmd::plan::Args),
+    /// Prints what an octree file holds (--json for programs).
+    Info(cmd::info::Args),
+    /// Translates an octree by an integer vector.
+    Translate(cmd::transform::TranslateArgs),
+    /// Rotates an octree by quarter turns about an axis.
+    Rotate(cmd::transform::RotateArgs),
+    /// Mirrors an octree in an axis.
+    Mirror(cmd::transform::MirrorArgs),
+    /// Scales an octree by 2^K.
+    Scale(cmd::transform::ScaleArgs),
+    /// Set operations: union, intersection, difference, xor.
+    Op(cmd::op::Args),
+    /// The complement of an octree within its space.
+    Complement(cmd::transform::ComplementArgs),
     /// Draws a scene or an octree file as a PNG image.
     Render(cmd::render::Args),
     /// Builds a scene's octree and writes it to a file.
@@ -33,8 +57,20 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
+        Command::Replay(args) => cmd::replay::run(args),
         Command::Tables(args) => cmd::tables::run(args),
         Command::Rsmc(args) => cmd::rsmc::run(args),
+        Command::Convert(args) => cmd::convert::run(args),
+        Command::Collide(args) => cmd::collide::run(args),
+        Command::Simulate(args) => cmd::simulate::run(args),
+        Command::Plan(args) => cmd::plan::run(args),
+        Command::Info(args) => cmd::info::run(args),
+        Command::Translate(args) => cmd::transform::translate(args),
+        Command::Rotate(args) => cmd::transform::rotate(args),
+        Command::Mirror(args) => cmd::transform::mirror(args),
+        Command::Scale(args) => cmd::transform::scale(args),
+        Command::Op(args) => cmd::op::run(args),
+        Command::Complement(args) => cmd::transform::complement(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Build(args) => cmd::build::run(args),
     };

@@ -85,6 +85,12 @@ fn json_summary_and_output_files() {
     let faces = obj.lines().filter(|l| l.starts_with("f ")).count();
     assert_eq!(faces as u64, v["area"].as_u64().unwrap());
     assert!(o.join("checkpoint.json").exists());
+    let pic = std::fs::read(o.join("surface.png")).unwrap();
+    assert_eq!(&pic[..8], b"\x89PNG\r\n\x1a\n");
+    // IHDR: width and height, big-endian, at bytes 16..24.
+    let width = u32::from_be_bytes(pic[16..20].try_into().unwrap());
+    let height = u32::from_be_bytes(pic[20..24].try_into().unwrap());
+    assert_eq!((width, height), (800, 600));
     // No temporary files are left behind.
     for e in std::fs::read_dir(&o).unwrap() {
         let name = e.unwrap().file_name().into_string().unwrap();
@@ -215,6 +221,28 @@ fn bad_input_is_a_clear_error() {
         "checkpoint.json",
     );
     fails(&tesseral(&["rsmc", "--steps", "abc"], d), "--steps");
+    fails(
+        &tesseral(
+            &["rsmc", "--steps", "10", "--render-width", "5", "--out", "o"],
+            d,
+        ),
+        "--render-width",
+    );
+    fails(
+        &tesseral(
+            &[
+                "rsmc",
+                "--steps",
+                "100000000000",
+                "--sample-every",
+                "1",
+                "--out",
+                "o",
+            ],
+            d,
+        ),
+        "--sample-every",
+    );
     // A damaged checkpoint.
     ok(&tesseral(&["rsmc", "--steps", "1000", "--out", "c"], d));
     std::fs::write(d.join("c/checkpoint.json"), "{\"chain\": 3}").unwrap();
@@ -249,4 +277,35 @@ fn bad_input_is_a_clear_error() {
         ),
         "--beta",
     );
+}
+
+#[test]
+fn octree_and_dense_backends_write_identical_outputs() {
+    let dir = tempfile::tempdir().unwrap();
+    for backend in ["octree", "dense"] {
+        let out = tesseral(
+            &[
+                "rsmc",
+                "--steps",
+                "40000",
+                "--beta",
+                "-0.1",
+                "--seed",
+                "3",
+                "--backend",
+                backend,
+                "--out",
+                backend,
+                "--json",
+            ],
+            dir.path(),
+        );
+        let v: serde_json::Value = serde_json::from_str(ok(&out).trim()).unwrap();
+        assert_eq!(v["backend"], backend);
+    }
+    for f in ["series.csv", "surface.obj", "checkpoint.json"] {
+        let x = std::fs::read(dir.path().join("octree").join(f)).unwrap();
+        let y = std::fs::read(dir.path().join("dense").join(f)).unwrap();
+        assert!(x == y, "{f} differs between the backends");
+    }
 }

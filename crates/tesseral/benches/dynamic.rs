@@ -179,6 +179,59 @@ fn summary(name: &str, cells: &[Voxel]) {
     r("hashset_bytes_per_voxel", hs_bytes / stored);
 }
 
+/// A random-surface-like walk with face bookkeeping: start from a 24³ cube; each step
+/// draws a random face (splitmix64), reads the 27-neighbourhood of the voxel behind it,
+/// then creates the white voxel in front of the face or deletes the black one behind
+/// it, alternately. Prints ns per step.
+fn surface_walk_summary() {
+    let mut t = DynamicOctree::with_faces();
+    for x in 0..24 {
+        for y in 0..24 {
+            for z in 0..24 {
+                t.insert([x, y, z]);
+            }
+        }
+    }
+    let mut r = SplitMix64(9);
+    let steps = 2_000_000;
+    let t0 = Instant::now();
+    let mut acc = 0u32;
+    for i in 0..steps {
+        let f = t.face((r.next() % t.face_count() as u64) as usize);
+        acc ^= t.neighbourhood(f.voxel);
+        if i % 2 == 0 {
+            t.insert(f.outside());
+        } else if t.voxel_count() > 1 {
+            t.remove(f.voxel);
+        }
+    }
+    let dt = t0.elapsed().as_nanos() as f64 / steps as f64;
+    black_box(acc);
+    println!("RESULT tesseral walk step_ns {dt:.2}");
+    // The read-only part of a step on the same surface: draw a face, read the
+    // 27-neighbourhoods of the voxels on both sides of it.
+    let picks: Vec<usize> = (0..steps)
+        .map(|_| (r.next() % t.face_count() as u64) as usize)
+        .collect();
+    let nb = best_of(3, || {
+        let t0 = Instant::now();
+        let mut acc = 0u32;
+        for &i in &picks {
+            let f = t.face(i);
+            acc ^= t.neighbourhood(f.voxel) ^ t.neighbourhood(f.outside());
+        }
+        black_box(acc);
+        t0.elapsed().as_nanos() as f64 / (2 * steps) as f64
+    });
+    println!("RESULT tesseral walk neighbourhood_ns {nb:.2}");
+    println!("RESULT tesseral walk voxels {}", t.voxel_count());
+    println!("RESULT tesseral walk faces {}", t.face_count());
+    println!(
+        "RESULT tesseral walk bytes_per_face {:.2}",
+        t.bytes() as f64 / t.face_count() as f64
+    );
+}
+
 fn criterion_benches(c: &mut Criterion, name: &str, cells: &[Voxel]) {
     let rq = random_cells(2, 1_000_000);
     let oq = occupied_queries(cells.to_vec());
@@ -209,6 +262,7 @@ fn main() {
     let shell = shell_cells();
     summary("random", &random);
     summary("shell", &shell);
+    surface_walk_summary();
     if std::env::var_os("TESSERAL_SUMMARY_ONLY").is_some() {
         return;
     }

@@ -1,7 +1,7 @@
 //! RS/MC throughput and memory at areas 10^4 to 10^5, dense baseline against the
 //! other lattice backends, measured in the same run.
 //!
-//! Each surface is grown from one voxel with Libes's rule (seeded), then the chain
+//! Areas of about 1e4, 3e4 and 1e5. Each surface is grown from one voxel with Libes's rule (seeded), then the chain
 //! runs with the Hastings factor, β = 0 and `max_area` at the target, so the area
 //! stays within a few percent below the target while the steps are timed. Memory is
 //! the live heap of the lattice, counted by a wrapping global allocator.
@@ -10,6 +10,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, Ordering};
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
+use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{Chain, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -71,7 +72,13 @@ fn chain_on<L: Lattice>(voxels: &[Voxel], cap: u64) -> (Chain<L>, isize) {
 
 fn bench_backend<L: Lattice>(c: &mut Criterion, name: &str, voxels: &[Voxel], cap: u64) -> f64 {
     let (mut chain, bytes) = chain_on::<L>(voxels, cap);
-    let target = if cap < 50_000 { "1e4" } else { "1e5" };
+    let target = if cap < 20_000 {
+        "1e4"
+    } else if cap < 50_000 {
+        "3e4"
+    } else {
+        "1e5"
+    };
     eprintln!(
         "rsmc {name} area {}: {} heap bytes, {:.1} bytes per plaquette",
         chain.area(),
@@ -84,22 +91,32 @@ fn bench_backend<L: Lattice>(c: &mut Criterion, name: &str, voxels: &[Voxel], ca
     group.bench_function(name, |b| b.iter(|| chain.run(N)));
     group.finish();
     // A direct timing as well, for the ratio printed below.
+    let before = chain.counters();
     let t = std::time::Instant::now();
     chain.run(5_000_000);
     let rate = 5e6 / t.elapsed().as_secs_f64();
+    let after = chain.counters();
+    let pct = |a: u64, b: u64| 100.0 * (a - b) as f64 / 5e6;
     eprintln!(
-        "rsmc {name} area {}: {:.2} M steps/s (direct, 5M steps)",
+        "rsmc {name} area {}: {:.2} M steps/s (direct, 5M steps; {:.1}% accepted, {:.1}% illegal, {:.1}% capped)",
         chain.area(),
-        rate / 1e6
+        rate / 1e6,
+        pct(after.accepted, before.accepted),
+        pct(after.illegal, before.illegal),
+        pct(after.capped, before.capped),
     );
     rate
 }
 
 fn bench_rsmc(c: &mut Criterion) {
-    for target in [10_000u64, 100_000] {
+    for target in [10_000u64, 30_000, 100_000] {
         let (voxels, area) = grow(target);
         let dense = bench_backend::<DenseLattice>(c, "dense", &voxels, area);
-        let _ = dense;
+        let octree = bench_backend::<DynamicOctree>(c, "octree", &voxels, area);
+        eprintln!(
+            "rsmc area {target}: octree/dense speed ratio {:.2}",
+            octree / dense
+        );
     }
 }
 

@@ -15,7 +15,9 @@ pub mod csg;
 pub mod dynamic;
 pub mod io;
 pub mod linear;
+pub mod mesh;
 pub mod motion;
+pub mod pointer;
 pub mod render;
 pub mod rsmc;
 

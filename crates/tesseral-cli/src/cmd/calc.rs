@@ -33,25 +33,25 @@ pub struct Args {
 enum Op {
     /// Tesseral addition A + B: A translated by the vector from 0 to B.
     Add {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         b: String,
     },
     /// Tesseral subtraction A - B, by the P-adic method.
     Sub {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         b: String,
     },
     /// Negation: the two's complement of every axis.
     Neg {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         a: String,
     },
@@ -69,7 +69,7 @@ enum Op {
     },
     /// Prints the coordinates `X Y Z` of an octal code.
     Decode {
-        /// Octal code.
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         code: String,
     },
@@ -183,7 +183,7 @@ pub fn run(args: Args) -> Result<()> {
                     explain_add(&mode, ca, cb, &mut out);
                 }
                 writeln!(out, "{}", mode.show(r.code))?;
-                print!("{out}");
+                print!("{}", tidy(&out));
                 if r.carry != 0 {
                     eprintln!(
                         "note: carry {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
@@ -215,7 +215,7 @@ pub fn run(args: Args) -> Result<()> {
                 explain_sub(&mode, ca, cb, &mut out)?;
             }
             writeln!(out, "{}", mode.show(code))?;
-            print!("{out}");
+            print!("{}", tidy(&out));
             if mode.bounded && r.carry != 0 {
                 eprintln!(
                     "note: borrow {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
@@ -276,8 +276,13 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
     }
-    print!("{out}");
+    print!("{}", tidy(&out));
     Ok(())
+}
+
+/// The output with trailing spaces removed from every line.
+fn tidy(out: &str) -> String {
+    out.lines().map(|l| format!("{}\n", l.trim_end())).collect()
 }
 
 /// Number of digits worth showing: all of a bounded space; in the hypercube, up to
@@ -418,6 +423,7 @@ fn explain_sub(mode: &Mode, a: u128, b: u128, out: &mut String) -> Result<()> {
         mode.show_short(a)
     )?;
     let mut found = String::new();
+    let tw = p.steps.len();
     for (k, st) in p.steps.iter().enumerate() {
         found.insert(0, char::from(b'0' + st.x));
         let eq = format!(
@@ -428,7 +434,7 @@ fn explain_sub(mode: &Mode, a: u128, b: u128, out: &mut String) -> Result<()> {
         );
         write!(
             out,
-            "{eq:<28} Table 2 [{}][{}] = {},{}: digit {}, carry {}   T = ...{found}",
+            "{eq:<28} Table 2 [{}][{}] = {},{}: digit {}, carry {}   T = ...{found:<tw$}",
             st.a, st.b, st.carry, st.x, st.x, st.carry
         )?;
         if k + 1 < p.steps.len() {

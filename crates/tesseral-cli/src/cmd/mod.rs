@@ -2,6 +2,15 @@
 
 pub mod build;
 pub mod calc;
+pub mod collide;
+pub mod convert;
+pub mod info;
+pub mod octree;
+pub mod op;
+pub mod plan;
 pub mod render;
+pub mod replay;
 pub mod rsmc;
+pub mod simulate;
 pub mod tables;
+pub mod transform;

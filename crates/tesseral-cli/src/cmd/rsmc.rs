@@ -8,6 +8,9 @@ use std::time::Instant;
 use anyhow::{bail, ensure, Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use serde::{Deserialize, Serialize};
+use tesseral::dynamic::DynamicOctree;
+use tesseral::linear::LinearOctree;
+use tesseral::render::{self, RenderOptions};
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
@@ -37,7 +40,7 @@ pub struct Args {
     #[arg(long)]
     libes: bool,
     /// Lattice implementation.
-    #[arg(long, value_enum, default_value_t = Backend::Dense)]
+    #[arg(long, value_enum, default_value_t = Backend::Octree)]
     backend: Backend,
     /// Folder for series.csv, area.png, the mesh and checkpoint.json.
     #[arg(long, default_value = "rsmc-out")]
@@ -56,6 +59,10 @@ pub struct Args {
     /// Mesh format of the final surface.
     #[arg(long, value_enum, default_value_t = MeshFormat::Obj)]
     mesh: MeshFormat,
+    /// Width in pixels of surface.png, the rendered final surface (height 3/4 of it);
+    /// 0: no picture.
+    #[arg(long, default_value_t = 800)]
+    render_width: usize,
     /// Continue the run saved in OUT/checkpoint.json.
     #[arg(long)]
     resume: bool,
@@ -67,7 +74,9 @@ pub struct Args {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 enum Backend {
-    /// Dense array that follows the surface (baseline).
+    /// The unbounded dynamic octree: O(|S|) memory.
+    Octree,
+    /// Dense array that follows the surface (baseline): O(box volume) memory.
     Dense,
 }
 
@@ -98,6 +107,8 @@ struct Row {
 }
 
 const MAX_BOX_SIDE: u64 = 1000;
+/// The series is kept in memory (it is rewritten at each checkpoint and plotted).
+const MAX_ROWS: u64 = 10_000_000;
 const MAX_START_VOXELS: u64 = 10_000_000;
 
 fn parse_start(s: &str) -> Result<Vec<Voxel>> {
@@ -182,8 +193,20 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
+    ensure!(
+        args.render_width == 0 || (16..=8192).contains(&args.render_width),
+        "--render-width {} is outside 16..=8192 (or 0 for no picture)",
+        args.render_width
+    );
+    ensure!(
+        args.steps / args.sample_every <= MAX_ROWS,
+        "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
+        args.steps,
+        args.sample_every
+    );
     fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
     match args.backend {
+        Backend::Octree => simulate::<DynamicOctree>(args),
         Backend::Dense => simulate::<DenseLattice>(args),
     }
 }
@@ -306,11 +329,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         write_file(&cp_path, |w| w.write_all(&json))
     };
     let next_multiple = |s: u64, every: u64| {
-        if every == 0 {
-            u64::MAX
-        } else {
-            (s / every + 1) * every
-        }
+        s.checked_div(every)
+            .map_or(u64::MAX, |q| (q + 1).saturating_mul(every))
     };
     let t0 = Instant::now();
     while chain.steps() < args.steps {
@@ -360,6 +380,18 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         MeshFormat::Obj => mesh::write_obj(&faces, w),
         MeshFormat::Ply => mesh::write_ply(&faces, w),
     })?;
+    if args.render_width > 0 {
+        let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
+            .context("building the octree to render")?;
+        let opts = RenderOptions {
+            width: args.render_width,
+            height: args.render_width * 3 / 4,
+            ao_samples: 4,
+            ..RenderOptions::default()
+        };
+        let image = render::render(&tree, render::Surface::default(), &opts);
+        write_file(&args.out.join("surface.png"), |w| image.encode_png(w))?;
+    }
     let k = chain.counters();
     let ran = k.steps - start_steps;
     let per_second = if seconds > 0.0 {

@@ -11,6 +11,8 @@
 //!   and written once.
 //! * Addressing: [`encode`]/[`decode`] (portable magic bits, inlined), and the slice
 //!   kernels in [`batch`] that pick BMI2 `pdep`/`pext` at run time ([`Backend`]).
+//!   Single codes use magic bits: a run-time CPU check per call, and a call that
+//!   cannot be inlined, would cost more than `pdep` saves; slices pay the check once.
 //! * Arithmetic: [`Space`] (a bounded space of `D` digits) adds, subtracts, negates,
 //!   steps and compares codes without decoding them; carries out of the top are
 //!   dropped and reported ([`Carried`]), or refused (`checked_*`).

@@ -46,7 +46,7 @@ fn naive_decode<W: CodeWord>(c: W) -> [u64; 3] {
     p
 }
 
-fn random_point<W: CodeWord>(rng: &mut Rng, depth: u32) -> [u64; 3] {
+fn random_point(rng: &mut Rng, depth: u32) -> [u64; 3] {
     let m = if depth >= 64 { !0 } else { (1u64 << depth) - 1 };
     [rng.next() & m, rng.next() & m, rng.next() & m]
 }
@@ -56,7 +56,7 @@ fn check_addressing<W: CodeWord>(seed: u64) {
     let mut rng = Rng(seed);
     let n = 5000;
     let pts: Vec<[u64; 3]> = (0..n)
-        .map(|_| random_point::<W>(&mut rng, W::MAX_DEPTH))
+        .map(|_| random_point(&mut rng, W::MAX_DEPTH))
         .collect();
     let coords: Vec<[W::Coord; 3]> = pts.iter().map(|p| p.map(W::coord_from_u64)).collect();
     let mut out = vec![W::ZERO; n];
@@ -193,14 +193,20 @@ fn check_arith<W: CodeWord>(seed: u64) {
     for depth in 0..=W::MAX_DEPTH {
         let s = Space::<W>::new(depth).unwrap();
         for _ in 0..200 {
-            let a: W = naive_encode(random_point::<W>(&mut rng, depth));
-            let b: W = naive_encode(random_point::<W>(&mut rng, depth));
+            let a: W = naive_encode(random_point(&mut rng, depth));
+            let b: W = naive_encode(random_point(&mut rng, depth));
             // Junk above the space must be ignored.
-            let junk = naive_encode::<W>(random_point::<W>(&mut rng, W::MAX_DEPTH)) & !s.mask();
+            let junk = naive_encode::<W>(random_point(&mut rng, W::MAX_DEPTH)) & !s.mask();
             let (ja, jb) = (a | junk, b | junk);
             let ctx = format!("depth {depth} a {a:?} b {b:?} seed {seed:#x}");
 
             let add = model_op(&s, a, b, |x, y| x + y);
+            let mut out = [W::ZERO; 1];
+            batch::add_slices(&s, &[ja], &[jb], &mut out).unwrap();
+            assert_eq!(out[0], add.code, "add_slices {ctx}");
+            let mut moved = [ja];
+            batch::translate_slice(&s, &mut moved, jb);
+            assert_eq!(moved[0], add.code, "translate_slice {ctx}");
             assert_eq!(s.overflowing_add(ja, jb), add, "add {ctx}");
             assert_eq!(s.add(ja, jb), add.code, "add {ctx}");
             assert_eq!(add_by_table(a, b, depth), add, "table add {ctx}");
@@ -317,6 +323,21 @@ proptest! {
     }
 }
 
+proptest! {
+    #[test]
+    fn prop_u128_space_matches_model(a: u128, b: u128, depth in 0u32..=42, axis in 0usize..3) {
+        let s = Space::<u128>::new(depth).unwrap();
+        let (a, b) = (a & s.mask(), b & s.mask());
+        prop_assert_eq!(s.overflowing_add(a, b), model_op(&s, a, b, |x, y| x + y));
+        prop_assert_eq!(s.overflowing_add(a, b), add_by_table(a, b, depth));
+        prop_assert_eq!(s.overflowing_sub(a, b), model_op(&s, a, b, |x, y| x - y));
+        prop_assert_eq!(padic_sub(&s, a, b, true).result, s.sub(a, b));
+        let axis = Axis::ALL[axis];
+        prop_assert_eq!(s.cmp_axis(a, b, axis), naive_decode(a)[axis as usize].cmp(&naive_decode(b)[axis as usize]));
+        prop_assert_eq!(s.dec(s.inc(a, axis), axis), a);
+    }
+}
+
 #[test]
 fn space_limits() {
     assert_eq!(
@@ -343,6 +364,7 @@ fn space_limits() {
 // ---- The papers' tables -----------------------------------------------------------
 
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn harakal_table1_is_the_definition_and_has_one_erratum() {
     // Spot entries read straight from the definition (per-axis sums).
     assert_eq!(ADD_TABLE[1][1], (1, 0));
@@ -368,6 +390,7 @@ fn harakal_table1_is_the_definition_and_has_one_erratum() {
 }
 
 #[test]
+#[allow(clippy::needless_range_loop)]
 fn harakal_table2_inverts_table1_and_has_one_erratum() {
     for a in 0..8usize {
         for b in 0..8usize {

@@ -128,7 +128,7 @@ const fn group_mask_u128(g: u32, n: u32) -> u128 {
 }
 
 macro_rules! impl_code_word {
-    ($w:ty, $coord:ty, $depth:expr, down: [$($g:expr),*], up: [$($h:expr),*],
+    ($w:ty, $coord:ty, $depth:expr, magic: $dil:ident, $undil:ident, $encm:ident, $decm:ident,
      bmi2: $enc:ident, $dec:ident, $encs:ident, $decs:ident) => {
         impl CodeWord for $w {
             type Coord = $coord;
@@ -139,16 +139,22 @@ macro_rules! impl_code_word {
 
             #[inline]
             fn dilate(v: $coord) -> $w {
-                let mut x = (v as $w) & (group_mask_u128(64, $depth) as $w);
-                $( x = (x | (x << (2 * $g))) & const { group_mask_u128($g, $depth) as $w }; )*
-                x
+                $dil(v)
             }
 
             #[inline]
             fn undilate(self) -> $coord {
-                let mut x = self & Self::X_MASK;
-                $( x = (x | (x >> $h)) & const { group_mask_u128($h, $depth) as $w }; )*
-                x as $coord
+                $undil(self)
+            }
+
+            #[inline]
+            fn encode(x: $coord, y: $coord, z: $coord) -> Self {
+                $encm(x, y, z)
+            }
+
+            #[inline]
+            fn decode(self) -> [$coord; 3] {
+                $decm(self)
             }
 
             #[inline]
@@ -185,7 +191,11 @@ macro_rules! impl_code_word {
             }
             #[inline]
             fn low_bits(bits: u32) -> Self {
-                if bits >= <$w>::BITS { !0 } else { (1 << bits) - 1 }
+                if bits >= <$w>::BITS {
+                    !0
+                } else {
+                    (1 << bits) - 1
+                }
             }
 
             #[inline]
@@ -209,7 +219,9 @@ macro_rules! impl_code_word {
             unsafe fn encode_slice_bmi2(src: &[[$coord; 3]], dst: &mut [Self]) {
                 #[cfg(target_arch = "x86_64")]
                 // SAFETY: the caller guarantees BMI2 (this method's contract).
-                unsafe { bmi2::$encs(src, dst) };
+                unsafe {
+                    bmi2::$encs(src, dst)
+                };
                 #[cfg(not(target_arch = "x86_64"))]
                 for (d, &[x, y, z]) in dst.iter_mut().zip(src) {
                     *d = Self::encode(x, y, z);
@@ -219,7 +231,9 @@ macro_rules! impl_code_word {
             unsafe fn decode_slice_bmi2(src: &[Self], dst: &mut [[$coord; 3]]) {
                 #[cfg(target_arch = "x86_64")]
                 // SAFETY: the caller guarantees BMI2 (this method's contract).
-                unsafe { bmi2::$decs(src, dst) };
+                unsafe {
+                    bmi2::$decs(src, dst)
+                };
                 #[cfg(not(target_arch = "x86_64"))]
                 for (d, &c) in dst.iter_mut().zip(src) {
                     *d = c.decode();
@@ -229,9 +243,84 @@ macro_rules! impl_code_word {
     };
 }
 
-impl_code_word!(u64, u32, 21, down: [16, 8, 4, 2, 1], up: [2, 4, 8, 16, 32],
+/// Magic bits for 21 bits: each step halves the groups of input bits and spreads them
+/// three times as far apart (groups of 16 bits 48 apart, then 8 bits 24 apart, …).
+#[inline]
+fn dilate_u64(v: u32) -> u64 {
+    let mut x = u64::from(v) & const { group_mask_u128(32, 21) as u64 };
+    x = (x | (x << 32)) & const { group_mask_u128(16, 21) as u64 };
+    x = (x | (x << 16)) & const { group_mask_u128(8, 21) as u64 };
+    x = (x | (x << 8)) & const { group_mask_u128(4, 21) as u64 };
+    x = (x | (x << 4)) & const { group_mask_u128(2, 21) as u64 };
+    x = (x | (x << 2)) & const { group_mask_u128(1, 21) as u64 };
+    x
+}
+
+/// The steps of [`dilate_u64`] in reverse.
+#[inline]
+fn undilate_u64(c: u64) -> u32 {
+    let mut x = c & const { group_mask_u128(1, 21) as u64 };
+    x = (x | (x >> 2)) & const { group_mask_u128(2, 21) as u64 };
+    x = (x | (x >> 4)) & const { group_mask_u128(4, 21) as u64 };
+    x = (x | (x >> 8)) & const { group_mask_u128(8, 21) as u64 };
+    x = (x | (x >> 16)) & const { group_mask_u128(16, 21) as u64 };
+    x = (x | (x >> 32)) & const { group_mask_u128(32, 21) as u64 };
+    x as u32
+}
+
+const LOW21: u64 = (1 << 21) - 1;
+const LOW63: u64 = (1 << 63) - 1;
+
+/// A `u128` code is two `u64` codes: digits 0..21 in bits 0..63, digits 21..42 in bits
+/// 63..126. Reusing the `u64` kernel on each half avoids slow two-register shifts.
+#[inline]
+fn dilate_u128(v: u64) -> u128 {
+    let lo = dilate_u64((v & LOW21) as u32);
+    let hi = dilate_u64(((v >> 21) & LOW21) as u32);
+    u128::from(lo) | (u128::from(hi) << 63)
+}
+
+/// The inverse of [`dilate_u128`].
+#[inline]
+fn undilate_u128(c: u128) -> u64 {
+    let lo = undilate_u64(c as u64 & LOW63);
+    let hi = undilate_u64((c >> 63) as u64 & LOW63);
+    u64::from(lo) | (u64::from(hi) << 21)
+}
+
+#[inline]
+fn encode_u64(x: u32, y: u32, z: u32) -> u64 {
+    dilate_u64(x) | (dilate_u64(y) << 1) | (dilate_u64(z) << 2)
+}
+
+#[inline]
+fn decode_u64(c: u64) -> [u32; 3] {
+    [undilate_u64(c), undilate_u64(c >> 1), undilate_u64(c >> 2)]
+}
+
+/// Two `u64` codes side by side (see [`dilate_u128`]).
+#[inline]
+fn encode_u128(x: u64, y: u64, z: u64) -> u128 {
+    let half = |s: u32| {
+        encode_u64(
+            ((x >> s) & LOW21) as u32,
+            ((y >> s) & LOW21) as u32,
+            ((z >> s) & LOW21) as u32,
+        )
+    };
+    u128::from(half(0)) | (u128::from(half(21)) << 63)
+}
+
+#[inline]
+fn decode_u128(c: u128) -> [u64; 3] {
+    let lo = decode_u64(c as u64 & LOW63);
+    let hi = decode_u64((c >> 63) as u64 & LOW63);
+    [0, 1, 2].map(|k| u64::from(lo[k]) | (u64::from(hi[k]) << 21))
+}
+
+impl_code_word!(u64, u32, 21, magic: dilate_u64, undilate_u64, encode_u64, decode_u64,
     bmi2: encode_u64, decode_u64, encode_slice_u64, decode_slice_u64);
-impl_code_word!(u128, u64, 42, down: [32, 16, 8, 4, 2, 1], up: [2, 4, 8, 16, 32, 64],
+impl_code_word!(u128, u64, 42, magic: dilate_u128, undilate_u128, encode_u128, decode_u128,
     bmi2: encode_u128, decode_u128, encode_slice_u128, decode_slice_u128);
 
 /// BMI2 kernels (`pdep`/`pext`), x86-64 only. Callers must have checked that the CPU

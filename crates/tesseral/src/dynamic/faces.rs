@@ -3,9 +3,6 @@
 //! uniformly random face is drawn in O(1) (Libes §5: "we stored face information in a
 //! separate array (which we could randomly choose from)").
 
-use std::collections::HashMap;
-use std::hash::{BuildHasher, Hasher};
-
 use crate::Voxel;
 
 /// One exposed face (plaquette) of the surface: the face of the black voxel `voxel`
@@ -56,103 +53,322 @@ pub fn opposite(dir: u8) -> u8 {
     dir ^ 1
 }
 
-/// A small, fast hasher for face keys (three `i64` and a direction). Not DoS-resistant,
-/// which is fine for keys the program itself makes.
-#[derive(Clone, Copy, Default)]
-pub(crate) struct FaceHasher(u64);
+/// Mixes a voxel into 32 well-spread bits (a multiply-xor fold, then murmur3's
+/// fmix64).
+#[inline]
+fn mix(v: Voxel) -> u32 {
+    let mut h = (v[0] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    h = (h.rotate_left(23) ^ v[1] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    h = (h.rotate_left(23) ^ v[2] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    h ^= h >> 33;
+    h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    (h ^ (h >> 33)) as u32
+}
 
-impl Hasher for FaceHasher {
+/// An empty slot of [`VoxelTable`].
+const VACANT: u32 = u32::MAX;
+
+/// A hash index from voxel to `u32` value, where the caller keeps the keys: each
+/// slot holds only the key's 32-bit hash and the value (8 bytes), and the caller's
+/// `key_of(value)` confirms a match. Open addressing, linear probing, load at most
+/// 1/2, deletion by backward shift (no tombstones). So the index of a surface of
+/// 100,000 voxels fits in 2 MiB, and a lookup touches one slot line plus the
+/// record the caller reads anyway.
+#[derive(Clone, Default)]
+pub(crate) struct VoxelTable {
+    /// `[hash, value]`; `value == VACANT` marks an empty slot.
+    slots: Vec<[u32; 2]>,
+    len: usize,
+}
+
+impl VoxelTable {
+    /// The value whose key is `key`, if any. O(1) expected.
     #[inline]
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
+    pub(crate) fn get(&self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
+        if self.slots.is_empty() {
+            return None;
+        }
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
+        loop {
+            let [sh, val] = self.slots[i];
+            if val == VACANT {
+                return None;
+            }
+            if sh == h && key_of(val) == key {
+                return Some(val);
+            }
+            i = (i + 1) & m;
         }
     }
+
+    /// Adds `val` under `key`, which must be absent. O(1) amortised.
     #[inline]
-    fn write_u8(&mut self, i: u8) {
-        self.write_u64(u64::from(i));
+    pub(crate) fn insert(&mut self, key: Voxel, val: u32) {
+        debug_assert!(val != VACANT);
+        if 2 * (self.len + 1) > self.slots.len() {
+            let cap = (self.slots.len() * 2).max(16);
+            self.rebuild(cap);
+        }
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
+        while self.slots[i][1] != VACANT {
+            i = (i + 1) & m;
+        }
+        self.slots[i] = [h, val];
+        self.len += 1;
     }
-    #[inline]
-    fn write_i64(&mut self, i: i64) {
-        self.write_u64(i as u64);
+
+    /// Removes the entry whose key is `key`; returns its value. O(1) expected.
+    pub(crate) fn remove(&mut self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
+        if self.slots.is_empty() {
+            return None;
+        }
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
+        loop {
+            let [sh, val] = self.slots[i];
+            if val == VACANT {
+                return None;
+            }
+            if sh == h && key_of(val) == key {
+                break;
+            }
+            i = (i + 1) & m;
+        }
+        let val = self.slots[i][1];
+        // Backward-shift deletion: pull later entries of the probe run into the hole
+        // when their home slot does not lie cyclically in (hole, j].
+        let mut hole = i;
+        let mut j = i;
+        loop {
+            j = (j + 1) & m;
+            if self.slots[j][1] == VACANT {
+                break;
+            }
+            let home = self.slots[j][0] as usize & m;
+            let stays = if hole <= j {
+                hole < home && home <= j
+            } else {
+                hole < home || home <= j
+            };
+            if !stays {
+                self.slots[hole] = self.slots[j];
+                hole = j;
+            }
+        }
+        self.slots[hole][1] = VACANT;
+        self.len -= 1;
+        Some(val)
     }
-    #[inline]
-    fn write_usize(&mut self, i: usize) {
-        self.write_u64(i as u64);
+
+    fn rebuild(&mut self, cap: usize) {
+        let old = std::mem::replace(&mut self.slots, vec![[0, VACANT]; cap]);
+        let m = cap - 1;
+        for s in old.into_iter().filter(|s| s[1] != VACANT) {
+            let mut i = s[0] as usize & m;
+            while self.slots[i][1] != VACANT {
+                i = (i + 1) & m;
+            }
+            self.slots[i] = s;
+        }
     }
-    #[inline]
-    fn write_u64(&mut self, i: u64) {
-        self.0 = (self.0.rotate_left(23) ^ i).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+
+    /// Shrinks to the smallest power of two that keeps the load at most 1/2.
+    pub(crate) fn shrink_to_fit(&mut self) {
+        let cap = (2 * self.len).next_power_of_two().max(16);
+        if cap < self.slots.len() {
+            self.rebuild(cap);
+        }
     }
-    #[inline]
-    fn finish(&self) -> u64 {
-        // murmur3 fmix64: spreads every input bit to the high bits (hashbrown's tag)
-        // and the low bits (its bucket).
-        let mut h = self.0;
-        h ^= h >> 33;
-        h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
-        h ^= h >> 33;
-        h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
-        h ^ (h >> 33)
+
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// Every value, in slot order.
+    pub(crate) fn values(&self) -> impl Iterator<Item = u32> + '_ {
+        self.slots.iter().filter(|s| s[1] != VACANT).map(|s| s[1])
+    }
+
+    pub(crate) fn heap_bytes(&self) -> usize {
+        self.slots.capacity() * 8
     }
 }
 
-#[derive(Clone, Copy, Default)]
-pub(crate) struct FaceHasherBuilder;
+/// No face in that direction.
+const NO_FACE: u32 = u32::MAX;
 
-impl BuildHasher for FaceHasherBuilder {
-    type Hasher = FaceHasher;
+/// One entry of the dense face list: the face and the back-pointer record of its
+/// voxel, so that a face moved by `swap_remove` updates its back-pointer without
+/// hashing.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Entry {
+    pub(crate) voxel: Voxel,
+    pub(crate) dir: u8,
+    pub(crate) owner: u32,
+}
+
+impl Entry {
     #[inline]
-    fn build_hasher(&self) -> FaceHasher {
-        FaceHasher(0)
+    pub(crate) fn face(&self) -> Face {
+        Face {
+            voxel: self.voxel,
+            dir: self.dir,
+        }
     }
 }
 
-/// The dense face list and its back-pointers.
+/// The back-pointers of one surface voxel: the voxel, where each of its six faces
+/// sits in the list (`NO_FACE` when covered), and how many it has.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Record {
+    pub(crate) voxel: Voxel,
+    pub(crate) at: [u32; 6],
+    pub(crate) count: u32,
+}
+
+/// The dense face list and its back-pointers. A surface voxel has one record (six
+/// list positions) found through one hash lookup; faces in the list point back at
+/// their record by index. So creating an isolated voxel costs one hash insertion, and
+/// removing a neighbour's face costs one hash lookup.
 #[derive(Clone, Default)]
 pub(crate) struct FaceList {
-    pub(crate) list: Vec<Face>,
-    pub(crate) index: HashMap<Face, u32, FaceHasherBuilder>,
+    pub(crate) list: Vec<Entry>,
+    pub(crate) owners: VoxelTable,
+    pub(crate) records: Vec<Record>,
+    pub(crate) free: Vec<u32>,
 }
 
 impl FaceList {
-    /// Appends a face. O(1) amortised.
+    /// The record of `v`, made if `v` has none. One hash lookup.
     #[inline]
-    pub(crate) fn push(&mut self, f: Face) {
-        let i = u32::try_from(self.list.len()).expect("more than 2^32 faces");
-        let old = self.index.insert(f, i);
-        debug_assert!(old.is_none(), "face {f:?} pushed twice");
-        self.list.push(f);
+    pub(crate) fn record_of(&mut self, v: Voxel) -> u32 {
+        let records = &self.records;
+        if let Some(r) = self.owners.get(v, |r| records[r as usize].voxel) {
+            return r;
+        }
+        let rec = Record {
+            voxel: v,
+            at: [NO_FACE; 6],
+            count: 0,
+        };
+        let r = if let Some(i) = self.free.pop() {
+            self.records[i as usize] = rec;
+            i
+        } else {
+            self.records.push(rec);
+            u32::try_from(self.records.len() - 1).expect("more than 2^32 surface voxels")
+        };
+        self.owners.insert(v, r);
+        r
     }
 
-    /// Removes a face by `swap_remove`: the last face takes its place. O(1).
+    /// The record of `v`, which must have one. One hash lookup.
     #[inline]
-    pub(crate) fn remove(&mut self, f: Face) {
-        let i = self
-            .index
-            .remove(&f)
-            .unwrap_or_else(|| panic!("face {f:?} missing from the face list"))
-            as usize;
+    pub(crate) fn existing_record(&self, v: Voxel) -> u32 {
+        let records = &self.records;
+        self.owners
+            .get(v, |r| records[r as usize].voxel)
+            .unwrap_or_else(|| panic!("voxel {v:?} has no faces"))
+    }
+
+    /// Appends face (`v`, `dir`) owned by record `rec`. O(1) amortised.
+    #[inline]
+    pub(crate) fn push(&mut self, rec: u32, v: Voxel, dir: u8) {
+        let i = u32::try_from(self.list.len()).expect("more than 2^32 faces");
+        let r = &mut self.records[rec as usize];
+        debug_assert_eq!(r.at[usize::from(dir)], NO_FACE, "face pushed twice");
+        r.at[usize::from(dir)] = i;
+        r.count += 1;
+        self.list.push(Entry {
+            voxel: v,
+            dir,
+            owner: rec,
+        });
+    }
+
+    /// Removes face (`v`, `dir`) owned by record `rec` by `swap_remove`: the last face
+    /// takes its place. When `v` has no face left its record goes (one hash removal).
+    #[inline]
+    pub(crate) fn remove(&mut self, rec: u32, v: Voxel, dir: u8) {
+        let r = &mut self.records[rec as usize];
+        let i = r.at[usize::from(dir)];
+        assert!(i != NO_FACE, "face {v:?} {dir} missing from the face list");
+        r.at[usize::from(dir)] = NO_FACE;
+        r.count -= 1;
+        let gone = r.count == 0;
         let last = self.list.pop().expect("face list is empty");
-        if i < self.list.len() {
-            self.list[i] = last;
-            *self
-                .index
-                .get_mut(&last)
-                .expect("back-pointer of the last face") = i as u32;
+        if (i as usize) < self.list.len() {
+            self.list[i as usize] = last;
+            self.records[last.owner as usize].at[usize::from(last.dir)] = i;
+        }
+        if gone {
+            let records = &self.records;
+            self.owners.remove(v, |r| records[r as usize].voxel);
+            self.free.push(rec);
         }
     }
 
-    /// Heap bytes held (capacity, not length). The hash table is estimated the way
-    /// hashbrown lays it out: a power-of-two bucket count, one control byte per bucket.
+    /// Checks the back-pointers; panics naming the first broken one.
+    pub(crate) fn assert_valid(&self) {
+        let records = &self.records;
+        let key_of = |r: u32| records[r as usize].voxel;
+        for (i, e) in self.list.iter().enumerate() {
+            assert!(e.dir < 6, "face {i} has direction {}", e.dir);
+            assert_eq!(
+                self.owners.get(e.voxel, key_of),
+                Some(e.owner),
+                "owner of face {i}"
+            );
+            assert_eq!(
+                records[e.owner as usize].voxel, e.voxel,
+                "record voxel of face {i}"
+            );
+            assert_eq!(
+                records[e.owner as usize].at[usize::from(e.dir)],
+                i as u32,
+                "back-pointer of face {i}"
+            );
+        }
+        let free: std::collections::HashSet<u32> = self.free.iter().copied().collect();
+        assert_eq!(
+            free.len(),
+            self.free.len(),
+            "record free list has duplicates"
+        );
+        assert_eq!(
+            self.owners.len() + self.free.len(),
+            records.len(),
+            "live + free records"
+        );
+        let mut total = 0usize;
+        for r in self.owners.values() {
+            assert!(!free.contains(&r), "record {r} is live and free");
+            let rec = &records[r as usize];
+            assert_eq!(
+                self.owners.get(rec.voxel, key_of),
+                Some(r),
+                "index of record {r}"
+            );
+            let n = rec.at.iter().filter(|&&a| a != NO_FACE).count();
+            assert_eq!(n as u32, rec.count, "face count in record {r}");
+            assert!(n > 0, "record {r} has no face");
+            total += n;
+        }
+        assert_eq!(total, self.list.len(), "faces in records vs list");
+    }
+
+    /// Heap bytes held (capacity, not length).
     pub(crate) fn heap_bytes(&self) -> usize {
-        let cap = self.index.capacity();
-        let buckets = if cap == 0 {
-            0
-        } else {
-            (cap * 8 / 7).next_power_of_two()
-        };
-        self.list.capacity() * std::mem::size_of::<Face>()
-            + buckets * (std::mem::size_of::<(Face, u32)>() + 1)
+        self.list.capacity() * std::mem::size_of::<Entry>()
+            + self.records.capacity() * std::mem::size_of::<Record>()
+            + self.free.capacity() * 4
+            + self.owners.heap_bytes()
     }
 }

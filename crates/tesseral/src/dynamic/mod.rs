@@ -19,7 +19,8 @@
 //!   per z-slice, bit `x + 8y`), one cache line. So a lookup touches about
 //!   `k − 3` nodes and one block, and a stored voxel costs a bit, not a node.
 //! - With [`DynamicOctree::with_faces`], every exposed face is kept in one dense list
-//!   with back-pointers (a hash map from face to index), so a random face is drawn
+//!   with back-pointers (one record of six list positions per surface voxel, found
+//!   through a compact hash index), so a random face is drawn
 //!   in O(1) and a face is removed by `swap_remove` in O(1) (Libes §5).
 //!
 //! # Invariants (checked by [`DynamicOctree::assert_valid`])
@@ -49,6 +50,7 @@ use std::fmt;
 use faces::FaceList;
 pub use faces::{opposite, step, Face};
 
+use crate::linear::{CellClass, Classifier, LinearOctree, OctreeError};
 use crate::Voxel;
 
 /// log2 of the side of a leaf block (8×8×8 voxels, 512 bits).
@@ -61,6 +63,8 @@ const FULL: u32 = u32::MAX;
 const NONE: u32 = 0;
 /// The parent field of a node or block on the free list.
 const FREED: u32 = u32::MAX;
+static ZERO_BLOCK: [u64; 8] = [0; 8];
+static FULL_BLOCK: [u64; 8] = [!0; 8];
 /// All 27 bits of a 3×3×3 neighbourhood.
 pub const NEIGHBOURHOOD_ALL: u32 = (1 << 27) - 1;
 /// Bit of the 27-bit neighbourhood for each face direction 0..6 (−x, +x, −y, +y, −z, +z).
@@ -586,9 +590,13 @@ impl DynamicOctree {
     /// whose eight children are all full.
     fn collapse_full(&mut self, leaf: u32, parent: u32, u: [u64; 3]) {
         self.free_leaf(leaf);
-        let mut level = LEAF_LOG2 + 1;
-        self.set_slot(parent, child_index(u, level), FULL);
-        let mut node = parent;
+        self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), FULL);
+        self.collapse_up(parent, LEAF_LOG2 + 1, u);
+    }
+
+    /// From `node` at `level` (on the path to offsets `u`) upwards: a node whose eight
+    /// children are all full becomes a full slot in its parent.
+    fn collapse_up(&mut self, mut node: u32, mut level: u32, u: [u64; 3]) {
         while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == FULL) {
             let p = self.node_parent[node as usize];
             self.free_node(node);
@@ -596,6 +604,69 @@ impl DynamicOctree {
             let ci = if p != NONE { child_index(u, level) } else { 0 };
             self.set_slot(p, ci, FULL);
             node = p;
+        }
+    }
+
+    /// Releases a stored subtree (slot `slot` at `level`).
+    fn free_subtree(&mut self, slot: u32, level: u32) {
+        if !is_index(slot) {
+            return;
+        }
+        if level > LEAF_LOG2 {
+            let ch = self.nodes[slot as usize].child;
+            for c in ch {
+                self.free_subtree(c, level - 1);
+            }
+            self.free_node(slot);
+        } else {
+            self.free_leaf(slot);
+        }
+    }
+
+    /// Makes the aligned cube of side `2^s` at offsets `u` full (no voxel count or
+    /// face update: the caller keeps those).
+    fn fill_aligned(&mut self, u: [u64; 3], s: u32) {
+        let target = s.max(LEAF_LOG2);
+        let mut level = self.phys_log2();
+        let mut parent = NONE;
+        let mut ci = 0usize;
+        let mut cur = self.root;
+        while level > target {
+            if cur == FULL {
+                return;
+            }
+            if cur == EMPTY {
+                cur = self.alloc_node(parent, EMPTY);
+                self.set_slot(parent, ci, cur);
+            }
+            ci = child_index(u, level);
+            parent = cur;
+            cur = self.nodes[cur as usize].child[ci];
+            level -= 1;
+        }
+        if cur == FULL {
+            return;
+        }
+        if s >= LEAF_LOG2 {
+            self.free_subtree(cur, level);
+            self.set_slot(parent, ci, FULL);
+            self.collapse_up(parent, level + 1, u);
+            return;
+        }
+        if cur == EMPTY {
+            cur = self.alloc_leaf(parent, 0);
+            self.set_slot(parent, ci, cur);
+        }
+        let side = 1u64 << s;
+        let (x0, y0, z0) = (u[0] & 7, u[1] & 7, u[2] & 7);
+        let row = ((1u64 << side) - 1) << x0;
+        let plane = (y0..y0 + side).fold(0u64, |p, y| p | row << (8 * y));
+        let l = &mut self.leaves[cur as usize].0;
+        for z in z0..z0 + side {
+            l[z as usize] |= plane;
+        }
+        if l.iter().all(|&w| w == !0) {
+            self.collapse_full(cur, parent, u);
         }
     }
 
@@ -879,10 +950,10 @@ impl DynamicOctree {
     /// The block (8³ voxels) whose minimum corner has offsets `t`, found from node
     /// `start` at `start_level` (which contains offsets `u`), or from the root when
     /// `start` is NONE.
-    fn block_bits(&self, t: [u64; 3], u: [u64; 3], start: u32, start_level: u32) -> [u64; 8] {
+    fn block_bits(&self, t: [u64; 3], u: [u64; 3], start: u32, start_level: u32) -> &[u64; 8] {
         let phys = self.phys_log2();
         if !within(t, phys) {
-            return [0; 8];
+            return &ZERO_BLOCK;
         }
         let (cur, level) = if start == NONE {
             (self.root, phys)
@@ -891,9 +962,9 @@ impl DynamicOctree {
         };
         let (slot, _, _) = self.descend(cur, level, NONE, t);
         match slot {
-            EMPTY => [0; 8],
-            FULL => [!0; 8],
-            _ => self.leaves[slot as usize].0,
+            EMPTY => &ZERO_BLOCK,
+            FULL => &FULL_BLOCK,
+            _ => &self.leaves[slot as usize].0,
         }
     }
 
@@ -909,7 +980,7 @@ impl DynamicOctree {
             u[1].wrapping_add(1) >> 3,
             u[2].wrapping_add(1) >> 3,
         ];
-        let mut blocks = [[0u64; 8]; 8];
+        let mut blocks: [&[u64; 8]; 8] = [&ZERO_BLOCK; 8];
         for i in 0..8usize {
             let sel = [i & 1, i >> 1 & 1, i >> 2 & 1];
             if (0..3).any(|a| sel[a] == 1 && hi[a] == lo[a]) {
@@ -918,20 +989,30 @@ impl DynamicOctree {
             let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
             blocks[i] = self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level);
         }
+        // Row by row: the three cells (x−1, x, x+1) of a row come from one block
+        // word, or from two when the row crosses a block boundary in x.
+        let lx = u[0] & 7;
         let mut r = 0u32;
         for dz in 0..3u64 {
             let cz = u[2].wrapping_add(dz).wrapping_sub(1);
-            let bz = usize::from(cz >> 3 != lo[2]);
+            let bz = usize::from(cz >> 3 != lo[2]) << 2;
+            let lz = (cz & 7) as usize;
             for dy in 0..3u64 {
                 let cy = u[1].wrapping_add(dy).wrapping_sub(1);
-                let by = usize::from(cy >> 3 != lo[1]);
-                for dx in 0..3u64 {
-                    let cx = u[0].wrapping_add(dx).wrapping_sub(1);
-                    let bx = usize::from(cx >> 3 != lo[0]);
-                    let w = blocks[bx | by << 1 | bz << 2][(cz & 7) as usize];
-                    let bit = (w >> ((cx & 7) + 8 * (cy & 7))) & 1;
-                    r |= (bit as u32) << (dx + 3 * dy + 9 * dz);
-                }
+                let b = usize::from(cy >> 3 != lo[1]) << 1 | bz;
+                let sh = 8 * (cy & 7);
+                let row = if lo[0] == hi[0] {
+                    (blocks[b][lz] >> (sh + lx - 1)) & 7
+                } else {
+                    let wl = blocks[b][lz] >> sh;
+                    let wh = blocks[b | 1][lz] >> sh;
+                    if lx == 0 {
+                        (wl >> 7 & 1) | (wh & 3) << 1
+                    } else {
+                        (wl >> 6 & 3) | (wh & 1) << 2
+                    }
+                };
+                r |= (row as u32) << (3 * dy + 9 * dz);
             }
         }
         r
@@ -961,14 +1042,15 @@ impl DynamicOctree {
     fn faces_after_insert(&mut self, v: Voxel) {
         let nb = self.face_neighbours(v);
         let f = self.faces.as_mut().expect("face bookkeeping");
+        let mut own = None;
         for dir in 0..6u8 {
             if nb >> dir & 1 == 1 {
-                f.remove(Face {
-                    voxel: step(v, dir),
-                    dir: opposite(dir),
-                });
+                let n = step(v, dir);
+                let r = f.existing_record(n);
+                f.remove(r, n, opposite(dir));
             } else {
-                f.push(Face { voxel: v, dir });
+                let r = *own.get_or_insert_with(|| f.record_of(v));
+                f.push(r, v, dir);
             }
         }
     }
@@ -976,14 +1058,20 @@ impl DynamicOctree {
     fn faces_after_remove(&mut self, v: Voxel) {
         let nb = self.face_neighbours(v);
         let f = self.faces.as_mut().expect("face bookkeeping");
+        // A black voxel with a white neighbour has a record; one with six black
+        // neighbours has no face to remove.
+        let own = if nb & 0b11_1111 != 0b11_1111 {
+            f.existing_record(v)
+        } else {
+            0
+        };
         for dir in 0..6u8 {
             if nb >> dir & 1 == 1 {
-                f.push(Face {
-                    voxel: step(v, dir),
-                    dir: opposite(dir),
-                });
+                let n = step(v, dir);
+                let r = f.record_of(n);
+                f.push(r, n, opposite(dir));
             } else {
-                f.remove(Face { voxel: v, dir });
+                f.remove(own, v, dir);
             }
         }
     }
@@ -993,6 +1081,26 @@ impl DynamicOctree {
     #[must_use]
     pub fn face_count(&self) -> usize {
         self.faces.as_ref().map_or(0, |f| f.list.len())
+    }
+
+    /// The number of exposed faces (the surface area), whether or not the face list
+    /// is kept: `face_count()` with face bookkeeping, otherwise
+    /// `6·voxels − 2·(face-adjacent pairs)` counted now in O(voxels · depth).
+    ///
+    /// ```
+    /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[0, 0, 0], [0, 1, 0]]);
+    /// assert_eq!(t.exposed_faces(), 10);
+    /// ```
+    #[must_use]
+    pub fn exposed_faces(&self) -> u64 {
+        if let Some(f) = &self.faces {
+            return f.list.len() as u64;
+        }
+        let mut pairs = 0u64;
+        for v in self.voxels() {
+            pairs += u64::from((self.face_neighbours(v) & 0b10_1010).count_ones());
+        }
+        6 * self.voxels - 2 * pairs
     }
 
     /// The `i`-th face of the face list. O(1).
@@ -1007,13 +1115,16 @@ impl DynamicOctree {
             "face index {i} out of range (face_count {})",
             f.len()
         );
-        f[i]
+        f[i].face()
     }
 
     /// The whole face list, in face-list order (empty without face bookkeeping).
+    /// O(faces).
     #[must_use]
-    pub fn faces(&self) -> &[Face] {
-        self.faces.as_ref().map_or(&[][..], |f| &f.list[..])
+    pub fn faces(&self) -> Vec<Face> {
+        self.faces
+            .as_ref()
+            .map_or_else(Vec::new, |f| f.list.iter().map(|e| e.face()).collect())
     }
 
     /// A uniformly random exposed face, or `None` when there is none. O(1).
@@ -1101,7 +1212,9 @@ impl DynamicOctree {
         self.leaf_free.shrink_to_fit();
         if let Some(f) = &mut self.faces {
             f.list.shrink_to_fit();
-            f.index.shrink_to_fit();
+            f.owners.shrink_to_fit();
+            f.records.shrink_to_fit();
+            f.free.shrink_to_fit();
         }
     }
 
@@ -1138,7 +1251,8 @@ impl DynamicOctree {
     }
 
     /// Every black voxel, in tesseral (Morton) order relative to the root corner.
-    /// O(voxels + nodes).
+    /// O(voxels + nodes): full octants are enumerated voxel by voxel, so for large
+    /// solids prefer [`DynamicOctree::to_linear`], whose cost follows the surface.
     ///
     /// ```
     /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[1, 0, 0], [0, 0, 0]]);
@@ -1146,7 +1260,7 @@ impl DynamicOctree {
     /// ```
     #[must_use]
     pub fn voxels(&self) -> Vec<Voxel> {
-        let mut out = Vec::with_capacity(usize::try_from(self.voxels).unwrap_or(0));
+        let mut out = Vec::with_capacity(usize::try_from(self.voxels.min(1 << 24)).unwrap_or(0));
         self.visit(|base, level, bits| match bits {
             None => {
                 let side = 1u64 << level;
@@ -1173,6 +1287,187 @@ impl DynamicOctree {
             }
         });
         out
+    }
+
+    /// Builds a tree (without face bookkeeping) from a linear octree: each black leaf
+    /// becomes a full slot (or bits of a block), so a solid costs its surface, not its
+    /// volume. O(leaves · depth).
+    ///
+    /// ```
+    /// use tesseral::{dynamic::DynamicOctree, linear::LinearOctree};
+    /// let cube = (0..4).flat_map(|x| (0..4).flat_map(move |y| (0..4).map(move |z| [x, y, z])));
+    /// let lin = LinearOctree::from_voxels(5, [-8, -8, -8], cube).unwrap();
+    /// let t = DynamicOctree::from_linear(&lin);
+    /// assert_eq!(t.voxel_count(), 64);
+    /// assert_eq!((t.root_min(), t.root_size_log2()), ([0, 0, 0], 2));
+    /// t.assert_valid();
+    /// ```
+    #[must_use]
+    pub fn from_linear(lin: &LinearOctree) -> Self {
+        let mut t = Self::new();
+        let count = lin.voxel_count();
+        if count == 0 {
+            return t;
+        }
+        t.root_min = lin.origin();
+        t.size_log2 = u32::from(lin.depth());
+        for leaf in lin.leaves() {
+            let [x, y, z] = crate::code::decode(leaf.code());
+            t.fill_aligned(
+                [u64::from(x), u64::from(y), u64::from(z)],
+                u32::from(leaf.size_log2()),
+            );
+        }
+        t.voxels = count;
+        t.contract();
+        t
+    }
+
+    /// The voxels of this tree inside the window `[origin, origin + 2^depth)³` as a
+    /// linear octree. Built top-down with [`LinearOctree::from_classifier`], each cell
+    /// classified by [`DynamicOctree::classify`], so the cost follows the surface.
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] when `depth` exceeds [`crate::linear::MAX_DEPTH`].
+    ///
+    /// ```
+    /// use tesseral::dynamic::DynamicOctree;
+    /// let t = DynamicOctree::from_voxels([[0, 0, 0], [1, 0, 0], [100, 0, 0]]);
+    /// let lin = t.to_linear(2, [-1, -1, -1]).unwrap(); // a 4³ window: [100, 0, 0] is cut
+    /// assert_eq!(lin.voxel_count(), 2);
+    /// ```
+    pub fn to_linear(&self, depth: u8, origin: Voxel) -> Result<LinearOctree, OctreeError> {
+        LinearOctree::from_classifier(depth, origin, self)
+    }
+
+    /// Whether the cube `[min, min + 2^size_log2)³` (any alignment) is all black
+    /// (`Inside`), all white (`Outside`) or mixed (`Partial`). A stored node always
+    /// holds both colours, so the search stops at every node that lies wholly inside
+    /// the cube: the cost follows the cube's boundary. A single voxel is never
+    /// `Partial`.
+    ///
+    /// ```
+    /// use tesseral::{dynamic::DynamicOctree, linear::CellClass};
+    /// let t = DynamicOctree::from_voxels([[0, 0, 0], [1, 0, 0]]);
+    /// assert_eq!(t.classify([0, 0, 0], 0), CellClass::Inside);
+    /// assert_eq!(t.classify([0, 0, 0], 1), CellClass::Partial);
+    /// assert_eq!(t.classify([2, 0, 0], 1), CellClass::Outside);
+    /// ```
+    #[must_use]
+    pub fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
+        if self.root == EMPTY {
+            return CellClass::Outside;
+        }
+        let side = 1i128 << size_log2.min(64);
+        let k = self.size_log2;
+        let modulus = 1i128 << 64;
+        // Per axis: the cube's intervals in root offsets, clipped to the root
+        // (a k = 64 root wraps, so an interval may split in two).
+        let mut spans: [[(u128, u128); 2]; 3] = [[(0, 0); 2]; 3];
+        let mut nspans = [0usize; 3];
+        let mut outside = false;
+        for a in 0..3 {
+            let lo = i128::from(min[a]) - i128::from(self.root_min[a]);
+            let hi = lo + side;
+            if k >= 64 {
+                let lo = lo.rem_euclid(modulus);
+                let hi = lo + side.min(modulus);
+                if hi <= modulus {
+                    spans[a][0] = (lo as u128, hi as u128);
+                    nspans[a] = 1;
+                } else {
+                    spans[a][0] = (lo as u128, modulus as u128);
+                    spans[a][1] = (0, (hi - modulus) as u128);
+                    nspans[a] = 2;
+                }
+            } else {
+                let root = 1i128 << k;
+                let (clo, chi) = (lo.max(0), hi.min(root));
+                if lo < 0 || hi > root {
+                    outside = true;
+                }
+                if clo < chi {
+                    spans[a][0] = (clo as u128, chi as u128);
+                    nspans[a] = 1;
+                }
+            }
+        }
+        let (mut black, mut white) = (false, outside);
+        'boxes: for i in 0..nspans[0] {
+            for j in 0..nspans[1] {
+                for l in 0..nspans[2] {
+                    let b = [spans[0][i], spans[1][j], spans[2][l]];
+                    let (bl, wh) = self.probe(self.root, self.phys_log2(), [0; 3], b);
+                    black |= bl;
+                    white |= wh;
+                    if black && white {
+                        break 'boxes;
+                    }
+                }
+            }
+        }
+        match (black, white) {
+            (true, false) => CellClass::Inside,
+            (false, _) => CellClass::Outside,
+            (true, true) => CellClass::Partial,
+        }
+    }
+
+    /// (any black, any white) in the intersection of cell (`slot`, `level`, `base`)
+    /// with the box `b` (half-open offset intervals per axis).
+    fn probe(&self, slot: u32, level: u32, base: [u128; 3], b: [(u128, u128); 3]) -> (bool, bool) {
+        let size = 1u128 << level;
+        let mut inside = true;
+        for a in 0..3 {
+            let (lo, hi) = (b[a].0.max(base[a]), b[a].1.min(base[a] + size));
+            if lo >= hi {
+                return (false, false);
+            }
+            inside &= lo == base[a] && hi == base[a] + size;
+        }
+        match slot {
+            EMPTY => (false, true),
+            FULL => (true, false),
+            // A stored node or block holds both colours (checked by assert_valid).
+            _ if inside => (true, true),
+            _ if level > LEAF_LOG2 => {
+                let ch = &self.nodes[slot as usize].child;
+                let h = size >> 1;
+                let (mut black, mut white) = (false, false);
+                for (ci, &c) in ch.iter().enumerate() {
+                    let cb = [
+                        base[0] + (ci as u128 & 1) * h,
+                        base[1] + (ci as u128 >> 1 & 1) * h,
+                        base[2] + (ci as u128 >> 2 & 1) * h,
+                    ];
+                    let (bl, wh) = self.probe(c, level - 1, cb, b);
+                    black |= bl;
+                    white |= wh;
+                    if black && white {
+                        break;
+                    }
+                }
+                (black, white)
+            }
+            _ => {
+                let l = &self.leaves[slot as usize].0;
+                let r: [(u128, u128); 3] = std::array::from_fn(|a| {
+                    (
+                        b[a].0.max(base[a]) - base[a],
+                        b[a].1.min(base[a] + 8) - base[a],
+                    )
+                });
+                let row = ((1u64 << (r[0].1 - r[0].0)) - 1) << r[0].0;
+                let plane = (r[1].0..r[1].1).fold(0u64, |p, y| p | row << (8 * y));
+                let (mut black, mut white) = (false, false);
+                for z in r[2].0..r[2].1 {
+                    let w = l[z as usize] & plane;
+                    black |= w != 0;
+                    white |= w != plane;
+                }
+                (black, white)
+            }
+        }
     }
 
     // ----- invariants -------------------------------------------------------------------
@@ -1300,20 +1595,10 @@ impl DynamicOctree {
             assert!(splits, "root block could contract");
         }
         if let Some(f) = &self.faces {
-            assert_eq!(
-                f.list.len(),
-                f.index.len(),
-                "face list and back-pointers differ in size"
-            );
-            for (i, face) in f.list.iter().enumerate() {
-                assert!(face.dir < 6, "face {i} has direction {}", face.dir);
-                assert_eq!(
-                    f.index.get(face).copied(),
-                    Some(i as u32),
-                    "back-pointer of face {i}"
-                );
-                assert!(self.contains(face.voxel), "face {i} on a white voxel");
-                assert!(!self.contains(face.outside()), "face {i} is covered");
+            f.assert_valid();
+            for (i, e) in f.list.iter().enumerate() {
+                assert!(self.contains(e.voxel), "face {i} on a white voxel");
+                assert!(!self.contains(e.face().outside()), "face {i} is covered");
             }
             let all = self.voxels();
             let pairs: u64 = all
@@ -1330,6 +1615,14 @@ impl DynamicOctree {
                 "face count is not 6·voxels − 2·pairs"
             );
         }
+    }
+}
+
+/// A dynamic octree classifies cells for [`LinearOctree::from_classifier`] (and so for
+/// CSG scenes) through [`DynamicOctree::classify`].
+impl Classifier for DynamicOctree {
+    fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
+        DynamicOctree::classify(self, min, size_log2)
     }
 }
 

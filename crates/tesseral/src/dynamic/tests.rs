@@ -86,7 +86,7 @@ fn check_against(t: &DynamicOctree, m: &Model, probes: &[Voxel]) {
         );
     }
     if t.tracks_faces() {
-        assert_eq!(t.faces(), &m.faces[..], "face list order");
+        assert_eq!(t.faces(), m.faces, "face list order");
     }
 }
 
@@ -330,7 +330,7 @@ fn face_list_order_follows_the_contract() {
             dir: 5,
         },
     ];
-    assert_eq!(t.faces(), &want[..]);
+    assert_eq!(t.faces(), want);
     t.remove([0, 0, 0]);
     t.assert_valid();
     // Worked by hand through the six swap_removes and one push.
@@ -338,7 +338,7 @@ fn face_list_order_follows_the_contract() {
         voxel: [1, 0, 0],
         dir,
     };
-    assert_eq!(t.faces(), &[b(5), b(2), b(0), b(4), b(3), b(1)][..]);
+    assert_eq!(t.faces(), [b(5), b(2), b(0), b(4), b(3), b(1)]);
 }
 
 #[test]
@@ -357,7 +357,7 @@ fn random_face_is_uniform_chi_square() {
         }
     }
     t.assert_valid();
-    let faces: Vec<Face> = t.faces().to_vec();
+    let faces: Vec<Face> = t.faces();
     let n = faces.len();
     assert!(n > 50);
     let index: std::collections::HashMap<Face, usize> =
@@ -522,5 +522,158 @@ fn fill_then_drain_a_block_in_random_order() {
         }
         assert!(t.is_empty());
         assert_eq!(t.node_count(), 0);
+    }
+}
+
+#[test]
+fn voxel_table_matches_a_hashmap() {
+    // Small key range so probe runs collide, wrap around and get backward-shifted.
+    // The table keeps hashes and values; the keys live in `keys[value]`.
+    let seed = 17;
+    eprintln!("voxel table seed {seed}");
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let mut t = faces::VoxelTable::default();
+    let mut keys: Vec<Voxel> = Vec::new();
+    let mut m = std::collections::HashMap::new();
+    for _ in 0..20_000u32 {
+        let k: Voxel = std::array::from_fn(|_| rng.random_range(-6..6));
+        match rng.random_range(0..3) {
+            0 => {
+                let got = t.get(k, |v| keys[v as usize]);
+                assert_eq!(got, m.get(&k).copied());
+                if got.is_none() {
+                    keys.push(k);
+                    let v = (keys.len() - 1) as u32;
+                    t.insert(k, v);
+                    m.insert(k, v);
+                }
+            }
+            1 => assert_eq!(t.remove(k, |v| keys[v as usize]), m.remove(&k)),
+            _ => assert_eq!(t.get(k, |v| keys[v as usize]), m.get(&k).copied()),
+        }
+        assert_eq!(t.len(), m.len());
+    }
+    let mut a: Vec<u32> = t.values().collect();
+    let mut b: Vec<u32> = m.values().copied().collect();
+    a.sort_unstable();
+    b.sort_unstable();
+    assert_eq!(a, b);
+    t.shrink_to_fit();
+    for (k, v) in m {
+        assert_eq!(t.get(k, |v| keys[v as usize]), Some(v));
+    }
+}
+
+/// A random solid with some full octants: random voxels plus a few filled cubes.
+fn random_solid(rng: &mut Pcg64, lo: i64, side: i64) -> HashSet<Voxel> {
+    let mut set = HashSet::new();
+    for _ in 0..rng.random_range(0..400) {
+        set.insert(std::array::from_fn(|_| lo + rng.random_range(0..side)));
+    }
+    for _ in 0..3 {
+        let c: Voxel = std::array::from_fn(|_| lo + rng.random_range(0..side));
+        let s = rng.random_range(1..12);
+        for x in 0..s {
+            for y in 0..s {
+                for z in 0..s {
+                    let v = [c[0] + x, c[1] + y, c[2] + z];
+                    if (0..3).all(|a| v[a] < lo + side) {
+                        set.insert(v);
+                    }
+                }
+            }
+        }
+    }
+    set
+}
+
+#[test]
+fn linear_round_trip_and_windows_match_the_model() {
+    use crate::linear::LinearOctree;
+    for seed in 50..62u64 {
+        eprintln!("linear seed {seed}");
+        let mut rng = Pcg64::seed_from_u64(seed);
+        let lo = rng.random_range(-40..10);
+        let set = random_solid(&mut rng, lo, 32);
+        let t = DynamicOctree::from_voxels(set.iter().copied());
+        t.assert_valid();
+        // A window that holds everything, on a grid not aligned with the tree's.
+        let origin = [lo - 3, lo - 1, lo - 2];
+        let lin = t.to_linear(6, origin).unwrap();
+        lin.assert_valid();
+        let want = LinearOctree::from_voxels(6, origin, set.iter().copied()).unwrap();
+        assert_eq!(lin, want);
+        // Back again.
+        let back = DynamicOctree::from_linear(&lin);
+        back.assert_valid();
+        let mut a = back.voxels();
+        let mut b: Vec<Voxel> = set.iter().copied().collect();
+        a.sort_unstable();
+        b.sort_unstable();
+        assert_eq!(a, b);
+        // A window that cuts the solid.
+        let o2: Voxel = std::array::from_fn(|_| lo + rng.random_range(0..24));
+        let d2 = rng.random_range(0..5u8);
+        let cut = t.to_linear(d2, o2).unwrap();
+        let side = 1i64 << d2;
+        let want = LinearOctree::from_voxels(
+            d2,
+            o2,
+            set.iter()
+                .copied()
+                .filter(|v| (0..3).all(|a| v[a] >= o2[a] && v[a] < o2[a] + side)),
+        )
+        .unwrap();
+        assert_eq!(cut, want);
+        // Every cell class agrees with the model on random cubes.
+        for _ in 0..200 {
+            let m: Voxel = std::array::from_fn(|_| lo - 4 + rng.random_range(0..40));
+            let k = rng.random_range(0..4u8);
+            let s = 1i64 << k;
+            let mut black = 0;
+            for x in 0..s {
+                for y in 0..s {
+                    for z in 0..s {
+                        black += i64::from(set.contains(&[m[0] + x, m[1] + y, m[2] + z]));
+                    }
+                }
+            }
+            let want = if black == 0 {
+                crate::linear::CellClass::Outside
+            } else if black == s * s * s {
+                crate::linear::CellClass::Inside
+            } else {
+                crate::linear::CellClass::Partial
+            };
+            assert_eq!(t.classify(m, k), want, "cube {m:?} size 2^{k}");
+        }
+    }
+}
+
+#[test]
+fn linear_conversion_of_big_solids_and_far_coordinates() {
+    use crate::linear::LinearOctree;
+    // A 2^20 cube costs one full slot each way.
+    let e = 1i64 << 62;
+    let lin = LinearOctree::from_sorted_leaves(20, [-e, 5, e], [crate::linear::Leaf::new(0, 20)])
+        .unwrap();
+    let t = DynamicOctree::from_linear(&lin);
+    t.assert_valid();
+    assert_eq!(t.voxel_count(), 1 << 60);
+    assert_eq!(t.node_count(), 0);
+    assert!(t.contains([-e + 12345, 5 + 777, e + (1 << 20) - 1]));
+    assert!(!t.contains([-e - 1, 5, e]));
+    assert_eq!(t.to_linear(20, [-e, 5, e]).unwrap(), lin);
+    // A window shifted by one voxel: the cube is cut and misaligned.
+    let w = t.to_linear(3, [-e - 1, 4, e - 1]).unwrap();
+    assert_eq!(w.voxel_count(), 7 * 7 * 7);
+    // Small depths use the logical root inside one block.
+    for depth in 0..4u8 {
+        let vs = [[-3, 0, 0], [-3 + (1 << depth) - 1, 0, 0]];
+        let lin = LinearOctree::from_voxels(depth, [-3, 0, 0], vs).unwrap();
+        let t = DynamicOctree::from_linear(&lin);
+        t.assert_valid();
+        assert!(vs.iter().all(|&v| t.contains(v)));
+        assert_eq!(t.voxel_count(), lin.voxel_count());
     }
 }

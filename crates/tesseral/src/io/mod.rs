@@ -20,6 +20,7 @@
 
 pub mod binvox;
 pub mod native;
+pub mod octomap;
 mod reframe;
 pub mod vox;
 pub mod xyz;
@@ -198,19 +199,23 @@ impl VoxelModel {
 
 /// How to read formats that need a choice (meshes need a resolution).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-#[non_exhaustive]
-pub struct ReadOptions {}
+pub struct ReadOptions {
+    /// How meshes are voxelized.
+    pub mesh: crate::mesh::VoxelizeOptions,
+}
 
 /// How to write formats that need a choice (meshes can be blocky or smooth).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-#[non_exhaustive]
-pub struct WriteOptions {}
+pub struct WriteOptions {
+    /// How meshes are made from the octree.
+    pub mesh: crate::mesh::MeshOptions,
+}
 
 /// The extensions [`read_octree`] understands.
-pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox";
+pub const KNOWN_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply";
 
 /// The extensions [`write_octree`] understands.
-pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox";
+pub const KNOWN_WRITE_EXTENSIONS: &str = "tess, xyz, binvox, vox, bt, ot, stl, obj, ply, glb";
 
 /// Reads an octree from `path`, choosing the format by its extension. Meshes are
 /// voxelized with [`ReadOptions::default`].
@@ -233,12 +238,14 @@ pub fn read_model(path: &Path) -> Result<VoxelModel, FormatError> {
 ///
 /// # Errors
 /// [`FormatError`] naming the file, and the line and column or field at fault.
-pub fn read_model_with(path: &Path, _options: &ReadOptions) -> Result<VoxelModel, FormatError> {
+pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<VoxelModel, FormatError> {
     match extension(path).as_str() {
         "tess" => native::read(path),
         "xyz" => xyz::read(path).map(VoxelModel::new),
         "binvox" => binvox::read(path),
         "vox" => vox::read(path),
+        "bt" | "ot" => octomap::read(path),
+        "stl" | "obj" | "ply" => crate::mesh::read_voxelized(path, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
@@ -271,13 +278,15 @@ pub fn write_model(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
 pub fn write_model_with(
     path: &Path,
     model: &VoxelModel,
-    _options: &WriteOptions,
+    options: &WriteOptions,
 ) -> Result<(), FormatError> {
     match extension(path).as_str() {
         "tess" => write_atomic(path, |w| native::write(w, model)),
         "xyz" => write_atomic(path, |w| xyz::write(w, &model.tree)),
         "binvox" => binvox::write_file(path, model),
         "vox" => vox::write_file(path, model),
+        "bt" | "ot" => octomap::write_file(path, model),
+        "stl" | "obj" | "ply" | "glb" => crate::mesh::write_meshed(path, model, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
             path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,
@@ -361,8 +370,17 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatErr
     fs::read(path).map_err(|e| FormatError::io(path, e))
 }
 
+/// Reads a whole file up to the reader limit (for the mesh parsers).
+pub(crate) fn read_limited_pub(path: &Path) -> Result<Vec<u8>, FormatError> {
+    read_limited(path, MAX_FILE_BYTES)
+}
+
 /// The largest file the whole-file readers load (4 GiB).
 pub(crate) const MAX_FILE_BYTES: u64 = 4 << 30;
 
 /// The most voxels a dense format (binvox, `.vox`) may expand to before we refuse.
-pub const MAX_DENSE_VOXELS: u64 = 1 << 28;
+pub const MAX_DENSE_VOXELS: u64 = 1 << 26;
+
+/// The most per-voxel colours a reader expands (a colour map entry takes about 40
+/// bytes).
+pub const MAX_COLORED_VOXELS: u64 = 1 << 24;

@@ -2,6 +2,9 @@
 //! eight children of a new root of twice the side, so every old block keeps its
 //! alignment in the new lattice.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use super::{OctreeError, MAX_DEPTH};
 use crate::Voxel;
 
@@ -42,6 +45,7 @@ pub(crate) fn grown_space(
 
 /// The child label that the old root takes in each root expansion from
 /// `(depth, origin)` to the grown `(new_depth, new_origin)`, outermost first.
+#[allow(dead_code)]
 pub(crate) fn expansion_labels(
     depth: u8,
     origin: Voxel,

@@ -8,6 +8,9 @@
 //! maximal run is exactly the canonical leaf list, so the output needs no second
 //! merging pass. Large inputs are split by octant and merged in parallel with rayon.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use rayon::prelude::*;
 
 use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};
@@ -23,18 +26,6 @@ pub enum SetOp {
     Difference,
     /// Voxels in exactly one of the two solids.
     SymmetricDifference,
-}
-
-impl SetOp {
-    #[inline]
-    fn apply(self, a: bool, b: bool) -> bool {
-        match self {
-            SetOp::Union => a | b,
-            SetOp::Intersection => a & b,
-            SetOp::Difference => a & !b,
-            SetOp::SymmetricDifference => a ^ b,
-        }
-    }
 }
 
 /// Below this many leaves (both operands together) a cell is merged on one thread.
@@ -209,7 +200,9 @@ impl<'a> Part<'a> {
         let mut rest = leaves;
         for (d, part) in parts.iter_mut().enumerate().take(7) {
             let end = code + (d as u64 + 1) * child;
-            let n = rest.partition_point(|l| l.code() < end);
+            // Packed leaves sort as codes, and a leaf ends by `end` exactly when
+            // its packed form is below `end << 1`.
+            let n = rest.partition_point(|l| l.packed() < end << 1);
             *part = Part::Leaves(&rest[..n]);
             rest = &rest[n..];
         }
@@ -222,9 +215,28 @@ impl<'a> Part<'a> {
 fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf> {
     let covering = a.covers(code, k) && b.covers(code, k);
     if k == 0 || covering || a.len() + b.len() < PARALLEL_MIN_LEAVES {
-        let mut out = Vec::with_capacity(a.len().max(b.len()));
-        let cell = (code, code + (1u64 << (3 * u32::from(k))));
-        merge_runs(op, runs(a, cell), runs(b, cell), &mut out);
+        let full = [Leaf::new(code, k)];
+        let clamp = |p: Part<'_>| -> bool {
+            match p {
+                Part::Full => true,
+                Part::Leaves(l) => l.len() == 1 && l[0].size_log2() > k,
+            }
+        };
+        let sa: &[Leaf] = match a {
+            Part::Leaves(l) if !clamp(a) => l,
+            _ => &full,
+        };
+        let sb: &[Leaf] = match b {
+            Part::Leaves(l) if !clamp(b) => l,
+            _ => &full,
+        };
+        let mut out = Vec::with_capacity(sa.len().max(sb.len()) + 8);
+        match op {
+            SetOp::Union => union(sa, sb, &mut out),
+            SetOp::Intersection => intersection(sa, sb, &mut out),
+            SetOp::Difference => difference(sa, sb, &mut out),
+            SetOp::SymmetricDifference => symmetric_difference(sa, sb, &mut out),
+        }
         return out;
     }
     let (pa, pb) = (a.split(code, k), b.split(code, k));
@@ -244,125 +256,168 @@ fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf
     out
 }
 
-/// The runs of black codes of one operand inside `cell`, clamped to it.
-fn runs(part: Part<'_>, cell: (u64, u64)) -> Runs<'_> {
-    match part {
-        Part::Full => Runs {
-            leaves: &[],
-            i: 0,
-            first: Some(cell),
-            cell,
-        },
-        Part::Leaves(leaves) => Runs {
-            leaves,
-            i: 0,
-            first: None,
-            cell,
-        },
-    }
-}
-
-/// Coalesces consecutive touching leaves into runs `[start, end)` of codes.
-struct Runs<'a> {
-    leaves: &'a [Leaf],
-    i: usize,
-    first: Option<(u64, u64)>,
-    cell: (u64, u64),
-}
-
-#[inline]
-fn bounds(leaf: Leaf) -> (u64, u64) {
+/// The code span `[start, end)` of a leaf, read straight off the packed form:
+/// `m = p ^ (p + 1)` is the size marker plus the zero bit above it.
+#[inline(always)]
+fn span2(leaf: Leaf) -> (u64, u64) {
     let p = leaf.packed();
-    let bits = 3 * (p.trailing_ones() / 3);
-    let code = (p >> 1) & !((1u64 << bits) - 1);
-    (code, code + (1u64 << bits))
+    let m = p ^ (p.wrapping_add(1));
+    let start = (p & !m) >> 1;
+    (start, start + (m >> 1) + 1)
 }
 
-impl Iterator for Runs<'_> {
-    type Item = (u64, u64);
-
-    #[inline]
-    fn next(&mut self) -> Option<(u64, u64)> {
-        if let Some(r) = self.first.take() {
-            return Some(r);
-        }
-        let (s, mut e) = bounds(*self.leaves.get(self.i)?);
-        self.i += 1;
-        while let Some(&l) = self.leaves.get(self.i) {
-            let (s2, e2) = bounds(l);
-            if s2 != e {
-                break;
-            }
-            e = e2;
-            self.i += 1;
-        }
-        // A single leaf larger than the cell covers it: clamp.
-        Some((s.max(self.cell.0), e.min(self.cell.1)))
+/// Pushes a leaf that follows every leaf in `out`, merging siblings only when the
+/// leaf is the last child (label 7) of its parent: the only time a merge can occur.
+#[inline(always)]
+fn push_m(out: &mut Vec<Leaf>, leaf: Leaf) {
+    let p = leaf.packed();
+    if p.checked_shr(p.trailing_ones() + 1).unwrap_or(0) & 7 == 7 {
+        push_merging(out, leaf);
+    } else {
+        out.push(leaf);
     }
 }
 
-/// Sweeps two sorted run lists together and appends the canonical leaves of
-/// `op(a, b)` to `out`.
-fn merge_runs(
-    op: SetOp,
-    mut a: impl Iterator<Item = (u64, u64)>,
-    mut b: impl Iterator<Item = (u64, u64)>,
-    out: &mut Vec<Leaf>,
-) {
-    let (mut ra, mut rb) = (a.next(), b.next());
-    let mut x = 0u64;
-    let mut pending: Option<(u64, u64)> = None;
-    loop {
-        match (op, ra, rb) {
-            (_, None, None)
-            | (SetOp::Intersection, None, _)
-            | (SetOp::Intersection, _, None)
-            | (SetOp::Difference, None, _) => break,
-            _ => {}
-        }
-        let (ina, na) = match ra {
-            Some((s, _)) if x < s => (false, s),
-            Some((_, e)) => (true, e),
-            None => (false, u64::MAX),
-        };
-        let (inb, nb) = match rb {
-            Some((s, _)) if x < s => (false, s),
-            Some((_, e)) => (true, e),
-            None => (false, u64::MAX),
-        };
-        let next = na.min(nb);
-        if op.apply(ina, inb) {
-            pending = match pending {
-                Some((s, e)) if e == x => Some((s, next)),
-                Some((s, e)) => {
-                    emit_run(out, s, e);
-                    Some((x, next))
-                }
-                None => Some((x, next)),
-            };
-        }
-        x = next;
-        if ra.is_some_and(|(_, e)| x >= e) {
-            ra = a.next();
-        }
-        if rb.is_some_and(|(_, e)| x >= e) {
-            rb = b.next();
-        }
-    }
-    if let Some((s, e)) = pending {
-        emit_run(out, s, e);
-    }
-}
-
-/// Appends the maximal aligned blocks of the code interval `[s, e)`, greedily: at
-/// each start the largest block aligned there that fits.
+/// Appends the maximal blocks of the code interval `[s, e)`, greedily (the largest
+/// block aligned at each start that fits), merging as it goes when asked.
 #[inline]
-pub(crate) fn emit_run(out: &mut Vec<Leaf>, mut s: u64, e: u64) {
+fn emit_gap(out: &mut Vec<Leaf>, mut s: u64, e: u64, merge: bool) {
     while s < e {
         let align = s.trailing_zeros().min(63) / 3;
         let fit = (63 - (e - s).leading_zeros()) / 3;
         let k = align.min(fit);
-        out.push(Leaf::new(s, k as u8));
+        let leaf = Leaf::new(s, k as u8);
+        if merge {
+            push_m(out, leaf);
+        } else {
+            out.push(leaf);
+        }
         s += 1u64 << (3 * k);
+    }
+}
+
+/// Union of two canonical leaf lists. A leaf nested in a larger one is skipped;
+/// siblings coming from both operands may merge.
+fn union(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
+        if xe <= ys {
+            push_m(out, a[i]);
+            i += 1;
+        } else if ye <= xs {
+            push_m(out, b[j]);
+            j += 1;
+        } else if xs <= ys && ye <= xe {
+            push_m(out, a[i]);
+            i += 1;
+            j += 1;
+            while j < b.len() && span2(b[j]).0 < xe {
+                j += 1;
+            }
+        } else {
+            push_m(out, b[j]);
+            j += 1;
+            i += 1;
+            while i < a.len() && span2(a[i]).0 < ye {
+                i += 1;
+            }
+        }
+    }
+    for &l in a[i..].iter().chain(&b[j..]) {
+        push_m(out, l);
+    }
+}
+
+/// Intersection: of two overlapping (hence nested) leaves the smaller is kept.
+/// No merge can occur: a full parent in both operands is inside a leaf of each.
+fn intersection(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
+        if xe <= ys {
+            i += 1;
+        } else if ye <= xs {
+            j += 1;
+        } else if xs <= ys && ye <= xe {
+            out.push(b[j]);
+            j += 1;
+        } else {
+            out.push(a[i]);
+            i += 1;
+        }
+    }
+}
+
+/// Difference: a leaf of `a` is kept whole, dropped, or cut around the leaves of
+/// `b` inside it (the gaps are emitted greedily as maximal blocks, which is
+/// canonical: a full parent of the result lies in one leaf of `a`, in one gap).
+fn difference(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
+    let mut j = 0;
+    for (i, &x) in a.iter().enumerate() {
+        let (xs, xe) = span2(x);
+        while j < b.len() && span2(b[j]).1 <= xs {
+            j += 1;
+        }
+        if j == b.len() {
+            out.extend_from_slice(&a[i..]);
+            return;
+        }
+        let (ys, ye) = span2(b[j]);
+        if ys >= xe {
+            out.push(x);
+        } else if ys <= xs && xe <= ye {
+            // Inside a leaf of b: dropped.
+        } else {
+            let mut pos = xs;
+            while j < b.len() {
+                let (ys, ye) = span2(b[j]);
+                if ys >= xe {
+                    break;
+                }
+                emit_gap(out, pos, ys, false);
+                pos = ye;
+                j += 1;
+            }
+            emit_gap(out, pos, xe, false);
+        }
+    }
+}
+
+/// Symmetric difference: disjoint leaves pass, a nested pair leaves the larger cut
+/// around every leaf of the other operand inside it; siblings may merge.
+fn symmetric_difference(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
+        if xe <= ys {
+            push_m(out, a[i]);
+            i += 1;
+        } else if ye <= xs {
+            push_m(out, b[j]);
+            j += 1;
+        } else {
+            // Nested: cut the larger (from `big`) around the leaves of `small`.
+            let (big_end, mut pos, small, k) = if xs <= ys && ye <= xe {
+                i += 1;
+                (xe, xs, b, &mut j)
+            } else {
+                j += 1;
+                (ye, ys, a, &mut i)
+            };
+            while *k < small.len() {
+                let (s, e) = span2(small[*k]);
+                if s >= big_end {
+                    break;
+                }
+                emit_gap(out, pos, s, true);
+                pos = e;
+                *k += 1;
+            }
+            emit_gap(out, pos, big_end, true);
+        }
+    }
+    for &l in a[i..].iter().chain(&b[j..]) {
+        push_m(out, l);
     }
 }

@@ -27,7 +27,7 @@ pub(crate) fn sort_u64(keys: &mut Vec<u64>) {
         for &k in keys.iter() {
             count[((k >> shift) & 0xff) as usize] += 1;
         }
-        if count.iter().any(|&c| c == keys.len()) {
+        if count.contains(&keys.len()) {
             shift += 8;
             continue;
         }

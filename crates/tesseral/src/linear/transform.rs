@@ -7,6 +7,9 @@
 //! dilated axis components of the code (a rotation swaps two components and
 //! complements one). [`rotation_labels`] gives the per-digit table for reference.
 
+// Per-axis loops index several arrays at once.
+#![allow(clippy::needless_range_loop)]
+
 use super::arith::MASK_X;
 use super::{push_merging, sort, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
 use crate::Voxel;

@@ -16,23 +16,34 @@
 //! when they share a voxel (interior), and *touch* when their closed cubes meet
 //! without sharing interior.
 
+mod draw;
 mod interfere;
 mod orient;
+mod plan;
 mod sweep;
 mod traverse;
+mod view;
 mod world;
 mod world_file;
 
+pub use draw::{
+    render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
+    SWEPT_COLOUR,
+};
 pub use interfere::{
-    clearance, clearance_squared, interference, interference_placed, intersects, intersects_placed,
-    Aabb, Interference, Placed, Placement,
+    clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
+    intersects_placed, Aabb, Interference, Placed, Placement,
 };
 pub use orient::{Rotation, RotationError};
+pub use plan::{
+    config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
+};
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
+pub use view::{BoxTree, Traversable};
 pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
 };
-pub use world_file::{read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
+pub use world_file::{read_solid, read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
 
 #[cfg(test)]
 mod tests;

@@ -54,6 +54,13 @@ impl Rotation {
         neg: [false; 3],
     };
 
+    /// The point reflection `p -> -p` (determinant −1, so not a rotation): used
+    /// internally to reflect a solid for Minkowski differences.
+    pub(crate) const REFLECTION: Rotation = Rotation {
+        perm: [0, 1, 2],
+        neg: [true; 3],
+    };
+
     /// All 24 rotations, identity first, in a fixed order (so an index names one).
     #[must_use]
     pub fn all() -> Vec<Rotation> {
@@ -179,6 +186,25 @@ impl Rotation {
             out[a] = if self.neg[a] { -(v + side) } else { v };
         }
         out
+    }
+
+    /// Maps the half-open box `[lo, hi)` of voxels (each cube mapped as by
+    /// [`Rotation::apply_cube`]); returns the new `(lo, hi)`.
+    #[inline]
+    pub(crate) fn apply_box(self, lo: Voxel, hi: Voxel) -> (Voxel, Voxel) {
+        let mut l = [0; 3];
+        let mut h = [0; 3];
+        for a in 0..3 {
+            let p = usize::from(self.perm[a]);
+            if self.neg[a] {
+                l[a] = -hi[p];
+                h[a] = -lo[p];
+            } else {
+                l[a] = lo[p];
+                h[a] = hi[p];
+            }
+        }
+        (l, h)
     }
 
     /// Rotates a block.

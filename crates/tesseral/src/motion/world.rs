@@ -14,8 +14,10 @@ use serde::Serialize;
 
 use super::interfere::{interference_placed, Aabb, Placed, Placement};
 use super::orient::Rotation;
+use super::plan::rotated;
 use super::sweep::{first_contact, Fraction};
-use crate::linear::LinearOctree;
+use crate::linear::{LinearOctree, OctreeError};
+use crate::pointer::PointerOctree;
 use crate::Voxel;
 
 /// How an object moves: its position (the offset added to its octree's voxels after
@@ -78,6 +80,23 @@ pub enum TranslationMethod {
     /// traversal. No tree is rebuilt, so this is the fastest.
     #[default]
     Offset,
+    /// Each object's octree is rotated once and then translated at every step by its
+    /// displacement since the last step with [`LinearOctree::translate`] (the linear
+    /// octree's translation by tesseral addition), so the stored tree always stands
+    /// where the object is, as Ahuja & Nash keep a moving object's octree current.
+    Linear,
+    /// As [`TranslationMethod::Linear`], but each object is kept as a pointer octree
+    /// and translated by Ahuja & Nash's label arithmetic
+    /// ([`crate::pointer::PointerOctree::translate`]: label increments with carries,
+    /// postorder in the direction of motion, compaction); its linear form is read
+    /// off after each move for the interference tests.
+    Labels,
+}
+
+impl TranslationMethod {
+    fn keeps_trees(self) -> bool {
+        self != TranslationMethod::Offset
+    }
 }
 
 /// One moving object.
@@ -188,9 +207,15 @@ impl World {
         }
     }
 
-    fn placed(&self, i: Option<usize>, offsets: &[Voxel]) -> Placed<'_> {
+    fn placed<'s>(
+        &'s self,
+        current: &'s [LinearOctree],
+        i: Option<usize>,
+        offsets: &[Voxel],
+    ) -> Placed<'s> {
         match i {
             None => Placed::fixed(&self.environment),
+            Some(i) if self.method.keeps_trees() => Placed::fixed(&current[i]),
             Some(i) => Placed::new(
                 &self.objects[i].tree,
                 Placement {
@@ -222,9 +247,14 @@ impl World {
     /// between the two rounded step positions.
     ///
     /// # Runtime
-    /// `steps × pairs` interference and swept traversals.
-    #[must_use]
-    pub fn simulate(&self, time_step: f64, steps: u64) -> Simulation {
+    /// `steps × pairs` interference and swept traversals, plus, with
+    /// [`TranslationMethod::Linear`] or [`TranslationMethod::Labels`], one translation
+    /// of each object's tree per step.
+    ///
+    /// # Errors
+    /// Only when trees are kept current: [`OctreeError`] when a translated tree
+    /// would outgrow [`crate::linear::MAX_DEPTH`] or its coordinates overflow.
+    pub fn simulate(&self, time_step: f64, steps: u64) -> Result<Simulation, OctreeError> {
         let pairs = self.pairs();
         let offsets_at = |n: u64| -> Vec<Voxel> {
             let t = n as f64 * time_step;
@@ -236,6 +266,16 @@ impl World {
         let mut contacts = Vec::new();
         let mut frames = Vec::new();
         let mut offsets = offsets_at(0);
+        let mut current: Vec<LinearOctree> = Vec::new();
+        let mut pointers: Vec<PointerOctree> = Vec::new();
+        if self.method.keeps_trees() {
+            for (o, off) in self.objects.iter().zip(&offsets) {
+                current.push(rotated(&o.tree, o.rotation).translate(*off)?);
+            }
+        }
+        if self.method == TranslationMethod::Labels {
+            pointers = current.iter().map(PointerOctree::from_linear).collect();
+        }
         let mut overlapping = vec![false; pairs.len()];
         for n in 0..=steps {
             let time = n as f64 * time_step;
@@ -248,8 +288,8 @@ impl World {
             };
             for (p, &(i, j)) in pairs.iter().enumerate() {
                 let hit = interference_placed(
-                    self.placed(i, &offsets),
-                    self.placed(Some(j), &offsets),
+                    self.placed(&current, i, &offsets),
+                    self.placed(&current, Some(j), &offsets),
                     true,
                 );
                 if hit.intersects {
@@ -258,9 +298,9 @@ impl World {
                     if n == 0 {
                         // In contact from the start.
                         let c = first_contact(
-                            self.placed(i, &offsets),
+                            self.placed(&current, i, &offsets),
                             [0; 3],
-                            self.placed(Some(j), &offsets),
+                            self.placed(&current, Some(j), &offsets),
                             [0; 3],
                         );
                         if let Some(c) = c {
@@ -294,15 +334,28 @@ impl World {
                 }
                 let a_move = i.map_or([0; 3], |i| moves[i]);
                 let Some(c) = first_contact(
-                    self.placed(i, &offsets),
+                    self.placed(&current, i, &offsets),
                     a_move,
-                    self.placed(Some(j), &offsets),
+                    self.placed(&current, Some(j), &offsets),
                     moves[j],
                 ) else {
                     continue;
                 };
-                let still =
-                    interference_placed(self.placed(i, &next), self.placed(Some(j), &next), false);
+                let still = match self.method {
+                    TranslationMethod::Offset => interference_placed(
+                        self.placed(&current, i, &next),
+                        self.placed(&current, Some(j), &next),
+                        false,
+                    ),
+                    TranslationMethod::Linear | TranslationMethod::Labels => {
+                        // The trees stand at the step's start: place them by the moves.
+                        let at = |k: Option<usize>| match k {
+                            None => Placed::fixed(&self.environment),
+                            Some(k) => Placed::new(&current[k], Placement::at(moves[k])),
+                        };
+                        interference_placed(at(i), at(Some(j)), false)
+                    }
+                };
                 step_contacts.push(Contact {
                     time: time + c.time.to_f64() * time_step,
                     step: n,
@@ -316,8 +369,27 @@ impl World {
             }
             step_contacts.sort_by(|x, y| x.fraction.cmp(&y.fraction));
             contacts.extend(step_contacts);
+            match self.method {
+                TranslationMethod::Offset => {}
+                TranslationMethod::Linear => {
+                    for (tree, mv) in current.iter_mut().zip(&moves) {
+                        if *mv != [0; 3] {
+                            *tree = tree.translate(*mv)?;
+                        }
+                    }
+                }
+                TranslationMethod::Labels => {
+                    for ((ptr, tree), mv) in pointers.iter_mut().zip(current.iter_mut()).zip(&moves)
+                    {
+                        if *mv != [0; 3] {
+                            ptr.translate(*mv)?;
+                            *tree = ptr.to_linear();
+                        }
+                    }
+                }
+            }
             offsets = next;
         }
-        Simulation { contacts, frames }
+        Ok(Simulation { contacts, frames })
     }
 }

@@ -1,7 +1,7 @@
 //! The world file: a JSON description of a static environment and moving objects
 //! with trajectories, read by `tesseral simulate`. Paths inside it are relative to
 //! the file's folder; octrees are read with [`crate::io::read_octree`], so every
-//! octree format works.
+//! octree format works, and `.tss` scene files are built with [`crate::csg`].
 //!
 //! ```json
 //! {
@@ -23,6 +23,7 @@ use serde::Deserialize;
 
 use super::orient::Rotation;
 use super::world::{MovingObject, Trajectory, TranslationMethod, World};
+use crate::csg::SceneError;
 use crate::io::{read_octree, FormatError};
 
 /// The most steps a world file may ask for.
@@ -65,6 +66,9 @@ pub enum WorldError {
     /// An octree file the world names could not be read.
     #[error(transparent)]
     Octree(#[from] FormatError),
+    /// A scene file the world names could not be read or built.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
 }
 
 #[derive(Deserialize)]
@@ -118,6 +122,19 @@ pub struct WorldFile {
     pub steps: u64,
 }
 
+/// Reads a solid: a `.tss` scene file (built with [`crate::csg::Scene::build`]) or an
+/// octree file in any format [`read_octree`] knows.
+///
+/// # Errors
+/// [`WorldError::Scene`] or [`WorldError::Octree`], naming the file and place.
+pub fn read_solid(path: &Path) -> Result<crate::linear::LinearOctree, WorldError> {
+    if crate::io::extension(path) == "tss" {
+        Ok(crate::csg::Scene::read(path)?.build()?)
+    } else {
+        Ok(read_octree(path)?)
+    }
+}
+
 /// Positions and times must stay where an `i64` offset and an `f64` time are exact.
 const MAX_COORD: f64 = (1u64 << 40) as f64;
 
@@ -158,14 +175,16 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
     }
     let method = match spec.translation.as_deref() {
         None | Some("offset") => TranslationMethod::Offset,
+        Some("linear") => TranslationMethod::Linear,
+        Some("labels") => TranslationMethod::Labels,
         Some(other) => {
             return Err(invalid(format!(
-                "translation {other:?} is not known (known: \"offset\")"
+                "translation {other:?} is not known (known: \"offset\", \"linear\", \"labels\")"
             )))
         }
     };
     let dir = path.parent().unwrap_or(Path::new(""));
-    let environment = read_octree(&dir.join(&spec.environment))?;
+    let environment = read_solid(&dir.join(&spec.environment))?;
     let mut objects = Vec::with_capacity(spec.objects.len());
     for (i, o) in spec.objects.into_iter().enumerate() {
         let name = o.name.unwrap_or_else(|| format!("object{i}"));
@@ -215,7 +234,7 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
                 Trajectory::Constant { start, velocity }
             }
         };
-        let tree = read_octree(&dir.join(&o.octree))?;
+        let tree = read_solid(&dir.join(&o.octree))?;
         objects.push(MovingObject {
             name,
             tree,

@@ -6,6 +6,8 @@ use crate::Voxel;
 /// Cells of margin kept white around every black voxel, so that the 3×3×3 block of
 /// any voxel next to the surface lies inside the box.
 const MARGIN: i64 = 2;
+/// The largest box, in cells (5 bytes each: 20 GiB). Beyond it `insert` panics.
+pub const MAX_CELLS: u64 = 1 << 32;
 /// No face index.
 const NONE: u32 = u32::MAX;
 
@@ -17,7 +19,8 @@ const NONE: u32 = u32::MAX;
 /// Memory is O(box volume): 5 bytes per cell of the bounding box (plus margin and
 /// slack), plus 24 bytes per black voxel and 32 per face. `insert`, `remove`,
 /// `contains` and `neighbourhood` are O(1), except when the box must move or grow,
-/// which costs O(box volume) and happens rarely (the box doubles).
+/// which costs O(box volume) and happens rarely (the box doubles). `insert` panics
+/// when the box would exceed [`MAX_CELLS`] cells.
 ///
 /// ```
 /// use tesseral::rsmc::{DenseLattice, Lattice};
@@ -114,6 +117,10 @@ impl DenseLattice {
 
     /// Moves and grows the box so that it holds every black voxel and `extra` with
     /// margin, with slack for growth. O(box volume).
+    ///
+    /// # Panics
+    /// When the box would need more than [`MAX_CELLS`] cells: the dense baseline is
+    /// for comparisons, the octree for unbounded runs.
     fn refit(&mut self, extra: Voxel) {
         let mut lo = extra;
         let mut hi = extra;
@@ -139,7 +146,13 @@ impl DenseLattice {
             dims[a] = size;
             origin[a] = lo[a] - (size - (hi[a] - lo[a] + 1)) / 2;
         }
-        let total = (dims[0] * dims[1] * dims[2]) as usize;
+        let total = dims
+            .iter()
+            .try_fold(1u128, |t, &d| t.checked_mul(d as u128));
+        let total = match total {
+            Some(t) if t <= MAX_CELLS as u128 => t as usize,
+            _ => panic!("DenseLattice: a box of {dims:?} cells exceeds {MAX_CELLS} cells"),
+        };
         let mut cells = vec![0u32; total];
         let mut occ = vec![0u8; total];
         for i in 0..self.cells.len() {

@@ -286,9 +286,9 @@ mod tests {
         // corner neighbours: 128 cases, exhaustive.
         for f in 0..64u32 {
             let mut x = 0;
-            for d in 0..6 {
+            for (d, bit) in FACE_BITS.iter().enumerate() {
                 if f & (1 << d) != 0 {
-                    x |= 1 << FACE_BITS[d];
+                    x |= 1 << bit;
                 }
             }
             assert_eq!(legal_join(x), brute_is_disc(x), "faces only {f:06b}");
@@ -298,6 +298,34 @@ mod tests {
                 brute_is_disc(y),
                 "faces {f:06b} + all others"
             );
+        }
+    }
+
+    #[test]
+    fn tables_match_brute_force_on_all_small_extras() {
+        // Every face set with every choice of up to two of the 20 edge and corner
+        // neighbours: 64 × (1 + 20 + 190) cases, exhaustive at that size.
+        let others: Vec<u32> = (0..27).filter(|b| NON_FACE & (1 << b) != 0).collect();
+        assert_eq!(others.len(), 20);
+        for f in 0..64u32 {
+            let mut x = 0;
+            for (d, bit) in FACE_BITS.iter().enumerate() {
+                if f & (1 << d) != 0 {
+                    x |= 1 << bit;
+                }
+            }
+            for i in 0..=others.len() {
+                for j in i..=others.len() {
+                    let mut y = x;
+                    if i < others.len() {
+                        y |= 1 << others[i];
+                    }
+                    if j < others.len() {
+                        y |= 1 << others[j];
+                    }
+                    assert_eq!(legal_join(y), brute_is_disc(y), "x = {y:#029b}");
+                }
+            }
         }
     }
 

@@ -9,15 +9,16 @@
 //! with the Metropolis–Hastings probability for the weight `exp(-β·A - μ·V)`
 //! ([`Chain`]).
 //!
-//! The chain runs on any [`Lattice`]: [`DenseLattice`] is the dense-array baseline
-//! (O(box volume) memory), and the unbounded dynamic octree implements the same trait
-//! (O(|S|) memory). Both follow the face-list order rule of the dynamic octree
+//! The chain runs on any [`Lattice`]: the unbounded
+//! [`DynamicOctree`](crate::dynamic::DynamicOctree) (O(|S|) memory, the default) and
+//! [`DenseLattice`], the dense-array baseline (O(box volume) memory). Both follow the face-list order rule of the dynamic octree
 //! contract, so for the same seed they produce the same trajectory, step for step.
 //!
 //! ```
-//! use tesseral::rsmc::{Chain, DenseLattice, Params};
+//! use tesseral::dynamic::DynamicOctree;
+//! use tesseral::rsmc::{Chain, Params};
 //! let params = Params { beta: 0.0, ..Params::default() };
-//! let mut chain = Chain::new(DenseLattice::new(), params, 7, &[[0, 0, 0]]).unwrap();
+//! let mut chain = Chain::new(DynamicOctree::with_faces(), params, 7, &[[0, 0, 0]]).unwrap();
 //! chain.run(10_000);
 //! assert_eq!(chain.steps(), 10_000);
 //! assert!(tesseral::rsmc::topology::check_sphere(&chain.voxels()).is_ok());
@@ -28,6 +29,7 @@ mod dense;
 pub mod enumerate;
 pub mod legality;
 pub mod mesh;
+mod octree;
 pub mod plot;
 pub mod stats;
 #[cfg(test)]
@@ -35,7 +37,7 @@ mod tests;
 pub mod topology;
 
 pub use chain::{Chain, Checkpoint, Counters, Params, CHECKPOINT_FORMAT};
-pub use dense::DenseLattice;
+pub use dense::{DenseLattice, MAX_CELLS};
 
 use crate::Voxel;
 

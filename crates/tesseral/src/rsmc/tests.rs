@@ -128,6 +128,7 @@ fn trajectories_keep_sphere_topology() {
             assert_eq!(report.volume, chain.volume(), "seed {seed}");
             assert_eq!(report.euler(), 2);
             chain.lattice().assert_valid();
+            chain.assert_valid();
         }
         let c = chain.counters();
         assert_eq!(c.steps, 20_000);
@@ -285,4 +286,197 @@ fn radius_of_gyration_of_a_domino() {
     let chain = Chain::new(DenseLattice::new(), params(0.0), 1, &[[0, 0, 0], [1, 0, 0]]).unwrap();
     assert!((chain.radius_of_gyration() - 0.5).abs() < 1e-12);
     assert_eq!((chain.area(), chain.volume()), (10, 2));
+}
+
+/// Detailed balance with a volume weight: the joint (area, volume) histogram against
+/// c_{A,V}·exp(−βA − μV).
+#[test]
+fn detailed_balance_with_volume_weight() {
+    let max_area = 22u64;
+    let surfaces = enumerate::sphere_surfaces(max_area).unwrap();
+    let key = |a: u64, v: u64| (a * 16 + v) as usize;
+    let mut counts = vec![0u64; key(max_area, 15) + 1];
+    for s in &surfaces {
+        let set: HashSet<Voxel> = s.iter().copied().collect();
+        let area = s
+            .iter()
+            .map(|&v| (0..6).filter(|&d| !set.contains(&step_dir(v, d))).count() as u64)
+            .sum::<u64>();
+        counts[key(area, s.len() as u64)] += 1;
+    }
+    let (beta, mu) = (0.1, 0.3);
+    let w: Vec<f64> = counts
+        .iter()
+        .enumerate()
+        .map(|(k, &c)| c as f64 * (-beta * (k / 16) as f64 - mu * (k % 16) as f64).exp())
+        .collect();
+    let z: f64 = w.iter().sum();
+    let expect: Vec<f64> = w.iter().map(|x| x / z).collect();
+    let p = Params {
+        beta,
+        mu,
+        max_area: Some(max_area),
+        ..Params::default()
+    };
+    let seed = 31;
+    let mut chain = Chain::new(DenseLattice::new(), p, seed, &[[0, 0, 0]]).unwrap();
+    chain.run(2000);
+    let mut hist = vec![0u64; counts.len()];
+    for _ in 0..40_000 {
+        chain.run(100);
+        hist[key(chain.area(), chain.volume())] += 1;
+    }
+    let t = chi_square(&hist, &expect);
+    println!(
+        "beta {beta} mu {mu} seed {seed}: chi2 {:.2} dof {} p {:.4}",
+        t.statistic, t.dof, t.p_value
+    );
+    assert!(t.dof >= 5 && t.p_value > 1e-3, "{t:?}");
+}
+
+/// The p-values over many seeds should look uniform (a check that thinning every
+/// 100 steps leaves the samples close enough to independent). Run by hand.
+#[test]
+#[ignore = "slow calibration run; prints p-values"]
+fn chi_square_calibration_over_seeds() {
+    let counts = sphere_counts(22).unwrap();
+    let mut ps = Vec::new();
+    for seed in 100..140u64 {
+        let p = Params {
+            beta: 0.1,
+            max_area: Some(22),
+            ..Params::default()
+        };
+        let hist = area_histogram(p, seed, 40_000, 100);
+        ps.push(chi_square(&hist, &area_distribution(&counts, 0.1)).p_value);
+    }
+    ps.sort_by(f64::total_cmp);
+    println!("sorted p-values: {ps:.3?}");
+    let below = ps.iter().filter(|&&p| p < 0.05).count();
+    println!("{below} of {} below 0.05", ps.len());
+}
+
+/// The dynamic octree and the dense baseline give the same trajectory, step for
+/// step, for the same seed: same accept/reject decisions, same face lists.
+#[test]
+fn octree_and_dense_give_identical_trajectories() {
+    use crate::dynamic::DynamicOctree;
+    for (seed, p) in [
+        (
+            1u64,
+            Params {
+                hastings: false,
+                ..Params::default()
+            },
+        ),
+        (2, params(-0.2)),
+        (
+            3,
+            Params {
+                beta: 0.3,
+                mu: -0.2,
+                ..Params::default()
+            },
+        ),
+    ] {
+        let mut a = Chain::new(DenseLattice::new(), p, seed, &[[0, 0, 0]]).unwrap();
+        let mut b = Chain::new(DynamicOctree::with_faces(), p, seed, &[[0, 0, 0]]).unwrap();
+        for step in 0..60_000u32 {
+            assert_eq!(a.step(), b.step(), "seed {seed} step {step}");
+            if step % 5000 == 0 {
+                assert_eq!(a.faces(), b.faces(), "seed {seed} step {step}");
+                b.lattice().assert_valid();
+            }
+        }
+        assert_eq!(a.counters(), b.counters(), "seed {seed}");
+        assert_eq!(a.faces(), b.faces(), "seed {seed}");
+        assert_eq!(a.voxels(), b.voxels(), "seed {seed}");
+        assert_eq!(
+            a.radius_of_gyration().to_bits(),
+            b.radius_of_gyration().to_bits()
+        );
+        b.lattice().assert_valid();
+        b.assert_valid();
+        // And after a checkpoint round trip on the other backend.
+        let cp = a.checkpoint();
+        let mut c = Chain::from_checkpoint(DynamicOctree::with_faces(), cp).unwrap();
+        let _ = b.checkpoint();
+        for step in 0..20_000u32 {
+            assert_eq!(b.step(), c.step(), "seed {seed} resumed step {step}");
+        }
+        assert_eq!(b.faces(), c.faces());
+        println!("seed {seed}: area {} volume {}", b.area(), b.volume());
+    }
+}
+
+/// Libes §6, rule (i) as worded in the paper: "if the east and south neighbors do
+/// not exist, the east-south neighbor is retrieved from the octree. If it exists, the
+/// operation is rejected". Rule (ii), Fig. 4: creating a voxel whose only neighbours
+/// are its top and bottom ones would make a hole.
+#[test]
+fn libes_worked_examples_on_the_octree() {
+    use crate::dynamic::DynamicOctree;
+    use legality::{legal_grow, legal_shrink};
+    let p = [0, 0, 0];
+    // East = +x, south = −y, up = +z (DESIGN.md axes).
+    let mut t = DynamicOctree::with_faces();
+    t.insert([0, 0, -1]); // below p: p is proposed from this voxel's top face
+    t.insert([0, -1, -1]);
+    t.insert([1, -1, -1]);
+    t.insert([1, -1, 0]); // east-south of p, joined to the rest below
+    assert!(topology::check_sphere(&t.voxels()).is_ok());
+    assert!(!t.contains([1, 0, 0]) && !t.contains([0, -1, 0]));
+    assert!(
+        !legal_grow(t.neighbourhood(p)),
+        "rule (i): east and south empty, east-south black"
+    );
+    // Fill the east neighbour: now p and the east-south voxel share a face neighbour.
+    t.insert([1, 0, -1]);
+    t.insert([1, 0, 0]);
+    assert!(topology::check_sphere(&t.voxels()).is_ok());
+    assert!(legal_grow(t.neighbourhood(p)));
+    // Fig. 4: a column with a gap of one; only the top and bottom neighbours exist.
+    let mut c = DynamicOctree::with_faces();
+    for v in [
+        [0, 0, -1],
+        [0, 1, -1],
+        [0, 2, -1],
+        [0, 2, 0],
+        [0, 2, 1],
+        [0, 1, 1],
+        [0, 0, 1],
+    ] {
+        c.insert(v);
+    }
+    assert!(topology::check_sphere(&c.voxels()).is_ok());
+    assert!(
+        !legal_grow(c.neighbourhood(p)),
+        "rule (ii): would close a ring"
+    );
+    // Fig. 3 (deletion, rule (i)): deleting a voxel that would leave two voxels
+    // sharing only an edge.
+    let mut s = DynamicOctree::with_faces();
+    for v in [
+        [1, 0, 0],
+        [0, 0, 0],
+        [0, 1, 0],
+        [-1, 1, 0],
+        [1, 1, -1],
+        [1, 1, 0],
+    ] {
+        s.insert(v);
+    }
+    // (0,0,0) joins (1,0,0) and (0,1,0); with (1,1,0) black too, removing (0,0,0)
+    // leaves the square's other three: legal.
+    assert!(topology::check_sphere(&s.voxels()).is_ok());
+    assert!(legal_shrink(s.neighbourhood([0, 0, 0])));
+    // Removing (1,1,0) instead leaves (1,0,0) and (0,1,0) joined through (0,0,0):
+    // still legal; but without (0,0,0), removing (1,1,0) would leave (1,0,0) and
+    // (0,1,0) sharing only an edge.
+    s.remove([0, 0, 0]);
+    assert!(topology::check_sphere(&s.voxels()).is_ok());
+    assert!(
+        !legal_shrink(s.neighbourhood([1, 1, 0])),
+        "rule (i) on deletion"
+    );
 }

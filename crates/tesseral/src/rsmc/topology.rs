@@ -67,7 +67,13 @@ pub enum TopologyError {
     /// `V − E + F` is not 2: the surface has handles.
     #[error("Euler characteristic {0}, not 2")]
     Euler(i64),
+    /// A coordinate is beyond ±[`MAX_COORD`].
+    #[error("voxel {0:?} is beyond ±2^60")]
+    OutOfRange(Voxel),
 }
+
+/// The largest coordinate magnitude accepted (2^60), far from `i64` overflow.
+pub const MAX_COORD: i64 = 1 << 60;
 
 /// Corner points of the face of voxel `v` in direction `dir`, in cyclic order.
 fn face_corners(v: Voxel, dir: u8) -> [Voxel; 4] {
@@ -93,6 +99,12 @@ fn face_corners(v: Voxel, dir: u8) -> [Voxel; 4] {
 pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
     if voxels.is_empty() {
         return Err(TopologyError::Empty);
+    }
+    if let Some(v) = voxels
+        .iter()
+        .find(|v| v.iter().any(|c| c.unsigned_abs() > MAX_COORD as u64))
+    {
+        return Err(TopologyError::OutOfRange(*v));
     }
     let set: HashSet<Voxel> = voxels.iter().copied().collect();
     // Black connected.
@@ -299,5 +311,14 @@ mod tests {
             check_sphere(&v),
             Err(TopologyError::Pinch(_)) | Err(TopologyError::Edge { .. })
         ));
+        assert!(matches!(
+            check_sphere(&[[i64::MAX, 0, 0]]),
+            Err(TopologyError::OutOfRange(_))
+        ));
+        // Far from the origin but in range: fine.
+        assert_eq!(
+            check_sphere(&[[MAX_COORD, -MAX_COORD, 5]]).unwrap().faces,
+            6
+        );
     }
 }

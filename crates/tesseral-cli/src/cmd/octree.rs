@@ -1,0 +1,104 @@
+//! Helpers shared by the octree commands: reading and writing through
+//! `tesseral::io`, and parsing of vectors and axes.
+
+use std::path::Path;
+
+use anyhow::Result;
+use tesseral::linear::{Axis, LinearOctree};
+
+/// Reads an octree, in any format `tesseral::io` knows by the extension.
+pub fn read(path: &Path) -> Result<LinearOctree> {
+    // The library's message already names the file and its cause; keep it as one
+    // line rather than repeating the cause from the error chain.
+    tesseral::io::read_octree(path).map_err(|e| anyhow::anyhow!("{e}"))
+}
+
+/// The most voxels a command writes as a voxel list (`.xyz` holds one line per
+/// voxel, so a scaled-up or complemented solid could otherwise fill the disk).
+pub const MAX_LISTED_VOXELS: u64 = 1 << 27;
+
+/// Writes an octree atomically, in the format named by the extension, and prints a
+/// one-line summary.
+pub fn write(path: &Path, tree: &LinearOctree) -> Result<()> {
+    if tesseral::io::extension(path) == "xyz" && tree.voxel_count() > MAX_LISTED_VOXELS {
+        anyhow::bail!(
+            "{}: {} voxels is too many for a voxel list (at most {MAX_LISTED_VOXELS}); \
+             write a block-based format instead",
+            path.display(),
+            tree.voxel_count()
+        );
+    }
+    tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
+    println!(
+        "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
+        path.display(),
+        tree.voxel_count(),
+        tree.leaf_count(),
+        tree.depth(),
+        fmt_voxel(tree.origin())
+    );
+    Ok(())
+}
+
+/// `(x, y, z)`.
+pub fn fmt_voxel(v: [i64; 3]) -> String {
+    format!("({}, {}, {})", v[0], v[1], v[2])
+}
+
+/// Parses `DX,DY,DZ` (integers, negative allowed).
+pub fn parse_vector(text: &str) -> Result<[i64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three integers `DX,DY,DZ`, got `{text}`"));
+    }
+    let mut v = [0i64; 3];
+    for (a, p) in parts.iter().enumerate() {
+        v[a] = p
+            .parse()
+            .map_err(|_| format!("`{p}` is not an integer (in `{text}`)"))?;
+    }
+    Ok(v)
+}
+
+/// An axis on the command line.
+#[derive(Clone, Copy, clap::ValueEnum)]
+pub enum AxisArg {
+    /// x, east.
+    X,
+    /// y, north.
+    Y,
+    /// z, up.
+    Z,
+}
+
+impl From<AxisArg> for Axis {
+    fn from(a: AxisArg) -> Self {
+        match a {
+            AxisArg::X => Axis::X,
+            AxisArg::Y => Axis::Y,
+            AxisArg::Z => Axis::Z,
+        }
+    }
+}
+
+/// Parses a scale factor `2^K` (K may be negative) into K.
+pub fn parse_power_of_two(text: &str) -> Result<i32, String> {
+    let t = text.trim();
+    if let Some(k) = t.strip_prefix("2^") {
+        let k: i32 = k
+            .trim_start_matches(['(', ' '])
+            .trim_end_matches([')', ' '])
+            .parse()
+            .map_err(|_| format!("`{t}`: the exponent is not an integer"))?;
+        if k.unsigned_abs() > 21 {
+            return Err(format!("`{t}`: the exponent must lie in -21..=21"));
+        }
+        return Ok(k);
+    }
+    match t.parse::<u64>() {
+        Ok(n) if n.is_power_of_two() && n.trailing_zeros() <= 21 => Ok(n.trailing_zeros() as i32),
+        _ => Err(format!(
+            "`{t}` is not a power of two; write `2^K` (for example 2^3 or 2^-1)"
+        )),
+    }
+}

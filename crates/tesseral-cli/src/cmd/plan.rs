@@ -1,0 +1,187 @@
+//! `tesseral plan`: a collision-free path for an object through an environment.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use serde::Serialize;
+use tesseral::motion::{plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::render::{Camera, RenderOptions, View};
+use tesseral::Voxel;
+
+use super::collide::parse_voxel;
+
+/// Arguments of `tesseral plan`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// The environment octree file (the obstacles).
+    env: PathBuf,
+    /// The moving object's octree file.
+    obj: PathBuf,
+    /// The start: the integer offset X,Y,Z of the object.
+    #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true)]
+    from: Voxel,
+    /// The goal offset X,Y,Z.
+    #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true)]
+    to: Voxel,
+    /// The object's fixed rotation, such as `z90` (see `tesseral collide --rotate`).
+    #[arg(long, default_value = "", allow_hyphen_values = true)]
+    rotate: Rotation,
+    /// Let the region reach this many voxels beyond the bounding box of the
+    /// environment and the object at both ends (room to go around the outside).
+    #[arg(long, default_value_t = 0)]
+    margin: u32,
+    /// The box of world voxels X0,Y0,Z0,X1,Y1,Z1 (inclusive) the object must stay
+    /// in; replaces the bounding box and --margin.
+    #[arg(long, value_parser = parse_region, allow_hyphen_values = true)]
+    region: Option<Aabb>,
+    /// Keep the raw A* path (no smoothing).
+    #[arg(long)]
+    no_smooth: bool,
+    /// Print JSON.
+    #[arg(long)]
+    json: bool,
+    /// Render a PNG picture of the path through the scene: the environment grey,
+    /// the object green at the start and blue at the goal, the path yellow.
+    #[arg(short = 'o', long = "output", value_name = "PATH.png")]
+    output: Option<PathBuf>,
+    /// The view of the picture: top, iso, front or side.
+    #[arg(long, default_value = "top", value_parser = parse_view)]
+    view: View,
+}
+
+fn parse_view(s: &str) -> Result<View, String> {
+    View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
+}
+
+fn parse_region(s: &str) -> Result<Aabb, String> {
+    let v: Vec<i64> = s
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<i64>()
+                .map_err(|_| format!("{p:?} in {s:?} is not an integer"))
+        })
+        .collect::<Result<_, _>>()?;
+    if v.len() != 6 {
+        return Err(format!(
+            "expected X0,Y0,Z0,X1,Y1,Z1 (six integers), got {s:?}"
+        ));
+    }
+    let (min, max) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
+    if (0..3).any(|a| max[a] < min[a]) {
+        return Err(format!(
+            "the region {s:?} is empty: each of X1,Y1,Z1 must be at least X0,Y0,Z0"
+        ));
+    }
+    Ok(Aabb { min, max })
+}
+
+#[derive(Serialize)]
+struct Found<'a> {
+    found: bool,
+    waypoints: &'a [Voxel],
+    raw: &'a [Voxel],
+    steps: u64,
+    length: f64,
+    clearance: Option<f64>,
+    free_cells: usize,
+    settled: usize,
+}
+
+#[derive(Serialize)]
+struct NotFound {
+    found: bool,
+    reason: String,
+}
+
+pub fn run(args: Args) -> Result<()> {
+    let env = read_solid(&args.env).context("reading the environment")?;
+    let obj = read_solid(&args.obj).context("reading the object")?;
+    let options = PlanOptions {
+        rotation: args.rotate,
+        smooth: !args.no_smooth,
+        margin: i64::from(args.margin),
+        region: args.region,
+        ..PlanOptions::default()
+    };
+    let result = plan(&env, &obj, args.from, args.to, &options);
+    if let Some(path) = &args.output {
+        picture(
+            path,
+            &env,
+            &obj,
+            &args,
+            result.as_ref().ok().map(|p| p.waypoints.as_slice()),
+        )?;
+    }
+    let mut out = std::io::stdout().lock();
+    match result {
+        Ok(p) => {
+            if args.json {
+                let f = Found {
+                    found: true,
+                    waypoints: &p.waypoints,
+                    raw: &p.raw,
+                    steps: p.steps,
+                    length: p.length,
+                    clearance: p.clearance,
+                    free_cells: p.free_cells,
+                    settled: p.settled,
+                };
+                serde_json::to_writer(&mut out, &f)?;
+                writeln!(out)?;
+            } else {
+                writeln!(
+                    out,
+                    "path: {} waypoints, length {:.3} voxels ({} unit moves before smoothing)",
+                    p.waypoints.len(),
+                    p.length,
+                    p.steps
+                )?;
+                match p.clearance {
+                    Some(c) => writeln!(out, "clearance: {c:.3}")?,
+                    None => writeln!(out, "clearance: unbounded (empty environment)")?,
+                }
+                for w in &p.waypoints {
+                    writeln!(out, "{},{},{}", w[0], w[1], w[2])?;
+                }
+            }
+            Ok(())
+        }
+        Err(why) => {
+            if args.json {
+                serde_json::to_writer(
+                    &mut out,
+                    &NotFound {
+                        found: false,
+                        reason: why.to_string(),
+                    },
+                )?;
+                writeln!(out)?;
+            } else {
+                writeln!(out, "{why}")?;
+            }
+            out.flush()?;
+            // No path is an answer, not a failure of the command: exit status 1.
+            std::process::exit(1);
+        }
+    }
+}
+
+fn picture(
+    path: &std::path::Path,
+    env: &tesseral::linear::LinearOctree,
+    obj: &tesseral::linear::LinearOctree,
+    args: &Args,
+    waypoints: Option<&[Voxel]>,
+) -> Result<()> {
+    let opts = RenderOptions {
+        camera: Camera::view(args.view),
+        ..RenderOptions::default()
+    };
+    let img = render_plan(env, obj, args.rotate, args.from, args.to, waypoints, &opts)
+        .context("drawing the path")?;
+    img.write_png(path)
+        .with_context(|| format!("writing {}", path.display()))
+}

@@ -1,0 +1,165 @@
+//! `tesseral translate`, `rotate`, `mirror`, `scale` and `complement`.
+
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use tesseral::pointer::PointerOctree;
+
+use super::octree::{self, AxisArg};
+
+/// How `translate` moves the tree.
+#[derive(Clone, Copy, Default, clap::ValueEnum)]
+pub enum Method {
+    /// Top-down on the linear octree's codes; time follows the leaves.
+    #[default]
+    Linear,
+    /// Ahuja & Nash §3.2 on a pointer octree, by label arithmetic with the Table 2
+    /// carries; prints the §3.3 node counts.
+    Labels,
+}
+
+/// Arguments of `tesseral translate`.
+#[derive(clap::Args)]
+pub struct TranslateArgs {
+    /// The input octree file.
+    input: PathBuf,
+    /// The displacement `DX,DY,DZ` in voxels (negative allowed: `--by=-4,-50,0` or
+    /// `--by -4,-50,0`).
+    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true)]
+    by: [i64; 3],
+    /// The output octree file.
+    #[arg(short, long)]
+    output: PathBuf,
+    /// The algorithm.
+    #[arg(long, value_enum, default_value_t)]
+    method: Method,
+    /// Keep the input's space and drop (and count) the voxels that leave it, instead
+    /// of growing the space. Only with `--method linear`.
+    #[arg(long)]
+    clip: bool,
+}
+
+pub fn translate(args: TranslateArgs) -> Result<()> {
+    let tree = octree::read(&args.input)?;
+    let by = args.by;
+    let moved = match (args.method, args.clip) {
+        (Method::Linear, false) => tree.translate(by).with_context(|| {
+            format!(
+                "translating {} by {}",
+                args.input.display(),
+                octree::fmt_voxel(by)
+            )
+        })?,
+        (Method::Linear, true) => {
+            let (moved, dropped) = tree
+                .translate_clipped(by)
+                .with_context(|| format!("translating {}", args.input.display()))?;
+            println!("clipped: {dropped} voxels left the space and were dropped");
+            moved
+        }
+        (Method::Labels, true) => {
+            anyhow::bail!("--clip works only with --method linear")
+        }
+        (Method::Labels, false) => {
+            let mut p = PointerOctree::from_linear(&tree);
+            let stats = p
+                .translate(by)
+                .with_context(|| format!("translating {}", args.input.display()))?;
+            for (name, s) in ["x", "y", "z"].iter().zip(stats.axes.iter()) {
+                if s.displacement != 0 {
+                    println!(
+                        "axis {name}: by {}, nodes of side 2^{} moved: {}, traversed {}, path steps {}, compaction {}, split {}",
+                        s.displacement, s.moved_size_log2, s.moved, s.traversed, s.path_steps, s.compacted, s.split_created
+                    );
+                }
+            }
+            println!(
+                "nodes visited: {} (root expansions: {})",
+                stats.nodes_visited(),
+                stats.root_expansions
+            );
+            p.to_linear()
+        }
+    };
+    octree::write(&args.output, &moved)
+}
+
+/// Arguments of `tesseral rotate`.
+#[derive(clap::Args)]
+pub struct RotateArgs {
+    /// The input octree file.
+    input: PathBuf,
+    /// The axis of rotation.
+    #[arg(long, value_enum)]
+    axis: AxisArg,
+    /// Quarter turns, right-handed (about z, +x goes to +y); negative allowed.
+    #[arg(long, allow_hyphen_values = true)]
+    turns: i32,
+    /// The output octree file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+pub fn rotate(args: RotateArgs) -> Result<()> {
+    let tree = octree::read(&args.input)?;
+    octree::write(&args.output, &tree.rotate(args.axis.into(), args.turns))
+}
+
+/// Arguments of `tesseral mirror`.
+#[derive(clap::Args)]
+pub struct MirrorArgs {
+    /// The input octree file.
+    input: PathBuf,
+    /// The axis whose coordinate is reversed within the space.
+    #[arg(long, value_enum)]
+    axis: AxisArg,
+    /// The output octree file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+pub fn mirror(args: MirrorArgs) -> Result<()> {
+    let tree = octree::read(&args.input)?;
+    octree::write(&args.output, &tree.mirror(args.axis.into()))
+}
+
+/// Arguments of `tesseral scale`.
+#[derive(clap::Args)]
+pub struct ScaleArgs {
+    /// The input octree file.
+    input: PathBuf,
+    /// The factor `2^K`: K > 0 scales up exactly, K < 0 scales down conservatively
+    /// (a block with any black voxel becomes black).
+    #[arg(long, value_parser = octree::parse_power_of_two, allow_hyphen_values = true)]
+    by: i32,
+    /// The output octree file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+pub fn scale(args: ScaleArgs) -> Result<()> {
+    let tree = octree::read(&args.input)?;
+    let k = args.by;
+    let scaled = if k >= 0 {
+        tree.scale_up(k as u8)
+    } else {
+        tree.scale_down(k.unsigned_abs() as u8)
+    }
+    .with_context(|| format!("scaling {} by 2^{k}", args.input.display()))?;
+    octree::write(&args.output, &scaled)
+}
+
+/// Arguments of `tesseral complement`.
+#[derive(clap::Args)]
+pub struct ComplementArgs {
+    /// The input octree file.
+    input: PathBuf,
+    /// The output octree file.
+    #[arg(short, long)]
+    output: PathBuf,
+}
+
+pub fn complement(args: ComplementArgs) -> Result<()> {
+    let tree = octree::read(&args.input)?;
+    octree::write(&args.output, &tree.complement())
+}

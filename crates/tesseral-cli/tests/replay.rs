@@ -1,0 +1,218 @@
+//! Integration tests of `tesseral replay`: the real binary, in a temporary directory.
+
+use std::collections::HashSet;
+use std::io::Write;
+use std::process::{Command, Output, Stdio};
+
+fn tesseral() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_tesseral"))
+}
+
+fn replay_file(body: &str, extra: &[&str]) -> (Output, tempfile::TempDir) {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("ops.txt");
+    std::fs::write(&path, body).unwrap();
+    let out = tesseral()
+        .arg("replay")
+        .arg(&path)
+        .args(extra)
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    (out, dir)
+}
+
+fn stdout_lines(out: &Output) -> Vec<String> {
+    String::from_utf8(out.stdout.clone())
+        .unwrap()
+        .lines()
+        .map(str::to_string)
+        .collect()
+}
+
+fn report(out: &Output) -> serde_json::Value {
+    let lines = stdout_lines(out);
+    serde_json::from_str(lines.last().expect("a JSON line")).expect("valid JSON")
+}
+
+#[test]
+fn queries_print_in_order_and_the_report_has_every_key() {
+    let body = "# two cubes side by side\n+ 0 0 0\n+ 1 0 0\n? 1 0 0\n? 2 0 0\n\n- 1 0 0\n? 1 0 0\n? 0 0 0\n";
+    for extra in [&[][..], &["--track-faces"][..]] {
+        let (out, _dir) = replay_file(body, extra);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let lines = stdout_lines(&out);
+        assert_eq!(&lines[..4], &["1", "0", "0", "1"]);
+        assert_eq!(lines.len(), 5);
+        let r = report(&out);
+        assert_eq!(r["voxels"], 1);
+        assert_eq!(r["faces"], 6);
+        assert_eq!(r["root_size_log2"], 0);
+        assert_eq!(r["root_min"], serde_json::json!([0, 0, 0]));
+        assert_eq!(r["expansions"], 1);
+        assert_eq!(r["contractions"], 1);
+        assert_eq!(r["nodes"], 1);
+        assert!(r["bytes"].as_u64().unwrap() > 0);
+    }
+}
+
+#[test]
+fn a_string_to_two_to_the_60_costs_sixty_expansions() {
+    let mut body = String::from("+ 0 0 0\n");
+    for i in 0..60 {
+        body.push_str(&format!("+ {} 0 0\n", 1u64 << i));
+    }
+    body.push_str(&format!(
+        "+ {} 0 0\n? {} 0 0\n",
+        (1u64 << 60) - 1,
+        1u64 << 59
+    ));
+    let (out, _dir) = replay_file(&body, &[]);
+    assert!(out.status.success());
+    let r = report(&out);
+    assert_eq!(r["expansions"], 60);
+    assert_eq!(r["root_size_log2"], 60);
+    assert_eq!(r["voxels"], 62);
+    assert_eq!(stdout_lines(&out)[0], "1");
+}
+
+#[test]
+fn random_log_matches_a_hashset_model() {
+    // A seeded pseudo-random log, its expected query answers and final counts computed
+    // with a HashSet.
+    let mut s = 12345u64;
+    let mut next = || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        s >> 33
+    };
+    let mut set = HashSet::new();
+    let mut body = String::new();
+    let mut answers = Vec::new();
+    for _ in 0..3000 {
+        let v = [
+            (next() % 9) as i64 - 4,
+            (next() % 9) as i64 - 4,
+            ((next() % 9) as i64 - 4) * 1_000_000_007,
+        ];
+        match next() % 3 {
+            0 => {
+                body.push_str(&format!("+ {} {} {}\n", v[0], v[1], v[2]));
+                set.insert(v);
+            }
+            1 => {
+                body.push_str(&format!("-\t{}  {} {}\n", v[0], v[1], v[2]));
+                set.remove(&v);
+            }
+            _ => {
+                body.push_str(&format!("? {} {} {}\n", v[0], v[1], v[2]));
+                answers.push(if set.contains(&v) { "1" } else { "0" }.to_string());
+            }
+        }
+    }
+    let (out, _dir) = replay_file(&body, &[]);
+    assert!(out.status.success());
+    let lines = stdout_lines(&out);
+    assert_eq!(&lines[..lines.len() - 1], &answers[..]);
+    let pairs: usize = set
+        .iter()
+        .map(|v| {
+            [[1, 0, 0], [0, 1, 0], [0, 0, 1]]
+                .iter()
+                .filter(|d| set.contains(&[v[0] + d[0], v[1] + d[1], v[2] + d[2]]))
+                .count()
+        })
+        .sum();
+    let r = report(&out);
+    assert_eq!(r["voxels"], set.len());
+    assert_eq!(r["faces"], 6 * set.len() - 2 * pairs);
+}
+
+#[test]
+fn malformed_lines_name_the_line_and_how_many_were_applied() {
+    let cases = [
+        (
+            "+ 0 0 0\n? 0 0 0\n+ 1 2\n",
+            "line 3",
+            "2 lines applied",
+            "3 coordinates",
+        ),
+        (
+            "+ 0 0 0\n* 1 2 3\n",
+            "line 2",
+            "1 lines applied",
+            "unknown operation '*'",
+        ),
+        ("# c\n+ 0 0 zz\n", "line 2", "1 lines applied", "'zz'"),
+        (
+            "+ 0 0 99999999999999999999\n",
+            "line 1",
+            "0 lines applied",
+            "not an integer",
+        ),
+        ("+ 0 0 0 0\n", "line 1", "0 lines applied", "found 4"),
+    ];
+    for (body, line, applied, what) in cases {
+        let (out, _dir) = replay_file(body, &[]);
+        assert_eq!(out.status.code(), Some(2), "{body:?}");
+        let err = String::from_utf8(out.stderr).unwrap();
+        assert_eq!(err.lines().count(), 1, "one-line message: {err}");
+        assert!(err.contains(line), "{err}");
+        assert!(err.contains(applied), "{err}");
+        assert!(err.contains(what), "{err}");
+        assert!(err.contains("ops.txt"), "{err}");
+        assert!(!err.contains("panicked"), "{err}");
+    }
+    // Queries before the bad line were still printed.
+    let (out, _dir) = replay_file("+ 0 0 0\n? 0 0 0\nbad\n", &[]);
+    assert_eq!(stdout_lines(&out), vec!["1"]);
+}
+
+#[test]
+fn an_overlong_line_is_an_error_not_a_memory_sink() {
+    let body = format!("+ 0 0 0\n+ 1 1 {}\n", "1".repeat(100_000));
+    let (out, _dir) = replay_file(&body, &[]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("line 2") && err.contains("longer than"),
+        "{err}"
+    );
+}
+
+#[test]
+fn missing_file_and_stdin() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = tesseral()
+        .args(["replay", "no-such-file.ops"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no-such-file.ops"));
+
+    let mut child = tesseral()
+        .args(["replay", "-"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"+ -4611686018427387904 4611686018427387904 0\n? -4611686018427387904 4611686018427387904 0\n")
+        .unwrap();
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success());
+    assert_eq!(stdout_lines(&out)[0], "1");
+    assert_eq!(
+        report(&out)["root_min"],
+        serde_json::json!([-4611686018427387904i64, 4611686018427387904i64, 0])
+    );
+}

@@ -1,0 +1,185 @@
+//! Mesh writers: STL (binary), OBJ, PLY (binary little-endian) and glTF binary
+//! (`.glb`). OBJ, PLY and glTF keep the shared (and split) vertices; STL stores each
+//! triangle on its own, as the format requires.
+
+use std::io::{self, Write};
+use std::path::Path;
+
+use super::TriMesh;
+use crate::io::{extension, write_atomic, FormatError};
+
+/// The mesh extensions we write.
+pub const MESH_EXTENSIONS: &str = "stl, obj, ply, glb";
+
+/// Writes `mesh` to `path` atomically, choosing the format by extension.
+///
+/// # Errors
+/// [`FormatError::UnknownFormat`] for another extension; [`FormatError::Io`].
+pub fn write_file(path: &Path, mesh: &TriMesh) -> Result<(), FormatError> {
+    let ext = extension(path);
+    let f: fn(&mut dyn Write, &TriMesh) -> io::Result<()> = match ext.as_str() {
+        "stl" => write_stl,
+        "obj" => write_obj,
+        "ply" => write_ply,
+        "glb" => write_glb,
+        _ => {
+            return Err(FormatError::UnknownFormat {
+                path: path.to_owned(),
+                known: MESH_EXTENSIONS,
+            })
+        }
+    };
+    write_atomic(path, |w| f(w, mesh))
+}
+
+fn normal(m: &TriMesh, t: &[u32; 3]) -> [f32; 3] {
+    let [a, b, c] = t.map(|i| m.positions[i as usize]);
+    let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+    let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    if l > 0.0 {
+        n.map(|x| (x / l) as f32)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Binary STL: 80-byte header, triangle count, then normal, three vertices and a
+/// zero attribute per triangle.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_stl(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    let mut header = [b' '; 80];
+    let text = b"binary STL written by tesseral";
+    header[..text.len()].copy_from_slice(text);
+    w.write_all(&header)?;
+    w.write_all(&(m.triangles.len() as u32).to_le_bytes())?;
+    for t in &m.triangles {
+        for x in normal(m, t) {
+            w.write_all(&x.to_le_bytes())?;
+        }
+        for &i in t {
+            for x in m.positions[i as usize] {
+                w.write_all(&(x as f32).to_le_bytes())?;
+            }
+        }
+        w.write_all(&[0, 0])?;
+    }
+    Ok(())
+}
+
+/// Wavefront OBJ: `v x y z` lines, then `f a b c` with 1-based indices.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_obj(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    writeln!(
+        w,
+        "# written by tesseral: {} vertices, {} triangles",
+        m.positions.len(),
+        m.triangles.len()
+    )?;
+    for p in &m.positions {
+        writeln!(w, "v {} {} {}", p[0], p[1], p[2])?;
+    }
+    for t in &m.triangles {
+        writeln!(w, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1)?;
+    }
+    Ok(())
+}
+
+/// Binary little-endian PLY with float vertices and `uchar`/`int` face lists.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_ply(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    write!(
+        w,
+        "ply\nformat binary_little_endian 1.0\ncomment written by tesseral\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        m.positions.len(),
+        m.triangles.len()
+    )?;
+    let mut buf = Vec::with_capacity(12 * m.positions.len() + 13 * m.triangles.len());
+    for p in &m.positions {
+        for x in p {
+            buf.extend_from_slice(&(*x as f32).to_le_bytes());
+        }
+    }
+    for t in &m.triangles {
+        buf.push(3);
+        for &i in t {
+            buf.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+    }
+    w.write_all(&buf)
+}
+
+/// glTF 2.0 binary: one mesh, one triangle primitive with `POSITION` (float VEC3,
+/// with its bounds) and `u32` indices.
+///
+/// # Errors
+/// I/O errors of `w`.
+pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    let mut bin = Vec::with_capacity(12 * m.positions.len() + 12 * m.triangles.len());
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for p in &m.positions {
+        for a in 0..3 {
+            let x = p[a] as f32;
+            lo[a] = lo[a].min(x);
+            hi[a] = hi[a].max(x);
+            bin.extend_from_slice(&x.to_le_bytes());
+        }
+    }
+    let pos_len = bin.len();
+    for t in &m.triangles {
+        for &i in t {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+    }
+    let idx_len = bin.len() - pos_len;
+    while bin.len() % 4 != 0 {
+        bin.push(0);
+    }
+    if m.positions.is_empty() {
+        lo = [0.0; 3];
+        hi = [0.0; 3];
+    }
+    let json = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "tesseral"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1, "mode": 4}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": pos_len, "target": 34962},
+            {"buffer": 0, "byteOffset": pos_len, "byteLength": idx_len, "target": 34963}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": m.positions.len(), "type": "VEC3",
+             "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5125, "count": 3 * m.triangles.len(), "type": "SCALAR"}
+        ]
+    });
+    let mut json = serde_json::to_vec(&json).map_err(io::Error::other)?;
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&(total as u32).to_le_bytes())?;
+    w.write_all(&(json.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&json)?;
+    w.write_all(&(bin.len() as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")?;
+    w.write_all(&bin)
+}

@@ -1,0 +1,45 @@
+//! The unbounded dynamic octree as an RS/MC lattice (Libes §5–6): O(|S|) memory and
+//! unbounded growth. Its face list follows the same order rule as
+//! [`DenseLattice`](super::DenseLattice), so the two give identical trajectories.
+
+use super::{Lattice, Plaquette};
+use crate::dynamic::DynamicOctree;
+use crate::Voxel;
+
+impl Lattice for DynamicOctree {
+    fn empty() -> Self {
+        DynamicOctree::with_faces()
+    }
+    #[inline]
+    fn insert(&mut self, v: Voxel) -> bool {
+        DynamicOctree::insert(self, v)
+    }
+    #[inline]
+    fn remove(&mut self, v: Voxel) -> bool {
+        DynamicOctree::remove(self, v)
+    }
+    #[inline]
+    fn contains(&self, v: Voxel) -> bool {
+        DynamicOctree::contains(self, v)
+    }
+    #[inline]
+    fn voxel_count(&self) -> u64 {
+        DynamicOctree::voxel_count(self)
+    }
+    #[inline]
+    fn face_count(&self) -> usize {
+        DynamicOctree::face_count(self)
+    }
+    #[inline]
+    fn face(&self, i: usize) -> Plaquette {
+        let f = DynamicOctree::face(self, i);
+        Plaquette {
+            voxel: f.voxel,
+            dir: f.dir,
+        }
+    }
+    #[inline]
+    fn neighbourhood(&self, v: Voxel) -> u32 {
+        DynamicOctree::neighbourhood(self, v)
+    }
+}
