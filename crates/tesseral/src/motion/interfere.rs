@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use super::orient::Rotation;
 use super::traverse::Node;
+use super::view::Traversable;
 use crate::linear::{Leaf, LinearOctree};
 use crate::Voxel;
 
@@ -45,34 +46,45 @@ impl Placement {
         ]
     }
 
+    /// The half-open box `b` (in the tree's coordinates) placed in the world.
     #[inline]
-    pub(crate) fn cell(&self, min: Voxel, side: i64) -> IBox {
-        let r = self.rotation.apply_cube(min, side);
-        let lo = [
-            r[0] + self.offset[0],
-            r[1] + self.offset[1],
-            r[2] + self.offset[2],
-        ];
+    pub(crate) fn place_box(&self, b: &IBox) -> IBox {
+        if self.rotation.is_identity() {
+            return IBox {
+                lo: [0, 1, 2].map(|a| b.lo[a] + self.offset[a]),
+                hi: [0, 1, 2].map(|a| b.hi[a] + self.offset[a]),
+            };
+        }
+        let (lo, hi) = self.rotation.apply_box(b.lo, b.hi);
         IBox {
-            lo,
-            hi: [lo[0] + side, lo[1] + side, lo[2] + side],
+            lo: [0, 1, 2].map(|a| lo[a] + self.offset[a]),
+            hi: [0, 1, 2].map(|a| hi[a] + self.offset[a]),
         }
     }
 }
 
-/// A tree with its placement in the world.
-#[derive(Debug, Clone, Copy)]
-pub struct Placed<'t> {
+/// A tree with its placement in the world: a [`LinearOctree`] or a prepared
+/// [`BoxTree`](super::BoxTree).
+#[derive(Debug)]
+pub struct Placed<'t, T: Traversable + ?Sized = LinearOctree> {
     /// The tree, in its own coordinates.
-    pub tree: &'t LinearOctree,
+    pub tree: &'t T,
     /// Where it is put.
     pub place: Placement,
 }
 
-impl<'t> Placed<'t> {
+impl<T: Traversable + ?Sized> Clone for Placed<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T: Traversable + ?Sized> Copy for Placed<'_, T> {}
+
+impl<'t, T: Traversable + ?Sized> Placed<'t, T> {
     /// `tree` where it stands (identity placement).
     #[must_use]
-    pub fn fixed(tree: &'t LinearOctree) -> Self {
+    pub fn fixed(tree: &'t T) -> Self {
         Placed {
             tree,
             place: Placement::default(),
@@ -81,8 +93,13 @@ impl<'t> Placed<'t> {
 
     /// `tree` placed by `place`.
     #[must_use]
-    pub fn new(tree: &'t LinearOctree, place: Placement) -> Self {
+    pub fn new(tree: &'t T, place: Placement) -> Self {
         Placed { tree, place }
+    }
+
+    #[inline]
+    pub(crate) fn world_box(&self, n: &T::Node) -> IBox {
+        self.place.place_box(&self.tree.node_box(n))
     }
 }
 
@@ -107,7 +124,8 @@ impl Aabb {
 
 /// A half-open integer box `[lo, hi)` per axis (internal).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) struct IBox {
+#[doc(hidden)]
+pub struct IBox {
     pub lo: Voxel,
     pub hi: Voxel,
 }
@@ -178,49 +196,45 @@ enum Mode {
     Contacts,
 }
 
-struct Overlap<'t> {
-    a: &'t [Leaf],
-    b: &'t [Leaf],
-    pa: Placement,
-    pb: Placement,
+struct Overlap<'t, A: Traversable + ?Sized, B: Traversable + ?Sized> {
+    a: Placed<'t, A>,
+    b: Placed<'t, B>,
     mode: Mode,
     out: Interference,
 }
 
-impl Overlap<'_> {
-    /// Every leaf of the `leaves` run of `n`, placed, lies inside the black box of the
-    /// other tree: all of them overlap.
-    fn covered(&mut self, leaves: &[Leaf], place: Placement, n: Node) -> ControlFlow<()> {
+/// Pushes the placed boxes of every black cell under `n`.
+fn push_leaves<T: Traversable + ?Sized>(p: Placed<'_, T>, n: T::Node, out: &mut Vec<Aabb>) {
+    if p.tree.is_black(&n) {
+        out.push(p.world_box(&n).aabb());
+        return;
+    }
+    let mut kids = [n; 8];
+    let k = p.tree.node_children(&n, &mut kids);
+    for &c in &kids[..k] {
+        push_leaves(p, c, out);
+    }
+}
+
+impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Overlap<'_, A, B> {
+    /// All of a node's voxels overlap the other tree's black cell.
+    fn covered(&mut self, voxels: u64, leaves: impl FnOnce(&mut Vec<Aabb>)) -> ControlFlow<()> {
         self.out.intersects = true;
         match self.mode {
             Mode::Any => return ControlFlow::Break(()),
-            Mode::Volume => self.out.overlap_voxels += n.voxel_count(leaves),
+            Mode::Volume => self.out.overlap_voxels += voxels,
             Mode::Contacts => {
-                self.out.overlap_voxels += n.voxel_count(leaves);
-                // The run's leaves, placed: walk them as blocks relative to the cell.
-                for l in &leaves[n.lo..n.hi] {
-                    let rel = crate::code::decode(l.code() - n.code);
-                    let min = [
-                        n.min[0] + i64::from(rel[0]),
-                        n.min[1] + i64::from(rel[1]),
-                        n.min[2] + i64::from(rel[2]),
-                    ];
-                    let b = place.cell(min, 1 << l.size_log2());
-                    self.out.contacts.push(b.aabb());
-                }
+                self.out.overlap_voxels += voxels;
+                leaves(&mut self.out.contacts);
             }
         }
         ControlFlow::Continue(())
     }
 
-    fn visit(&mut self, na: Node, nb: Node) -> ControlFlow<()> {
-        let ba = self.pa.cell(na.min, na.side());
-        let bb = self.pb.cell(nb.min, nb.side());
-        if !ba.overlaps(&bb) {
-            return ControlFlow::Continue(());
-        }
-        let fa = na.is_full(self.a);
-        let fb = nb.is_full(self.b);
+    /// Visits a pair of nodes whose placed boxes `ba` and `bb` overlap.
+    fn visit(&mut self, na: A::Node, ba: IBox, nb: B::Node, bb: IBox) -> ControlFlow<()> {
+        let fa = self.a.tree.is_black(&na);
+        let fb = self.b.tree.is_black(&nb);
         if fa && fb {
             self.out.intersects = true;
             if self.mode == Mode::Any {
@@ -234,38 +248,52 @@ impl Overlap<'_> {
             return ControlFlow::Continue(());
         }
         if fa && bb.inside(&ba) {
-            return self.covered(self.b, self.pb, nb);
+            let (b, v) = (self.b, self.b.tree.node_voxels(&nb));
+            return self.covered(v, |out| push_leaves(b, nb, out));
         }
         if fb && ba.inside(&bb) {
-            return self.covered(self.a, self.pa, na);
+            let (a, v) = (self.a, self.a.tree.node_voxels(&na));
+            return self.covered(v, |out| push_leaves(a, na, out));
         }
-        let mut kids = [na; 8];
-        if !fa && (fb || na.k >= nb.k) {
-            let n = na.children(self.a, &mut kids);
+        if !fa && (fb || self.a.tree.node_size(&na) >= self.b.tree.node_size(&nb)) {
+            let mut kids = [na; 8];
+            let n = self.a.tree.node_children(&na, &mut kids);
             for &c in &kids[..n] {
-                self.visit(c, nb)?;
+                let bc = self.a.world_box(&c);
+                if bc.overlaps(&bb) {
+                    self.visit(c, bc, nb, bb)?;
+                }
             }
         } else {
-            let n = nb.children(self.b, &mut kids);
+            let mut kids = [nb; 8];
+            let n = self.b.tree.node_children(&nb, &mut kids);
             for &c in &kids[..n] {
-                self.visit(na, c)?;
+                let bc = self.b.world_box(&c);
+                if ba.overlaps(&bc) {
+                    self.visit(na, ba, c, bc)?;
+                }
             }
         }
         ControlFlow::Continue(())
     }
 }
 
-fn run_overlap(a: Placed<'_>, b: Placed<'_>, mode: Mode) -> Interference {
+fn run_overlap<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
+    mode: Mode,
+) -> Interference {
     let mut o = Overlap {
-        a: a.tree.leaves(),
-        b: b.tree.leaves(),
-        pa: a.place,
-        pb: b.place,
+        a,
+        b,
         mode,
         out: Interference::default(),
     };
-    if let (Some(ra), Some(rb)) = (Node::tight_root(a.tree), Node::tight_root(b.tree)) {
-        let _ = o.visit(ra, rb);
+    if let (Some(ra), Some(rb)) = (a.tree.root_node(), b.tree.root_node()) {
+        let (ba, bb) = (a.world_box(&ra), b.world_box(&rb));
+        if ba.overlaps(&bb) {
+            let _ = o.visit(ra, ba, rb, bb);
+        }
     }
     o.out
 }
@@ -288,13 +316,20 @@ fn run_overlap(a: Placed<'_>, b: Placed<'_>, mode: Mode) -> Interference {
 /// assert!(!intersects(&cube, &cube, Placement::at([4, 0, 0])));
 /// ```
 #[must_use]
-pub fn intersects(a: &LinearOctree, b: &LinearOctree, place: Placement) -> bool {
+pub fn intersects<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: &A,
+    b: &B,
+    place: Placement,
+) -> bool {
     intersects_placed(Placed::fixed(a), Placed::new(b, place))
 }
 
 /// [`intersects`] with both trees placed.
 #[must_use]
-pub fn intersects_placed(a: Placed<'_>, b: Placed<'_>) -> bool {
+pub fn intersects_placed<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
+) -> bool {
     run_overlap(a, b, Mode::Any).intersects
 }
 
@@ -314,9 +349,9 @@ pub fn intersects_placed(a: Placed<'_>, b: Placed<'_>) -> bool {
 /// assert_eq!(hit.contacts.iter().map(|b| b.voxel_count()).sum::<u64>(), 8);
 /// ```
 #[must_use]
-pub fn interference(
-    a: &LinearOctree,
-    b: &LinearOctree,
+pub fn interference<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: &A,
+    b: &B,
     place: Placement,
     contacts: bool,
 ) -> Interference {
@@ -325,7 +360,11 @@ pub fn interference(
 
 /// [`interference`] with both trees placed.
 #[must_use]
-pub fn interference_placed(a: Placed<'_>, b: Placed<'_>, contacts: bool) -> Interference {
+pub fn interference_placed<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
+    contacts: bool,
+) -> Interference {
     let mode = if contacts {
         Mode::Contacts
     } else {
@@ -352,54 +391,57 @@ pub fn interference_placed(a: Placed<'_>, b: Placed<'_>, contacts: bool) -> Inte
 /// assert_eq!(clearance(&dot, &dot, Placement::at([1, 0, 0])), Some(0.0));
 /// ```
 #[must_use]
-pub fn clearance(a: &LinearOctree, b: &LinearOctree, place: Placement) -> Option<f64> {
+pub fn clearance<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: &A,
+    b: &B,
+    place: Placement,
+) -> Option<f64> {
     clearance_squared(Placed::fixed(a), Placed::new(b, place)).map(|d| (d as f64).sqrt())
 }
 
 /// The squared clearance of two placed trees, exactly, or `None` when either is empty.
 #[must_use]
-pub fn clearance_squared(a: Placed<'_>, b: Placed<'_>) -> Option<u128> {
-    let ra = Node::tight_root(a.tree)?;
-    let rb = Node::tight_root(b.tree)?;
+pub fn clearance_squared<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
+) -> Option<u128> {
+    let ra = a.tree.root_node()?;
+    let rb = b.tree.root_node()?;
     let mut c = Clearance {
-        a: a.tree.leaves(),
-        b: b.tree.leaves(),
-        pa: a.place,
-        pb: b.place,
+        a,
+        b,
         best: u128::MAX,
     };
     c.visit(ra, rb);
     Some(c.best)
 }
 
-struct Clearance<'t> {
-    a: &'t [Leaf],
-    b: &'t [Leaf],
-    pa: Placement,
-    pb: Placement,
+struct Clearance<'t, A: Traversable + ?Sized, B: Traversable + ?Sized> {
+    a: Placed<'t, A>,
+    b: Placed<'t, B>,
     best: u128,
 }
 
-impl Clearance<'_> {
-    fn visit(&mut self, na: Node, nb: Node) {
-        let ba = self.pa.cell(na.min, na.side());
-        let bb = self.pb.cell(nb.min, nb.side());
+impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Clearance<'_, A, B> {
+    fn visit(&mut self, na: A::Node, nb: B::Node) {
+        let ba = self.a.world_box(&na);
+        let bb = self.b.world_box(&nb);
         let d = ba.gap2(&bb);
         if d >= self.best {
             return;
         }
-        let fa = na.is_full(self.a);
-        let fb = nb.is_full(self.b);
+        let fa = self.a.tree.is_black(&na);
+        let fb = self.b.tree.is_black(&nb);
         if fa && fb {
             self.best = d;
             return;
         }
-        let mut kids = [na; 8];
         let mut order = [(0u128, 0usize); 8];
-        if !fa && (fb || na.k >= nb.k) {
-            let n = na.children(self.a, &mut kids);
+        if !fa && (fb || self.a.tree.node_size(&na) >= self.b.tree.node_size(&nb)) {
+            let mut kids = [na; 8];
+            let n = self.a.tree.node_children(&na, &mut kids);
             for i in 0..n {
-                order[i] = (self.pa.cell(kids[i].min, kids[i].side()).gap2(&bb), i);
+                order[i] = (self.a.world_box(&kids[i]).gap2(&bb), i);
             }
             order[..n].sort_unstable();
             for &(d, i) in &order[..n] {
@@ -409,9 +451,10 @@ impl Clearance<'_> {
                 self.visit(kids[i], nb);
             }
         } else {
-            let n = nb.children(self.b, &mut kids);
+            let mut kids = [nb; 8];
+            let n = self.b.tree.node_children(&nb, &mut kids);
             for i in 0..n {
-                order[i] = (ba.gap2(&self.pb.cell(kids[i].min, kids[i].side())), i);
+                order[i] = (ba.gap2(&self.b.world_box(&kids[i])), i);
             }
             order[..n].sort_unstable();
             for &(d, i) in &order[..n] {

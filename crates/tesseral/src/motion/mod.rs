@@ -22,6 +22,7 @@ mod orient;
 mod plan;
 mod sweep;
 mod traverse;
+mod view;
 mod world;
 mod world_file;
 
@@ -38,6 +39,7 @@ pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
 pub use sweep::{first_contact, first_contact_brute, Fraction, SweptContact};
+pub use view::{BoxTree, Traversable};
 pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
 };

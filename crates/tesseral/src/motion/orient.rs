@@ -188,6 +188,25 @@ impl Rotation {
         out
     }
 
+    /// Maps the half-open box `[lo, hi)` of voxels (each cube mapped as by
+    /// [`Rotation::apply_cube`]); returns the new `(lo, hi)`.
+    #[inline]
+    pub(crate) fn apply_box(self, lo: Voxel, hi: Voxel) -> (Voxel, Voxel) {
+        let mut l = [0; 3];
+        let mut h = [0; 3];
+        for a in 0..3 {
+            let p = usize::from(self.perm[a]);
+            if self.neg[a] {
+                l[a] = -hi[p];
+                h[a] = -lo[p];
+            } else {
+                l[a] = lo[p];
+                h[a] = hi[p];
+            }
+        }
+        (l, h)
+    }
+
     /// Rotates a block.
     #[must_use]
     pub fn apply_block(self, b: Block) -> Block {

@@ -8,9 +8,8 @@ use std::fmt;
 
 use serde::Serialize;
 
-use super::interfere::{Aabb, IBox, Placed, Placement};
-use super::traverse::Node;
-use crate::linear::Leaf;
+use super::interfere::{Aabb, IBox, Placed};
+use super::view::Traversable;
 use crate::Voxel;
 
 /// An exact non-negative rational number `num / den`, in lowest terms, `den > 0`.
@@ -169,19 +168,17 @@ fn first_time(a: &IBox, b: &IBox, v: Voxel) -> Option<Fraction> {
 /// assert_eq!(hit.time, Fraction::new(8, 20)); // its front face x = 2 reaches x = 10
 /// ```
 #[must_use]
-pub fn first_contact(
-    a: Placed<'_>,
+pub fn first_contact<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
     a_move: Voxel,
-    b: Placed<'_>,
+    b: Placed<'_, B>,
     b_move: Voxel,
 ) -> Option<SweptContact> {
-    let ra = Node::tight_root(a.tree)?;
-    let rb = Node::tight_root(b.tree)?;
+    let ra = a.tree.root_node()?;
+    let rb = b.tree.root_node()?;
     let mut s = Sweep {
-        a: a.tree.leaves(),
-        b: b.tree.leaves(),
-        pa: a.place,
-        pb: b.place,
+        a,
+        b,
         v: [
             b_move[0] - a_move[0],
             b_move[1] - a_move[1],
@@ -193,31 +190,29 @@ pub fn first_contact(
     s.best
 }
 
-struct Sweep<'t> {
-    a: &'t [Leaf],
-    b: &'t [Leaf],
-    pa: Placement,
-    pb: Placement,
+struct Sweep<'t, A: Traversable + ?Sized, B: Traversable + ?Sized> {
+    a: Placed<'t, A>,
+    b: Placed<'t, B>,
     v: Voxel,
     best: Option<SweptContact>,
 }
 
-impl Sweep<'_> {
+impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Sweep<'_, A, B> {
     fn improves(&self, t: Fraction) -> bool {
         self.best.is_none_or(|b| t < b.time)
     }
 
-    fn visit(&mut self, na: Node, nb: Node) {
-        let ba = self.pa.cell(na.min, na.side());
-        let bb = self.pb.cell(nb.min, nb.side());
+    fn visit(&mut self, na: A::Node, nb: B::Node) {
+        let ba = self.a.world_box(&na);
+        let bb = self.b.world_box(&nb);
         let Some(t) = first_time(&ba, &bb, self.v) else {
             return;
         };
         if !self.improves(t) {
             return;
         }
-        let fa = na.is_full(self.a);
-        let fb = nb.is_full(self.b);
+        let fa = self.a.tree.is_black(&na);
+        let fb = self.b.tree.is_black(&nb);
         if fa && fb {
             self.best = Some(SweptContact {
                 time: t,
@@ -226,34 +221,39 @@ impl Sweep<'_> {
             });
             return;
         }
-        let mut kids = [na; 8];
         let mut order: [(Fraction, usize); 8] = [(Fraction::ZERO, 0); 8];
         let mut m = 0;
-        let split_a = !fa && (fb || na.k >= nb.k);
-        let n = if split_a {
-            na.children(self.a, &mut kids)
-        } else {
-            nb.children(self.b, &mut kids)
-        };
-        for (i, kid) in kids[..n].iter().enumerate() {
-            let t = if split_a {
-                first_time(&self.pa.cell(kid.min, kid.side()), &bb, self.v)
-            } else {
-                first_time(&ba, &self.pb.cell(kid.min, kid.side()), self.v)
-            };
-            if let Some(t) = t {
-                order[m] = (t, i);
-                m += 1;
+        let split_a = !fa && (fb || self.a.tree.node_size(&na) >= self.b.tree.node_size(&nb));
+        if split_a {
+            let mut kids = [na; 8];
+            let n = self.a.tree.node_children(&na, &mut kids);
+            for (i, kid) in kids[..n].iter().enumerate() {
+                if let Some(t) = first_time(&self.a.world_box(kid), &bb, self.v) {
+                    order[m] = (t, i);
+                    m += 1;
+                }
             }
-        }
-        order[..m].sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
-        for &(t, i) in &order[..m] {
-            if !self.improves(t) {
-                break;
-            }
-            if split_a {
+            order[..m].sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
+            for &(t, i) in &order[..m] {
+                if !self.improves(t) {
+                    break;
+                }
                 self.visit(kids[i], nb);
-            } else {
+            }
+        } else {
+            let mut kids = [nb; 8];
+            let n = self.b.tree.node_children(&nb, &mut kids);
+            for (i, kid) in kids[..n].iter().enumerate() {
+                if let Some(t) = first_time(&ba, &self.b.world_box(kid), self.v) {
+                    order[m] = (t, i);
+                    m += 1;
+                }
+            }
+            order[..m].sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.cmp(&y.1)));
+            for &(t, i) in &order[..m] {
+                if !self.improves(t) {
+                    break;
+                }
                 self.visit(na, kids[i]);
             }
         }

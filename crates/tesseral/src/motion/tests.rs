@@ -152,6 +152,37 @@ fn interference_matches_brute_force() {
         let shared: HashSet<Voxel> = moved.iter().copied().filter(|v| sa.contains(v)).collect();
 
         let got = interference(&a, &b, place, true);
+        let (pa, pb) = (BoxTree::new(&a), BoxTree::new(&b));
+        pa.assert_valid();
+        pb.assert_valid();
+        assert_eq!(pa.voxel_count(), a.voxel_count());
+        // Prepared trees, alone or mixed with plain ones, give the same answers.
+        assert_eq!(
+            intersects(&pa, &pb, place),
+            !shared.is_empty(),
+            "seed {seed}"
+        );
+        assert_eq!(
+            intersects(&a, &pb, place),
+            !shared.is_empty(),
+            "seed {seed}"
+        );
+        let prepared = interference(&pa, &pb, place, true);
+        assert_eq!(prepared.overlap_voxels, shared.len() as u64, "seed {seed}");
+        let mut cells: Vec<Aabb> = prepared.contacts.clone();
+        let mut plain: Vec<Aabb> = got.contacts.clone();
+        cells.sort_by_key(|b| (b.min, b.max));
+        plain.sort_by_key(|b| (b.min, b.max));
+        assert_eq!(cells, plain, "seed {seed}");
+        assert_eq!(
+            interference(&pa, &b, place, false).overlap_voxels,
+            shared.len() as u64
+        );
+        assert_eq!(
+            clearance_squared(Placed::fixed(&pa), Placed::new(&pb, place)),
+            clearance_squared(Placed::fixed(&a), Placed::new(&b, place)),
+            "seed {seed}"
+        );
         assert_eq!(got.intersects, !shared.is_empty(), "seed {seed}");
         assert_eq!(got.overlap_voxels, shared.len() as u64, "seed {seed}");
         assert_eq!(intersects(&a, &b, place), !shared.is_empty(), "seed {seed}");
@@ -216,6 +247,9 @@ fn first_contact_matches_brute_force_and_sampling() {
         let got = first_contact(Placed::fixed(&a), [0; 3], Placed::new(&b, place), v);
         let brute = first_contact_brute(&va, &moved, v);
         assert_eq!(got.map(|c| c.time), brute, "seed {seed}");
+        let (pa, pb) = (BoxTree::new(&a), BoxTree::new(&b));
+        let prepared = first_contact(Placed::fixed(&pa), [0; 3], Placed::new(&pb, place), v);
+        assert_eq!(prepared.map(|c| c.time), brute, "seed {seed}");
         // Independent check by sampling: no overlap strictly before the time, overlap
         // just after it.
         let overlap_at = |t: f64| {

@@ -14,7 +14,8 @@ const LINEAR_SPLIT: usize = 24;
 
 /// A cell with its run of leaves `leaves[lo..hi]`.
 #[derive(Debug, Clone, Copy)]
-pub(crate) struct Node {
+#[doc(hidden)]
+pub struct Node {
     /// The code of the cell's lowest voxel, relative to the tree's origin.
     pub code: u64,
     /// The lowest voxel of the cell in the tree's own world coordinates.

