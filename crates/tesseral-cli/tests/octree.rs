@@ -303,9 +303,120 @@ fn errors_exit_2_with_one_line() {
     fails(d, &["scale", "a.xyz", "--by", "2^x", "-o", "o.xyz"]);
     let err = fails(d, &["scale", "a.xyz", "--by", "2^20", "-o", "o.xyz"]);
     assert!(err.contains("depth"), "{err}");
+    // A voxel list that would be absurdly long is refused before writing.
+    let err = fails(d, &["scale", "a.xyz", "--by", "2^9", "-o", "o.xyz"]);
+    assert!(err.contains("too many for a voxel list"), "{err}");
     fails(d, &["op", "nand", "a.xyz", "a.xyz", "-o", "o.xyz"]);
     fails(d, &["op", "union", "a.xyz", "bad.xyz", "-o", "o.xyz"]);
     fails(d, &["complement", "bad.xyz", "-o", "o.xyz"]);
     assert!(!d.join("o.xyz").exists(), "no output on failure");
+    no_temp_files(d);
+}
+
+fn info_json(dir: &Path, file: &str) -> serde_json::Value {
+    serde_json::from_str(&ok(dir, &["info", file, "--json"])).unwrap()
+}
+
+#[test]
+fn native_format_keeps_the_space_through_every_command() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_xyz(d, "a.xyz", &solid());
+    ok(d, &["convert", "a.xyz", "a.tess"]);
+    let json = info_json(d, "a.tess");
+    assert_eq!(json["voxels"], 27);
+    assert_eq!(json["origin"], serde_json::json!([-3, -2, 0]));
+    assert_eq!(json["depth"], 4);
+    // Translation within the 16^3 space keeps it (a .tess remembers its space).
+    ok(d, &["translate", "a.tess", "--by", "1,1,1", "-o", "t.tess"]);
+    let json = info_json(d, "t.tess");
+    assert_eq!(
+        (json["depth"].clone(), json["origin"].clone()),
+        (serde_json::json!(4), serde_json::json!([-3, -2, 0]))
+    );
+    ok(d, &["convert", "t.tess", "t.xyz"]);
+    assert_eq!(read_xyz(d, "t.xyz"), shifted(&solid(), [1, 1, 1]));
+    // Leaving the space grows it by root expansion; both methods agree exactly.
+    ok(d, &["translate", "a.tess", "--by=-20,0,3", "-o", "g.tess"]);
+    ok(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "--by=-20,0,3",
+            "-o",
+            "g2.tess",
+            "--method",
+            "labels",
+        ],
+    );
+    assert_eq!(
+        fs::read(d.join("g.tess")).unwrap(),
+        fs::read(d.join("g2.tess")).unwrap()
+    );
+    let json = info_json(d, "g.tess");
+    assert_eq!(json["depth"], 6);
+    // Two root expansions downwards in x: -3 - 16 - 32.
+    assert_eq!(json["origin"], serde_json::json!([-51, -2, 0]));
+    ok(d, &["convert", "g.tess", "g.xyz"]);
+    assert_eq!(read_xyz(d, "g.xyz"), shifted(&solid(), [-20, 0, 3]));
+    // The complement is taken within the stored space.
+    ok(d, &["complement", "a.tess", "-o", "c.tess"]);
+    assert_eq!(info_json(d, "c.tess")["voxels"], 4096 - 27);
+    // Set operations between .tess and .xyz operands.
+    ok(d, &["op", "union", "a.tess", "t.xyz", "-o", "u.tess"]);
+    ok(d, &["convert", "u.tess", "u.xyz"]);
+    let want: Voxels = solid()
+        .union(&shifted(&solid(), [1, 1, 1]))
+        .copied()
+        .collect();
+    assert_eq!(read_xyz(d, "u.xyz"), want);
+    ok(
+        d,
+        &[
+            "rotate", "a.tess", "--axis", "x", "--turns", "2", "-o", "r.tess",
+        ],
+    );
+    ok(
+        d,
+        &[
+            "rotate", "r.tess", "--axis", "x", "--turns", "2", "-o", "r2.tess",
+        ],
+    );
+    assert_eq!(
+        fs::read(d.join("a.tess")).unwrap(),
+        fs::read(d.join("r2.tess")).unwrap()
+    );
+    no_temp_files(d);
+}
+
+#[test]
+fn corrupt_native_files_are_errors_not_panics() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_xyz(d, "a.xyz", &solid());
+    ok(d, &["convert", "a.xyz", "a.tess"]);
+    let bytes = fs::read(d.join("a.tess")).unwrap();
+    // Truncated at every length, and with one byte flipped at every offset.
+    for cut in [0, 7, 8, 20, 56, bytes.len() - 5, bytes.len() - 1] {
+        fs::write(d.join("cut.tess"), &bytes[..cut]).unwrap();
+        for cmd in [
+            vec!["info", "cut.tess"],
+            vec!["translate", "cut.tess", "--by", "1,0,0", "-o", "o.tess"],
+            vec!["op", "union", "a.tess", "cut.tess", "-o", "o.tess"],
+        ] {
+            let err = fails(d, &cmd);
+            assert!(err.contains("cut.tess"), "{cut}: {err}");
+            assert_eq!(err.trim().lines().count(), 1, "{err}");
+        }
+    }
+    for i in (0..bytes.len()).step_by(3) {
+        let mut b = bytes.clone();
+        b[i] ^= 0x5a;
+        fs::write(d.join("flip.tess"), &b).unwrap();
+        let err = fails(d, &["info", "flip.tess"]);
+        assert!(err.contains("flip.tess"), "{i}: {err}");
+    }
+    assert!(!d.join("o.tess").exists());
     no_temp_files(d);
 }

@@ -208,6 +208,22 @@ fn surface_walk_summary() {
     let dt = t0.elapsed().as_nanos() as f64 / steps as f64;
     black_box(acc);
     println!("RESULT tesseral walk step_ns {dt:.2}");
+    // The read-only part of a step on the same surface: draw a face, read the
+    // 27-neighbourhoods of the voxels on both sides of it.
+    let picks: Vec<usize> = (0..steps)
+        .map(|_| (r.next() % t.face_count() as u64) as usize)
+        .collect();
+    let nb = best_of(3, || {
+        let t0 = Instant::now();
+        let mut acc = 0u32;
+        for &i in &picks {
+            let f = t.face(i);
+            acc ^= t.neighbourhood(f.voxel) ^ t.neighbourhood(f.outside());
+        }
+        black_box(acc);
+        t0.elapsed().as_nanos() as f64 / (2 * steps) as f64
+    });
+    println!("RESULT tesseral walk neighbourhood_ns {nb:.2}");
     println!("RESULT tesseral walk voxels {}", t.voxel_count());
     println!("RESULT tesseral walk faces {}", t.face_count());
     println!(

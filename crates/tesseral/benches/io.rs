@@ -14,6 +14,7 @@ use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
 use tesseral::io::{binvox, native, octomap, VoxelModel};
 use tesseral::linear::LinearOctree;
+use tesseral::mesh::{boundary_mesh, voxelize, Resolution, TriMesh, VoxelizeOptions};
 
 fn random_tree(n: usize, side: i64, seed: u64) -> LinearOctree {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
@@ -67,5 +68,79 @@ fn bench_io(c: &mut Criterion) {
     );
 }
 
-criterion_group!(benches, bench_io);
+/// A closed UV sphere of radius 1 with bumps, `2·lon·(lat−1)` triangles.
+fn bumpy_sphere(lat: usize, lon: usize) -> TriMesh {
+    let mut positions = vec![[0.0, 0.0, -1.0]];
+    for i in 1..lat {
+        let th = std::f64::consts::PI * i as f64 / lat as f64;
+        for j in 0..lon {
+            let ph = 2.0 * std::f64::consts::PI * j as f64 / lon as f64;
+            let r = 1.0 + 0.05 * (5.0 * th).sin() * (7.0 * ph).cos();
+            positions.push([
+                r * th.sin() * ph.cos(),
+                r * th.sin() * ph.sin(),
+                -r * th.cos(),
+            ]);
+        }
+    }
+    positions.push([0.0, 0.0, 1.0]);
+    let top = (positions.len() - 1) as u32;
+    let at = |i: usize, j: usize| (1 + (i - 1) * lon + j % lon) as u32;
+    let mut triangles = Vec::new();
+    for j in 0..lon {
+        triangles.push([0, at(1, j + 1), at(1, j)]);
+        triangles.push([top, at(lat - 1, j), at(lat - 1, j + 1)]);
+    }
+    for i in 1..lat - 1 {
+        for j in 0..lon {
+            triangles.push([at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+            triangles.push([at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+        }
+    }
+    TriMesh {
+        positions,
+        triangles,
+    }
+}
+
+fn bench_mesh(c: &mut Criterion) {
+    let sphere = bumpy_sphere(225, 224);
+    let n = sphere.triangles.len();
+    let mut g = c.benchmark_group("mesh");
+    g.sample_size(10);
+    for (depth, surface_only) in [(10u8, false), (10, true), (8, false)] {
+        let opts = VoxelizeOptions {
+            resolution: Resolution::Depth(depth),
+            surface_only,
+        };
+        let label = if surface_only { "surface" } else { "solid" };
+        g.bench_function(
+            format!("voxelize_{label}/{n}_triangles_depth_{depth}"),
+            |b| b.iter(|| voxelize(black_box(&sphere), &opts, Path::new("s.stl")).unwrap()),
+        );
+    }
+    let solid = voxelize(
+        &sphere,
+        &VoxelizeOptions {
+            resolution: Resolution::Depth(8),
+            surface_only: false,
+        },
+        Path::new("s"),
+    )
+    .unwrap();
+    let mesh = boundary_mesh(&solid.tree);
+    eprintln!(
+        "mesh bench: depth-8 solid {} voxels, {} leaves -> {} triangles, {} vertices",
+        solid.tree.voxel_count(),
+        solid.tree.leaf_count(),
+        mesh.triangles.len(),
+        mesh.positions.len()
+    );
+    g.bench_function("boundary_mesh/sphere_depth_8", |b| {
+        b.iter(|| boundary_mesh(black_box(&solid.tree)))
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench_io, bench_mesh);
 criterion_main!(benches);

@@ -5,7 +5,7 @@
 
 use std::hint::black_box;
 
-use criterion::{criterion_group, criterion_main, Criterion};
+use criterion::{criterion_group, criterion_main, BatchSize, Criterion};
 use tesseral::linear::{CellClass, LinearOctree, SetOp};
 use tesseral::pointer::PointerOctree;
 use tesseral::Voxel;
@@ -47,11 +47,15 @@ fn set_operations(c: &mut Criterion) {
     // The second sphere is offset by 50 voxels in x in the same space (it is cut by
     // the space's face at x = 256).
     let b = sphere(178.0);
+    let p = PointerOctree::from_linear(&a);
     eprintln!(
-        "sphere: {} voxels, {} leaves, {:.3} bytes/voxel; offset sphere: {} leaves",
+        "sphere: {} voxels, {} leaves, linear {:.3} bytes/voxel, pointer {} nodes \
+         ({:.3} bytes/voxel at 36 bytes a node); offset sphere: {} leaves",
         a.voxel_count(),
         a.leaf_count(),
         (a.leaf_count() * 8) as f64 / a.voxel_count() as f64,
+        p.node_count(),
+        (p.node_count() * 36) as f64 / a.voxel_count() as f64,
         b.leaf_count()
     );
     let mut g = c.benchmark_group("set_op");
@@ -79,33 +83,41 @@ fn set_operations(c: &mut Criterion) {
 fn translation(c: &mut Criterion) {
     let a = sphere(128.0);
     let mut g = c.benchmark_group("translate");
+    // Unaligned displacements (the issue's targets), then aligned ones: (64, 0, 0)
+    // and (32, -32, 0) are multiples of every leaf's side, so leaves move whole.
     for by in [
         [50, 0, 0],
         [37, -11, 5],
+        [1, 0, 0],
         [64, 0, 0],
         [32, -32, 0],
-        [1, 0, 0],
     ] {
         g.bench_function(format!("linear {by:?}"), |bch| {
             bch.iter(|| black_box(a.translate(by).unwrap()))
         });
     }
-    // Baseline: rebuild from the moved voxels.
+    // Baseline: rebuild from the moved voxels (radix-sorted codes, then merged).
     let voxels: Vec<Voxel> = a.voxels().collect();
     g.sample_size(10);
-    g.bench_function("rebuild_from_voxels [37, -11, 5]", |bch| {
-        bch.iter(|| {
-            let moved = voxels.iter().map(|v| [v[0] + 37, v[1] - 11, v[2] + 5]);
-            black_box(LinearOctree::from_voxels(9, [-256, -256, 0], moved).unwrap())
-        })
-    });
-    let p = PointerOctree::from_linear(&a);
-    for by in [[50, 0, 0], [37, -11, 5], [64, 0, 0]] {
-        g.bench_function(format!("pointer {by:?}"), |bch| {
+    for by in [[50, 0, 0], [37, -11, 5]] {
+        g.bench_function(format!("rebuild_from_voxels {by:?}"), |bch| {
             bch.iter(|| {
-                let mut t = p.clone();
-                black_box(t.translate(by).unwrap())
+                let moved = voxels
+                    .iter()
+                    .map(|v| [v[0] + by[0], v[1] + by[1], v[2] + by[2]]);
+                black_box(LinearOctree::from_voxels(9, [-256, -256, 0], moved).unwrap())
             })
+        });
+    }
+    // Ahuja & Nash §3.2 on the pointer octree; the clone is outside the timing.
+    let p = PointerOctree::from_linear(&a);
+    for by in [[64, 0, 0], [50, 0, 0], [37, -11, 5]] {
+        g.bench_function(format!("pointer {by:?}"), |bch| {
+            bch.iter_batched(
+                || p.clone(),
+                |mut t| black_box(t.translate(by).unwrap()),
+                BatchSize::LargeInput,
+            )
         });
     }
     g.finish();

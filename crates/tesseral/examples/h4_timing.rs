@@ -86,6 +86,23 @@ fn main() {
                 "t64" => {
                     std::hint::black_box(a.translate([64, 0, 0]).unwrap());
                 }
+                "p50" => {
+                    let mut p = tesseral::pointer::PointerOctree::from_linear(&a);
+                    std::hint::black_box(p.translate([50, 0, 0]).unwrap());
+                }
+                "p37" => {
+                    let mut p = tesseral::pointer::PointerOctree::from_linear(&a);
+                    let s = p.translate([37, -11, 5]).unwrap();
+                    eprintln!("{s:?} nodes {}", p.node_count());
+                }
+                "p64" => {
+                    let mut p = tesseral::pointer::PointerOctree::from_linear(&a);
+                    std::hint::black_box(p.translate([64, 0, 0]).unwrap());
+                }
+                "pconv" => {
+                    let p = tesseral::pointer::PointerOctree::from_linear(&a);
+                    std::hint::black_box(p);
+                }
                 _ => panic!(),
             }
         }

@@ -1,17 +1,38 @@
 //! `tesseral convert IN OUT`: converts between formats, chosen by extension.
+//!
+//! Meshes coming in (`.stl`, `.obj`, `.ply`) are voxelized at `--depth` (voxels along
+//! the longest side) or `--voxel-size` (in mesh units); `--surface-only` keeps the
+//! voxels the surface touches, for meshes that are not watertight. Meshes going out
+//! (`.stl`, `.obj`, `.ply`, `.glb`) are the exact boundary, or with `--smooth` a
+//! surface-nets surface.
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use tesseral::io::{self, ReadOptions, WriteOptions};
+use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
 /// Arguments of `tesseral convert`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The input file (.tess, .xyz, .binvox, .vox, .bt, .ot).
+    /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply.
     pub input: PathBuf,
-    /// The output file (.tess, .xyz, .binvox, .vox, .bt, .ot).
+    /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply, .glb.
     pub output: PathBuf,
+    /// Voxelize an input mesh with 2^DEPTH voxels along its longest side (default 8).
+    #[arg(long, conflicts_with = "voxel_size")]
+    pub depth: Option<u8>,
+    /// Voxelize an input mesh with voxels of this side, in the mesh's units.
+    #[arg(long)]
+    pub voxel_size: Option<f64>,
+    /// Keep only the voxels an input mesh's surface touches (no inside test, so the
+    /// mesh need not be watertight).
+    #[arg(long)]
+    pub surface_only: bool,
+    /// Write an output mesh as a smooth surface (surface nets) instead of the exact
+    /// blocky boundary.
+    #[arg(long)]
+    pub smooth: bool,
     /// Print a summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -19,13 +40,38 @@ pub struct Args {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    let read = ReadOptions::default();
-    let write = WriteOptions::default();
+    let resolution = match (args.depth, args.voxel_size) {
+        (Some(d), _) => {
+            if d > MAX_VOXELIZE_DEPTH {
+                bail!("--depth {d}: at most {MAX_VOXELIZE_DEPTH}");
+            }
+            Resolution::Depth(d)
+        }
+        (None, Some(h)) => {
+            if !(h.is_finite() && h > 0.0) {
+                bail!("--voxel-size {h}: must be a positive number");
+            }
+            Resolution::VoxelSize(h)
+        }
+        (None, None) => Resolution::Depth(8),
+    };
+    let read = ReadOptions {
+        mesh: VoxelizeOptions {
+            resolution,
+            surface_only: args.surface_only,
+        },
+    };
+    let write = WriteOptions {
+        mesh: MeshOptions {
+            smooth: args.smooth,
+        },
+    };
     let model = io::read_model_with(&args.input, &read)
         .with_context(|| format!("reading {}", args.input.display()))?;
     io::write_model_with(&args.output, &model, &write)
         .with_context(|| format!("writing {}", args.output.display()))?;
     if args.json {
+        let bbox = model.tree.bbox();
         let summary = serde_json::json!({
             "input": args.input,
             "output": args.output,
@@ -33,7 +79,10 @@ pub fn run(args: Args) -> Result<()> {
             "leaves": model.tree.leaf_count(),
             "depth": model.tree.depth(),
             "origin": model.tree.origin(),
+            "bbox_min": bbox.map(|b| b.0),
+            "bbox_max": bbox.map(|b| b.1),
             "voxel_size": model.frame.map(|f| f.voxel_size),
+            "translate": model.frame.map(|f| f.translate),
             "colors": model.colors.as_ref().map(|c| c.len()),
         });
         println!("{summary}");

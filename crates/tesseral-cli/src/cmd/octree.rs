@@ -13,9 +13,21 @@ pub fn read(path: &Path) -> Result<LinearOctree> {
     tesseral::io::read_octree(path).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
+/// The most voxels a command writes as a voxel list (`.xyz` holds one line per
+/// voxel, so a scaled-up or complemented solid could otherwise fill the disk).
+pub const MAX_LISTED_VOXELS: u64 = 1 << 27;
+
 /// Writes an octree atomically, in the format named by the extension, and prints a
 /// one-line summary.
 pub fn write(path: &Path, tree: &LinearOctree) -> Result<()> {
+    if tesseral::io::extension(path) == "xyz" && tree.voxel_count() > MAX_LISTED_VOXELS {
+        anyhow::bail!(
+            "{}: {} voxels is too many for a voxel list (at most {MAX_LISTED_VOXELS}); \
+             write a block-based format instead",
+            path.display(),
+            tree.voxel_count()
+        );
+    }
     tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
     println!(
         "wrote {}: {} voxels, {} leaves, depth {}, origin {}",

@@ -167,18 +167,18 @@ pub fn run(args: Args) -> Result<()> {
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
-    let (tree, csg, to_voxel): (LinearOctree, Option<Csg>, Box<dyn Fn(usize, f64) -> f64>) =
-        if is_scene {
-            let scene = Scene::read(&args.input)?;
-            let csg = scene.csg()?;
-            let tree = scene.build()?;
-            let (v, lo) = (scene.voxel, scene.bounds_min);
-            (tree, Some(csg), Box::new(move |a, c| (c - lo[a]) / v))
-        } else {
-            let tree = io::read_octree(&args.input)
-                .with_context(|| format!("reading {}", args.input.display()))?;
-            (tree, None, Box::new(|_, c| c))
-        };
+    // A scene's cut and slice positions are in scene units: (scale, lower corner).
+    let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
+        let scene = Scene::read(&args.input)?;
+        let csg = scene.csg()?;
+        let tree = scene.build()?;
+        (tree, Some(csg), (scene.voxel, scene.bounds_min))
+    } else {
+        let tree = io::read_octree(&args.input)
+            .with_context(|| format!("reading {}", args.input.display()))?;
+        (tree, None, (1.0, [0.0; 3]))
+    };
+    let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let shader = csg
         .as_ref()

@@ -147,10 +147,11 @@ impl Csg {
                 return Ok(self.push_node(Op::Prim(i), &[], colour));
             }
             Solid::Transformed(inner, u) => {
-                if !(u.scale.is_finite() && u.scale > 0.0)
-                    || !u.at.iter().all(|v| v.is_finite())
-                    || !u.rot.iter().flatten().all(|v| v.is_finite())
-                {
+                let finite =
+                    u.at.iter()
+                        .chain(u.rot.iter().flatten())
+                        .all(|v| v.is_finite());
+                if !(finite && u.scale.is_finite() && u.scale > 0.0) {
                     return Err(CsgError::Invalid(
                         "a transform must be finite, with a positive scale".into(),
                     ));
@@ -322,7 +323,7 @@ impl Csg {
             g[a] = f(hi) - f(lo);
         }
         let l = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
-        if !(l > 1e-12) {
+        if l.is_nan() || l <= 1e-12 {
             return None;
         }
         // A primitive that is subtracted or negated has its normal flipped.
@@ -489,7 +490,7 @@ impl Csg {
                     .into_par_iter()
                     .map(|d| {
                         let (cc, cm) = child_of(code, min, k, d);
-                        if k - 1 >= PARALLEL_MIN_SIZE_LOG2 {
+                        if k > PARALLEL_MIN_SIZE_LOG2 {
                             self.build_par(cc, cm, k - 1, learn, budget)
                         } else {
                             let mut part = Vec::new();

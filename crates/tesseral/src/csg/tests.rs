@@ -129,7 +129,7 @@ fn random_rotation(rng: &mut Rng) -> [f64; 3] {
 
 #[test]
 fn every_primitive_at_random_rotations_and_sizes_equals_dense() {
-    let seed = 0x5eed_c59_u64;
+    let seed = 0x05ee_dc59_u64;
     println!("seed {seed:#x}");
     let mut rng = Rng(seed);
     for kind in 0..SHAPE_KINDS {

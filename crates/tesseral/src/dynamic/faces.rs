@@ -53,9 +53,10 @@ pub fn opposite(dir: u8) -> u8 {
     dir ^ 1
 }
 
-/// Mixes a voxel into 64 well-spread bits (murmur3's fmix64 over a multiply-xor fold).
+/// Mixes a voxel into 32 well-spread bits (a multiply-xor fold, then murmur3's
+/// fmix64).
 #[inline]
-fn mix(v: Voxel) -> u64 {
+fn mix(v: Voxel) -> u32 {
     let mut h = (v[0] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
     h = (h.rotate_left(23) ^ v[1] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
     h = (h.rotate_left(23) ^ v[2] as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
@@ -63,105 +64,94 @@ fn mix(v: Voxel) -> u64 {
     h = h.wrapping_mul(0xff51_afd7_ed55_8ccd);
     h ^= h >> 33;
     h = h.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
-    h ^ (h >> 33)
+    (h ^ (h >> 33)) as u32
 }
 
 /// An empty slot of [`VoxelTable`].
 const VACANT: u32 = u32::MAX;
 
-#[derive(Clone, Copy)]
-#[repr(C, align(32))]
-struct Slot {
-    key: Voxel,
-    val: u32,
-}
-
-/// A map from voxel to `u32`: open addressing with linear probing, keys stored in
-/// the slots (one cache line per lookup, where a SwissTable touches two), load
-/// factor at most 1/2, deletion by backward shift (no tombstones).
+/// A hash index from voxel to `u32` value, where the caller keeps the keys: each
+/// slot holds only the key's 32-bit hash and the value (8 bytes), and the caller's
+/// `key_of(value)` confirms a match. Open addressing, linear probing, load at most
+/// 1/2, deletion by backward shift (no tombstones). So the index of a surface of
+/// 100,000 voxels fits in 2 MiB, and a lookup touches one slot line plus the
+/// record the caller reads anyway.
 #[derive(Clone, Default)]
 pub(crate) struct VoxelTable {
-    slots: Vec<Slot>,
+    /// `[hash, value]`; `value == VACANT` marks an empty slot.
+    slots: Vec<[u32; 2]>,
     len: usize,
 }
 
 impl VoxelTable {
+    /// The value whose key is `key`, if any. O(1) expected.
     #[inline]
-    fn mask(&self) -> usize {
-        self.slots.len() - 1
-    }
-
-    /// The value of `key`, if any. O(1) expected.
-    #[inline]
-    pub(crate) fn get(&self, key: Voxel) -> Option<u32> {
+    pub(crate) fn get(&self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
         if self.slots.is_empty() {
             return None;
         }
-        let m = self.mask();
-        let mut i = mix(key) as usize & m;
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
         loop {
-            let s = &self.slots[i];
-            if s.val == VACANT {
+            let [sh, val] = self.slots[i];
+            if val == VACANT {
                 return None;
             }
-            if s.key == key {
-                return Some(s.val);
+            if sh == h && key_of(val) == key {
+                return Some(val);
             }
             i = (i + 1) & m;
         }
     }
 
-    /// The value of `key`, inserting `make()` first if it has none. O(1) amortised.
+    /// Adds `val` under `key`, which must be absent. O(1) amortised.
     #[inline]
-    pub(crate) fn get_or_insert_with<F: FnOnce() -> u32>(&mut self, key: Voxel, make: F) -> u32 {
+    pub(crate) fn insert(&mut self, key: Voxel, val: u32) {
+        debug_assert!(val != VACANT);
         if 2 * (self.len + 1) > self.slots.len() {
-            self.grow();
+            let cap = (self.slots.len() * 2).max(16);
+            self.rebuild(cap);
         }
-        let m = self.mask();
-        let mut i = mix(key) as usize & m;
-        loop {
-            let s = &mut self.slots[i];
-            if s.val == VACANT {
-                let v = make();
-                debug_assert!(v != VACANT);
-                *s = Slot { key, val: v };
-                self.len += 1;
-                return v;
-            }
-            if s.key == key {
-                return s.val;
-            }
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
+        while self.slots[i][1] != VACANT {
             i = (i + 1) & m;
         }
+        self.slots[i] = [h, val];
+        self.len += 1;
     }
 
-    /// Removes `key`; returns its value. O(1) expected.
-    pub(crate) fn remove(&mut self, key: Voxel) -> Option<u32> {
+    /// Removes the entry whose key is `key`; returns its value. O(1) expected.
+    pub(crate) fn remove(&mut self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
         if self.slots.is_empty() {
             return None;
         }
-        let m = self.mask();
-        let mut i = mix(key) as usize & m;
+        let m = self.slots.len() - 1;
+        let h = mix(key);
+        let mut i = h as usize & m;
         loop {
-            if self.slots[i].val == VACANT {
+            let [sh, val] = self.slots[i];
+            if val == VACANT {
                 return None;
             }
-            if self.slots[i].key == key {
+            if sh == h && key_of(val) == key {
                 break;
             }
             i = (i + 1) & m;
         }
-        let val = self.slots[i].val;
+        let val = self.slots[i][1];
         // Backward-shift deletion: pull later entries of the probe run into the hole
         // when their home slot does not lie cyclically in (hole, j].
         let mut hole = i;
         let mut j = i;
         loop {
             j = (j + 1) & m;
-            if self.slots[j].val == VACANT {
+            if self.slots[j][1] == VACANT {
                 break;
             }
-            let home = mix(self.slots[j].key) as usize & m;
+            let home = self.slots[j][0] as usize & m;
             let stays = if hole <= j {
                 hole < home && home <= j
             } else {
@@ -172,31 +162,17 @@ impl VoxelTable {
                 hole = j;
             }
         }
-        self.slots[hole].val = VACANT;
+        self.slots[hole][1] = VACANT;
         self.len -= 1;
         Some(val)
     }
 
-    fn grow(&mut self) {
-        let cap = (self.slots.len() * 2).max(16);
-        self.rebuild(cap);
-    }
-
     fn rebuild(&mut self, cap: usize) {
-        let old = std::mem::replace(
-            &mut self.slots,
-            vec![
-                Slot {
-                    key: [0; 3],
-                    val: VACANT
-                };
-                cap
-            ],
-        );
+        let old = std::mem::replace(&mut self.slots, vec![[0, VACANT]; cap]);
         let m = cap - 1;
-        for s in old.into_iter().filter(|s| s.val != VACANT) {
-            let mut i = mix(s.key) as usize & m;
-            while self.slots[i].val != VACANT {
+        for s in old.into_iter().filter(|s| s[1] != VACANT) {
+            let mut i = s[0] as usize & m;
+            while self.slots[i][1] != VACANT {
                 i = (i + 1) & m;
             }
             self.slots[i] = s;
@@ -215,15 +191,13 @@ impl VoxelTable {
         self.len
     }
 
-    pub(crate) fn iter(&self) -> impl Iterator<Item = (Voxel, u32)> + '_ {
-        self.slots
-            .iter()
-            .filter(|s| s.val != VACANT)
-            .map(|s| (s.key, s.val))
+    /// Every value, in slot order.
+    pub(crate) fn values(&self) -> impl Iterator<Item = u32> + '_ {
+        self.slots.iter().filter(|s| s[1] != VACANT).map(|s| s[1])
     }
 
     pub(crate) fn heap_bytes(&self) -> usize {
-        self.slots.capacity() * std::mem::size_of::<Slot>()
+        self.slots.capacity() * 8
     }
 }
 
@@ -250,10 +224,11 @@ impl Entry {
     }
 }
 
-/// The back-pointers of one surface voxel: where each of its six faces sits in the
-/// list (`NO_FACE` when covered), and how many it has.
+/// The back-pointers of one surface voxel: the voxel, where each of its six faces
+/// sits in the list (`NO_FACE` when covered), and how many it has.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Record {
+    pub(crate) voxel: Voxel,
     pub(crate) at: [u32; 6],
     pub(crate) count: u32,
 }
@@ -261,7 +236,7 @@ pub(crate) struct Record {
 /// The dense face list and its back-pointers. A surface voxel has one record (six
 /// list positions) found through one hash lookup; faces in the list point back at
 /// their record by index. So creating an isolated voxel costs one hash insertion, and
-/// a face removed by `swap_remove` costs one hash lookup for its owner.
+/// removing a neighbour's face costs one hash lookup.
 #[derive(Clone, Default)]
 pub(crate) struct FaceList {
     pub(crate) list: Vec<Entry>,
@@ -274,28 +249,32 @@ impl FaceList {
     /// The record of `v`, made if `v` has none. One hash lookup.
     #[inline]
     pub(crate) fn record_of(&mut self, v: Voxel) -> u32 {
-        let records = &mut self.records;
-        let free = &mut self.free;
-        self.owners.get_or_insert_with(v, || {
-            let r = Record {
-                at: [NO_FACE; 6],
-                count: 0,
-            };
-            if let Some(i) = free.pop() {
-                records[i as usize] = r;
-                i
-            } else {
-                records.push(r);
-                (records.len() - 1) as u32
-            }
-        })
+        let records = &self.records;
+        if let Some(r) = self.owners.get(v, |r| records[r as usize].voxel) {
+            return r;
+        }
+        let rec = Record {
+            voxel: v,
+            at: [NO_FACE; 6],
+            count: 0,
+        };
+        let r = if let Some(i) = self.free.pop() {
+            self.records[i as usize] = rec;
+            i
+        } else {
+            self.records.push(rec);
+            u32::try_from(self.records.len() - 1).expect("more than 2^32 surface voxels")
+        };
+        self.owners.insert(v, r);
+        r
     }
 
     /// The record of `v`, which must have one. One hash lookup.
     #[inline]
     pub(crate) fn existing_record(&self, v: Voxel) -> u32 {
+        let records = &self.records;
         self.owners
-            .get(v)
+            .get(v, |r| records[r as usize].voxel)
             .unwrap_or_else(|| panic!("voxel {v:?} has no faces"))
     }
 
@@ -330,18 +309,29 @@ impl FaceList {
             self.records[last.owner as usize].at[usize::from(last.dir)] = i;
         }
         if gone {
-            self.owners.remove(v);
+            let records = &self.records;
+            self.owners.remove(v, |r| records[r as usize].voxel);
             self.free.push(rec);
         }
     }
 
     /// Checks the back-pointers; panics naming the first broken one.
     pub(crate) fn assert_valid(&self) {
+        let records = &self.records;
+        let key_of = |r: u32| records[r as usize].voxel;
         for (i, e) in self.list.iter().enumerate() {
             assert!(e.dir < 6, "face {i} has direction {}", e.dir);
-            assert_eq!(self.owners.get(e.voxel), Some(e.owner), "owner of face {i}");
             assert_eq!(
-                self.records[e.owner as usize].at[usize::from(e.dir)],
+                self.owners.get(e.voxel, key_of),
+                Some(e.owner),
+                "owner of face {i}"
+            );
+            assert_eq!(
+                records[e.owner as usize].voxel, e.voxel,
+                "record voxel of face {i}"
+            );
+            assert_eq!(
+                records[e.owner as usize].at[usize::from(e.dir)],
                 i as u32,
                 "back-pointer of face {i}"
             );
@@ -354,16 +344,21 @@ impl FaceList {
         );
         assert_eq!(
             self.owners.len() + self.free.len(),
-            self.records.len(),
+            records.len(),
             "live + free records"
         );
         let mut total = 0usize;
-        for (v, r) in self.owners.iter() {
-            assert!(!free.contains(&r), "record of {v:?} is free");
-            let rec = &self.records[r as usize];
+        for r in self.owners.values() {
+            assert!(!free.contains(&r), "record {r} is live and free");
+            let rec = &records[r as usize];
+            assert_eq!(
+                self.owners.get(rec.voxel, key_of),
+                Some(r),
+                "index of record {r}"
+            );
             let n = rec.at.iter().filter(|&&a| a != NO_FACE).count();
-            assert_eq!(n as u32, rec.count, "face count in the record of {v:?}");
-            assert!(n > 0, "record of {v:?} has no face");
+            assert_eq!(n as u32, rec.count, "face count in record {r}");
+            assert!(n > 0, "record {r} has no face");
             total += n;
         }
         assert_eq!(total, self.list.len(), "faces in records vs list");

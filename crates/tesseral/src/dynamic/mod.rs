@@ -19,7 +19,8 @@
 //!   per z-slice, bit `x + 8y`), one cache line. So a lookup touches about
 //!   `k − 3` nodes and one block, and a stored voxel costs a bit, not a node.
 //! - With [`DynamicOctree::with_faces`], every exposed face is kept in one dense list
-//!   with back-pointers (a hash map from face to index), so a random face is drawn
+//!   with back-pointers (one record of six list positions per surface voxel, found
+//!   through a compact hash index), so a random face is drawn
 //!   in O(1) and a face is removed by `swap_remove` in O(1) (Libes §5).
 //!
 //! # Invariants (checked by [`DynamicOctree::assert_valid`])
@@ -1250,7 +1251,8 @@ impl DynamicOctree {
     }
 
     /// Every black voxel, in tesseral (Morton) order relative to the root corner.
-    /// O(voxels + nodes).
+    /// O(voxels + nodes): full octants are enumerated voxel by voxel, so for large
+    /// solids prefer [`DynamicOctree::to_linear`], whose cost follows the surface.
     ///
     /// ```
     /// let t = tesseral::dynamic::DynamicOctree::from_voxels([[1, 0, 0], [0, 0, 0]]);
@@ -1258,7 +1260,7 @@ impl DynamicOctree {
     /// ```
     #[must_use]
     pub fn voxels(&self) -> Vec<Voxel> {
-        let mut out = Vec::with_capacity(usize::try_from(self.voxels).unwrap_or(0));
+        let mut out = Vec::with_capacity(usize::try_from(self.voxels.min(1 << 24)).unwrap_or(0));
         self.visit(|base, level, bits| match bits {
             None => {
                 let side = 1u64 << level;

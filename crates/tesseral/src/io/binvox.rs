@@ -19,8 +19,8 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::{FormatError, Frame, VoxelModel, MAX_DENSE_VOXELS};
-use crate::linear::LinearOctree;
-use crate::Voxel;
+use crate::code;
+use crate::linear::{Leaf, LinearOctree};
 
 /// The largest extent along one axis that we write (the run-length body of an empty
 /// `N³` grid takes about `N³/128` bytes).
@@ -155,7 +155,8 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
     }
     let row = dy;
     let slab = dz * dy;
-    let mut voxels: Vec<Voxel> = Vec::new();
+    // Codes relative to the origin `shift` are the grid coordinates themselves.
+    let mut codes: Vec<u64> = Vec::new();
     let mut index = 0u64;
     let data = &bytes[pos..];
     let mut i = 0usize;
@@ -186,7 +187,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
             ));
         }
         if value == 1 {
-            if voxels.len() as u64 + count > MAX_DENSE_VOXELS {
+            if codes.len() as u64 + count > MAX_DENSE_VOXELS {
                 return Err(FormatError::too_large(
                     path,
                     format!("more than {MAX_DENSE_VOXELS} filled voxels"),
@@ -196,19 +197,17 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
                 let x = j / slab;
                 let z = (j % slab) / row;
                 let y = j % row;
-                voxels.push([
-                    x as i64 + shift[0],
-                    y as i64 + shift[1],
-                    z as i64 + shift[2],
-                ]);
+                codes.push(code::encode(x as u32, y as u32, z as u32));
             }
         }
         index += count;
         i += 2;
     }
     let depth = max_dim.next_power_of_two().trailing_zeros() as u8;
-    let tree = LinearOctree::from_voxels(depth, shift, voxels)
-        .map_err(|e| FormatError::octree(path, e))?;
+    codes.sort_unstable();
+    let tree =
+        LinearOctree::from_sorted_leaves(depth, shift, codes.into_iter().map(|c| Leaf::new(c, 0)))
+            .map_err(|e| FormatError::octree(path, e))?;
     Ok(VoxelModel {
         tree,
         frame: Some(Frame {
@@ -335,6 +334,7 @@ fn put_runs(out: &mut Vec<u8>, value: u8, mut n: u64) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Voxel;
     use rand::{Rng, SeedableRng};
     use std::collections::HashSet;
 

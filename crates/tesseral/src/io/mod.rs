@@ -379,4 +379,8 @@ pub(crate) fn read_limited_pub(path: &Path) -> Result<Vec<u8>, FormatError> {
 pub(crate) const MAX_FILE_BYTES: u64 = 4 << 30;
 
 /// The most voxels a dense format (binvox, `.vox`) may expand to before we refuse.
-pub const MAX_DENSE_VOXELS: u64 = 1 << 28;
+pub const MAX_DENSE_VOXELS: u64 = 1 << 26;
+
+/// The most per-voxel colours a reader expands (a colour map entry takes about 40
+/// bytes).
+pub const MAX_COLORED_VOXELS: u64 = 1 << 24;

@@ -24,7 +24,7 @@
 
 use std::path::Path;
 
-use super::{reframe, ColorMap, FormatError, Frame, VoxelModel, MAX_DENSE_VOXELS};
+use super::{reframe, ColorMap, FormatError, Frame, VoxelModel, MAX_COLORED_VOXELS};
 use crate::linear::{Leaf, LinearOctree};
 
 /// The depth of every OctoMap tree.
@@ -291,7 +291,7 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
                 leaves.push(leaf);
                 if color {
                     coloured_voxels += leaf.voxel_count();
-                    if coloured_voxels > MAX_DENSE_VOXELS {
+                    if coloured_voxels > MAX_COLORED_VOXELS {
                         return Err(FormatError::too_large(
                             path,
                             "too many coloured voxels".to_string(),

@@ -230,33 +230,28 @@ impl LinearOctree {
     }
 
     /// The inclusive bounding box `(min, max)` of the black voxels, or `None` when empty.
+    ///
+    /// # Runtime
+    /// Six pruned descents (one per face): cells that cannot beat the best face
+    /// found so far are skipped, so a compact solid costs O(depth · log n); at
+    /// worst O(n log n).
     #[must_use]
     pub fn bbox(&self) -> Option<(Voxel, Voxel)> {
-        // Dilated integers compare as the integers do, so the extremes are taken on
-        // the dilated axis components of the codes and undilated once at the end.
-        self.leaves.first()?;
-        let mut lo = [u64::MAX; 3];
-        let mut hi = [0u64; 3];
-        for l in &self.leaves {
-            // First and last code of the leaf, straight off the packed form.
-            let p = l.packed();
-            let m = p ^ p.wrapping_add(1);
-            let (c, last) = ((p & !m) >> 1, (p | m) >> 1);
-            for a in 0..3 {
-                let (l, h) = ((c >> a) & arith::MASK_X, (last >> a) & arith::MASK_X);
-                if l < lo[a] {
-                    lo[a] = l;
-                }
-                if h > hi[a] {
-                    hi[a] = h;
-                }
-            }
+        if self.leaves.is_empty() {
+            return None;
         }
-        let world = |d: u64, a: usize| self.origin[a] + i64::from(code::undilate3(d));
-        Some((
-            std::array::from_fn(|a| world(lo[a], a)),
-            std::array::from_fn(|a| world(hi[a], a)),
-        ))
+        let mut lo = [0i64; 3];
+        let mut hi = [0i64; 3];
+        for a in 0..3 {
+            let mut best = u64::MAX;
+            extreme(&self.leaves, 0, self.depth, [0; 3], a, false, &mut best);
+            lo[a] = self.origin[a] + best as i64;
+            let mut best = u64::MAX;
+            extreme(&self.leaves, 0, self.depth, [0; 3], a, true, &mut best);
+            // For the maximum the search minimises a reversed coordinate.
+            hi[a] = self.origin[a] + (REVERSED_TOP - best) as i64;
+        }
+        Some((lo, hi))
     }
 
     /// Whether world voxel `v` is black.
@@ -372,6 +367,81 @@ fn check_depth(depth: u8) -> Result<(), OctreeError> {
     Ok(())
 }
 
+/// The least coordinate on `axis` of a black voxel in the cell `(code, k)` whose
+/// lowest voxel is `min` (relative), over `leaves` (all inside the cell or one
+/// covering it); with `reversed`, of the coordinate counted from the top of the
+/// space. Lowers `best`; skips cells that cannot beat it.
+fn extreme(
+    leaves: &[Leaf],
+    code: u64,
+    k: u8,
+    min: [u64; 3],
+    axis: usize,
+    reversed: bool,
+    best: &mut u64,
+) {
+    if leaves.is_empty() {
+        return;
+    }
+    // The cell's own extreme on the axis, in the search's direction.
+    let cell_near = cell_near(min, k, axis, reversed);
+    if cell_near >= *best {
+        return;
+    }
+    if leaves.len() == 1 && leaves[0].size_log2() >= k {
+        *best = cell_near;
+        return;
+    }
+    let half = 1u64 << (k - 1);
+    let child = 1u64 << (3 * u32::from(k - 1));
+    let mut parts: [&[Leaf]; 8] = [&[]; 8];
+    let mut rest = leaves;
+    for (d, part) in parts.iter_mut().enumerate() {
+        let end = code + (d as u64 + 1) * child;
+        let n = rest.partition_point(|l| l.packed() < end << 1);
+        *part = &rest[..n];
+        rest = &rest[n..];
+    }
+    // Visit the near half on the axis first: it is the likelier to hold the best.
+    let near_bit = usize::from(reversed);
+    for side in [near_bit, 1 - near_bit] {
+        for (d, part) in parts.iter().enumerate() {
+            if (d >> axis) & 1 != side {
+                continue;
+            }
+            let m = [
+                min[0] + (d as u64 & 1) * half,
+                min[1] + ((d as u64 >> 1) & 1) * half,
+                min[2] + ((d as u64 >> 2) & 1) * half,
+            ];
+            extreme(
+                part,
+                code + d as u64 * child,
+                k - 1,
+                m,
+                axis,
+                reversed,
+                best,
+            );
+        }
+    }
+}
+
+/// Reversed coordinates count down from here, so that one minimising search finds
+/// both faces: the highest coordinate `c` is the least `REVERSED_TOP - c`.
+const REVERSED_TOP: u64 = u64::MAX >> 1;
+
+/// The best coordinate any voxel of the cell could give the search: the cell's
+/// lowest on `axis`, or (reversed) its highest, reversed.
+#[inline]
+fn cell_near(min: [u64; 3], k: u8, axis: usize, reversed: bool) -> u64 {
+    if reversed {
+        REVERSED_TOP - (min[axis] + (1u64 << k) - 1)
+    } else {
+        min[axis]
+    }
+}
+
 /// Whether eight leaves (sorted, disjoint) are the eight children of one parent.
 fn completes_parent(run: &[Leaf]) -> bool {
     let k = run[0].size_log2();
@@ -379,6 +449,30 @@ fn completes_parent(run: &[Leaf]) -> bool {
     run.iter().all(|l| l.size_log2() == k)
         && run[0].code() % parent_cells == 0
         && run[7].code() == run[0].code() + 7 * run[0].voxel_count()
+}
+
+/// [`completes_parent`] on packed values: the eight leaves are children 0..=7 of one
+/// parent exactly when their packed forms step by `2 · 8^k` from a child 0.
+#[inline]
+fn completes_parent_fast(run: &[Leaf]) -> bool {
+    let p0 = run[0].packed();
+    let t = p0.trailing_ones(); // 3k
+    if t + 4 > 64 {
+        return false;
+    }
+    // Child 0: the code's digit k is zero (packed bits t+1 ..= t+3).
+    if (p0 >> (t + 1)) & 7 != 0 {
+        return false;
+    }
+    let step = 2u64 << t;
+    let mut want = p0;
+    for l in &run[1..8] {
+        want += step;
+        if l.packed() != want {
+            return false;
+        }
+    }
+    true
 }
 
 /// Appends `leaf` (which follows every leaf in `out`) and merges complete sibling
@@ -391,7 +485,7 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
     if p.checked_shr(p.trailing_ones() + 1).unwrap_or(0) & 7 != 7 {
         return;
     }
-    while out.len() >= 8 && completes_parent(&out[out.len() - 8..]) {
+    while out.len() >= 8 && completes_parent_fast(&out[out.len() - 8..]) {
         let first = out[out.len() - 8];
         out.truncate(out.len() - 8);
         out.push(Leaf::new(first.code(), first.size_log2() + 1));

@@ -200,7 +200,9 @@ impl<'a> Part<'a> {
         let mut rest = leaves;
         for (d, part) in parts.iter_mut().enumerate().take(7) {
             let end = code + (d as u64 + 1) * child;
-            let n = rest.partition_point(|l| l.code() < end);
+            // Packed leaves sort as codes, and a leaf ends by `end` exactly when
+            // its packed form is below `end << 1`.
+            let n = rest.partition_point(|l| l.packed() < end << 1);
             *part = Part::Leaves(&rest[..n]);
             rest = &rest[n..];
         }

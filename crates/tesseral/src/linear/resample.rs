@@ -47,7 +47,12 @@ struct Index {
 impl Index {
     /// Builds the index in one pass over the sorted leaves, keeping the path of open
     /// gray nodes on a stack.
-    fn new(leaves: &[Leaf], depth: u8) -> Self {
+    ///
+    /// With `compact` (for depth ≥ 2), the gray nodes of side 4 are the deepest
+    /// built: leaves of side 1 and 2 go straight into their 64-bit masks, and no
+    /// node of side 2 is made (they are most of the nodes, and only masks are read
+    /// at those levels).
+    fn new(leaves: &[Leaf], depth: u8, compact: bool) -> Self {
         let Some(first) = leaves.first() else {
             return Self {
                 nodes: Vec::new(),
@@ -67,8 +72,16 @@ impl Index {
         let d = u32::from(depth);
         let mut nodes: Vec<[u32; 8]> = Vec::with_capacity(leaves.len() / 3 + 1);
         let mut levels: Vec<u8> = Vec::with_capacity(leaves.len() / 3 + 1);
+        let mut masks: Vec<u64> = Vec::new();
         nodes.push([EMPTY; 8]);
         levels.push(depth);
+        if compact {
+            masks.reserve(leaves.len() / 6 + 1);
+            masks.push(0);
+        }
+        debug_assert!(!compact || depth >= 2);
+        // In compact mode, leaves below side 4 are held by the node of side 4.
+        let holder = if compact { d - 1 } else { d + 1 };
         let mut stack: Vec<u32> = Vec::with_capacity(usize::from(depth) + 1);
         stack.push(0);
         let mut prev = first.code();
@@ -81,18 +94,33 @@ impl Index {
             } else {
                 d - 1 - (63 - diff.leading_zeros()) / 3
             };
-            let keep = common.min(leaf_depth - 1) as usize + 1;
+            let small = leaf_depth >= holder;
+            let target = if small { holder } else { leaf_depth };
+            let keep = common.min(target - 1) as usize + 1;
             stack.truncate(keep);
-            while (stack.len() as u32) < leaf_depth {
+            while (stack.len() as u32) < target {
                 let parent = *stack.last().expect("root stays on the stack") as usize;
                 let digit = (c >> (3 * (d - stack.len() as u32))) & 7;
                 let id = nodes.len() as u32;
                 nodes.push([EMPTY; 8]);
                 levels.push(depth - stack.len() as u8);
+                if compact {
+                    masks.push(0);
+                }
                 nodes[parent][digit as usize] = id + 2;
                 stack.push(id);
             }
             let parent = *stack.last().expect("root stays on the stack") as usize;
+            if small {
+                let base = octant_shift(((c >> 3) & 7) as usize);
+                masks[parent] |= if leaf.size_log2() == 1 {
+                    OCTANT << base
+                } else {
+                    1 << (base + octant_shift((c & 7) as usize) / 2)
+                };
+                prev = c;
+                continue;
+            }
             let digit = (c >> (3 * (d - leaf_depth))) & 7;
             nodes[parent][digit as usize] = FULL;
             prev = c;
@@ -100,7 +128,7 @@ impl Index {
         Self {
             nodes,
             levels,
-            masks: Vec::new(),
+            masks,
             root: 2,
         }
     }
@@ -190,61 +218,130 @@ const fn repeat(pattern: u64, width: u32) -> u64 {
     out
 }
 
-/// The 4 × 4 × 4 block at offset `r` (each in 0..4) inside the 8 × 8 × 8 region
-/// made of the eight blocks `m` (index `x + 2y + 4z`), all in layout `x + 4y + 16z`.
+/// How to cut a 4 × 4 × 4 block at offset `r` (each in 0..4) out of the 8 × 8 × 8
+/// region of eight blocks: the shifts and the masks of the bits that come from the
+/// lower block on each axis, computed once per resample.
+#[derive(Clone, Copy)]
+struct Cut {
+    r: [u32; 3],
+    low_x: u64,
+    low_y: u64,
+}
+
+impl Cut {
+    fn new(r: [i64; 3]) -> Self {
+        let r = r.map(|v| v as u32);
+        Self {
+            r,
+            low_x: repeat((1 << (4 - r[0])) - 1, 4),
+            low_y: repeat((1 << (4 * (4 - r[1]))) - 1, 16),
+        }
+    }
+
+    /// The block, from the eight blocks `m` (index `x + 2y + 4z`), all in layout
+    /// `x + 4y + 16z`.
+    #[inline]
+    fn extract(&self, m: [u64; 8]) -> u64 {
+        let [rx, ry, rz] = self.r;
+        let sx = |a: u64, b: u64| -> u64 {
+            if rx == 0 {
+                a
+            } else {
+                ((a >> rx) & self.low_x) | ((b << (4 - rx)) & !self.low_x)
+            }
+        };
+        let sy = |a: u64, b: u64| -> u64 {
+            if ry == 0 {
+                a
+            } else {
+                ((a >> (4 * ry)) & self.low_y) | ((b << (4 * (4 - ry))) & !self.low_y)
+            }
+        };
+        let p0 = sy(sx(m[0], m[1]), sx(m[2], m[3]));
+        if rz == 0 {
+            return p0;
+        }
+        let p1 = sy(sx(m[4], m[5]), sx(m[6], m[7]));
+        (p0 >> (16 * rz)) | (p1 << (16 * (4 - rz)))
+    }
+}
+
+/// Appends the canonical leaves of a 4 × 4 × 4 block (bit `x + 4y + 16z`) whose
+/// lowest voxel has code `code`.
 #[inline]
-fn extract(m: [u64; 8], r: [i64; 3]) -> u64 {
-    let sx = |a: u64, b: u64| -> u64 {
-        let r = r[0] as u32;
-        if r == 0 {
-            return a;
+fn emit_block(block: u64, code: u64, out: &mut Vec<Leaf>) {
+    if block == u64::MAX {
+        out.push(Leaf::new(code, 2));
+        return;
+    }
+    if block == 0 {
+        return;
+    }
+    for d in 0..8usize {
+        let x = block >> octant_shift(d);
+        // The octant's eight voxels as a byte, bit e for voxel label e.
+        let byte = (x & 0x3) | ((x >> 2) & 0xc) | ((x >> 12) & 0x30) | ((x >> 14) & 0xc0);
+        let c = code + 8 * d as u64;
+        if byte == 0xff {
+            out.push(Leaf::new(c, 1));
+            continue;
         }
-        let low = repeat((1 << (4 - r)) - 1, 4);
-        ((a >> r) & low) | ((b << (4 - r)) & !low)
-    };
-    let sy = |a: u64, b: u64| -> u64 {
-        let r = r[1] as u32;
-        if r == 0 {
-            return a;
+        let mut bits = byte;
+        while bits != 0 {
+            let e = u64::from(bits.trailing_zeros());
+            out.push(Leaf::new(c + e, 0));
+            bits &= bits - 1;
         }
-        let low = repeat((1 << (4 * (4 - r))) - 1, 16);
-        ((a >> (4 * r)) & low) | ((b << (4 * (4 - r))) & !low)
-    };
-    let sz = |a: u64, b: u64| -> u64 {
-        let r = r[2] as u32;
-        if r == 0 {
-            return a;
-        }
-        (a >> (16 * r)) | (b << (16 * (4 - r)))
-    };
-    let p0 = sy(sx(m[0], m[1]), sx(m[2], m[3]));
-    let p1 = sy(sx(m[4], m[5]), sx(m[6], m[7]));
-    sz(p0, p1)
+    }
 }
 
 /// For one depth: which parent-window entry and which child digit each of the eight
 /// window entries of each of the eight children reads.
-type ChildTable = [[(u8, u8); 8]; 8];
+/// Children's windows are drawn from a 3 × 3 × 3 grid of input cells of half the
+/// side (the parent window's children that the children's preimages can touch).
+#[derive(Clone, Copy)]
+struct ChildTable {
+    /// For each grid cell: the parent-window entry and the child digit it is.
+    grid: [(u8, u8); 27],
+    /// For each child and each of its window entries: the grid cell.
+    pick: [[u8; 8]; 8],
+}
+
+const EMPTY_TABLE: ChildTable = ChildTable {
+    grid: [(0, 0); 27],
+    pick: [[0; 8]; 8],
+};
 
 fn child_table(r: [i64; 3], k: u8) -> ChildTable {
     // r: the offset of the preimage inside window cell 0 at depth k (side 2^k).
+    // Along each axis the children's cells are u = base + d + e in the 4-wide grid
+    // of the parent window's children, base = r >> (k - 1); g = u - base is 0..=2.
     let half = 1i64 << (k - 1);
-    let mut t = [[(0u8, 0u8); 8]; 8];
-    for (d, row) in t.iter_mut().enumerate() {
+    let mut t = EMPTY_TABLE;
+    for (g, entry) in t.grid.iter_mut().enumerate() {
+        let (mut parent, mut digit) = (0u8, 0u8);
+        for (a, ga) in [g % 3, (g / 3) % 3, g / 9].into_iter().enumerate() {
+            let u = (r[a] >> (k - 1)) + ga as i64;
+            // u can reach 4 only for a grid cell no child picks: clamp it.
+            let u = u.min(3);
+            parent |= ((u >> 1) as u8) << a;
+            digit |= ((u & 1) as u8) << a;
+        }
+        *entry = (parent, digit);
+    }
+    for (d, row) in t.pick.iter_mut().enumerate() {
         for (e, entry) in row.iter_mut().enumerate() {
-            let (mut parent, mut digit) = (0u8, 0u8);
-            for a in 0..3 {
-                let da = ((d >> a) & 1) as i64;
-                let mut ea = ((e >> a) & 1) as i64;
+            let mut g = 0;
+            for (a, scale) in [1usize, 3, 9].into_iter().enumerate() {
+                let da = (d >> a) & 1;
+                let mut ea = (e >> a) & 1;
                 // An aligned axis needs one cell: duplicate entry 0.
                 if r[a] % half == 0 {
                     ea = 0;
                 }
-                let u = (r[a] >> (k - 1)) + da + ea;
-                parent |= ((u >> 1) as u8) << a;
-                digit |= ((u & 1) as u8) << a;
+                g += (da + ea) * scale;
             }
-            *entry = (parent, digit);
+            *entry = g as u8;
         }
     }
     t
@@ -256,8 +353,12 @@ const PARALLEL_MIN_SIZE_LOG2: u8 = 7;
 
 struct Resampler<'a> {
     index: &'a Index,
-    /// The offset of the preimage in its window at side 4.
-    r2: [i64; 3],
+    /// Cuts a child's 4 × 4 × 4 block out of its window at side 4.
+    cut: Cut,
+    /// The output depth and the input's leaf count: a guess at each parallel
+    /// part's size, so that parts rarely reallocate.
+    depth: u8,
+    input_leaves: usize,
     /// `tables[k]` serves the children of an output cell of side `2^k`.
     tables: Vec<ChildTable>,
 }
@@ -278,39 +379,46 @@ impl Resampler<'_> {
             for (mask, &slot) in m.iter_mut().zip(window.iter()) {
                 *mask = self.index.mask(slot);
             }
-            let block = extract(m, self.r2);
-            if block == u64::MAX {
-                out.push(Leaf::new(code, 2));
-            } else if block != 0 {
-                for d in 0..8usize {
-                    let oct = OCTANT << octant_shift(d);
-                    let c = code + 8 * d as u64;
-                    if block & oct == oct {
-                        out.push(Leaf::new(c, 1));
-                    } else if block & oct != 0 {
-                        for e in 0..8usize {
-                            if block >> (octant_shift(d) + octant_shift(e) / 2) & 1 == 1 {
-                                out.push(Leaf::new(c + e as u64, 0));
-                            }
-                        }
-                    }
-                }
-            }
+            emit_block(self.cut.extract(m), code, out);
             return;
         }
         let table = &self.tables[usize::from(k)];
         let child_cells = 1u64 << (3 * u32::from(k - 1));
+        let mut grid = [EMPTY; 27];
+        for (slot, &(p, digit)) in grid.iter_mut().zip(table.grid.iter()) {
+            *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+        }
+        if k == 3 {
+            // The children are 4 x 4 x 4 blocks: read the grid's occupancy masks
+            // once and cut each child's block out of them directly.
+            let mut masks = [0u64; 27];
+            for (m, &slot) in masks.iter_mut().zip(grid.iter()) {
+                *m = self.index.mask(slot);
+            }
+            for (d, row) in table.pick.iter().enumerate() {
+                let mut m = [0u64; 8];
+                for (mask, &g) in m.iter_mut().zip(row.iter()) {
+                    *mask = masks[usize::from(g)];
+                }
+                emit_block(self.cut.extract(m), code + 64 * d as u64, out);
+            }
+            if let Some(last) = out.pop() {
+                push_merging(out, last);
+            }
+            return;
+        }
         let mut windows = [[EMPTY; 8]; 8];
-        for (row, w) in table.iter().zip(windows.iter_mut()) {
-            for (&(p, digit), slot) in row.iter().zip(w.iter_mut()) {
-                *slot = self.index.child(window[usize::from(p)], usize::from(digit));
+        for (row, w) in table.pick.iter().zip(windows.iter_mut()) {
+            for (&g, slot) in row.iter().zip(w.iter_mut()) {
+                *slot = grid[usize::from(g)];
             }
         }
         if k >= PARALLEL_MIN_SIZE_LOG2 {
             let parts: Vec<Vec<Leaf>> = (0..8usize)
                 .into_par_iter()
                 .map(|d| {
-                    let mut part = Vec::new();
+                    let share = self.input_leaves >> (3 * u32::from(self.depth - k + 1));
+                    let mut part = Vec::with_capacity(share + share / 4 + 16);
                     self.cell(k - 1, windows[d], code + d as u64 * child_cells, &mut part);
                     part
                 })
@@ -410,7 +518,8 @@ impl LinearOctree {
 
     /// The general top-down resample; `delta` is the new origin minus ours.
     pub(super) fn resample_general(&self, depth: u8, delta: [i64; 3]) -> Vec<Leaf> {
-        let mut index = Index::new(&self.leaves, self.depth);
+        let compact = self.depth >= 2 && depth >= 2;
+        let mut index = Index::new(&self.leaves, self.depth, compact);
         // Wrap the input in gray ancestors until it is at least as deep as the
         // output (the input space becomes child 0 of each new root), so windows at
         // every output depth can be read from the index.
@@ -420,16 +529,21 @@ impl LinearOctree {
             node[0] = index.root;
             index.nodes.push(node);
             index.levels.push(src_depth + 1);
+            if compact {
+                index.masks.push(0);
+            }
             index.root = index.nodes.len() as u32 + 1;
             src_depth += 1;
         }
-        index.fill_masks();
+        if !compact {
+            index.fill_masks();
+        }
         let side = |k: u8| 1i64 << k;
         let r = |k: u8| -> [i64; 3] { delta.map(|v| v.rem_euclid(side(k))) };
         let tables = (0..=depth)
             .map(|k| {
                 if k == 0 {
-                    [[(0, 0); 8]; 8]
+                    EMPTY_TABLE
                 } else {
                     child_table(r(k), k)
                 }
@@ -448,7 +562,9 @@ impl LinearOctree {
         });
         let resampler = Resampler {
             index: &index,
-            r2: r(2.min(depth)),
+            cut: Cut::new(r(2.min(depth))),
+            depth,
+            input_leaves: self.leaves.len(),
             tables,
         };
         let mut out = Vec::with_capacity(self.leaves.len());
@@ -467,44 +583,61 @@ impl LinearOctree {
         all_inside: bool,
     ) -> Option<Vec<Leaf>> {
         let max_k = self.leaves.iter().map(|l| l.size_log2()).max().unwrap_or(0);
-        if delta.iter().any(|&v| v.rem_euclid(1 << max_k) != 0) {
+        // Cells of side 2^a move whole: a is the displacement's alignment, capped
+        // by the new space; every leaf must fit in such a cell.
+        let align = delta
+            .iter()
+            .map(|&v| if v == 0 { 64 } else { v.trailing_zeros() })
+            .min()
+            .unwrap_or(64);
+        let a = align.min(u32::from(depth)) as u8;
+        if max_k > a {
             return None;
         }
-        // New relative coordinate = old - delta, kept when inside [0, 2^depth).
-        let lo = delta;
         let side = 1i64 << depth;
-        // A leaf larger than the new space would be cut: not this path.
-        if max_k > depth {
-            return None;
-        }
-        // Kept leaves land inside [0, 2^depth), so the 21-bit modular tesseral sum
-        // is exact for them.
+        // The tesseral sum is taken modulo 2^21 per axis; kept cells land inside
+        // [0, 2^depth), where it is exact. The displacement's low `a` digits are
+        // zero, so a leaf's digits below `a` ride along unchanged.
         let t = arith::displacement_code([-delta[0], -delta[1], -delta[2]]);
-        let inside = |l: &Leaf| {
-            let v = code::decode(l.code());
-            (0..3).all(|a| {
-                let c = i64::from(v[a]) - lo[a];
+        let shift = 3 * u32::from(a);
+        let low = (1u64 << shift) - 1;
+        let inside = |cell: u64| {
+            let v = code::decode(cell);
+            (0..3).all(|i| {
+                let c = i64::from(v[i]) - delta[i];
                 c >= 0 && c < side
             })
         };
-        let mut moved: Vec<Leaf> = if all_inside {
-            self.leaves
-                .iter()
-                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
-                .collect()
-        } else {
-            self.leaves
-                .iter()
-                .filter(|l| inside(l))
-                .map(|l| Leaf::new(arith::add(l.code(), t), l.size_log2()))
-                .collect()
-        };
-        if !moved.is_sorted() {
-            super::sort::sort_leaves(&mut moved);
+        // Runs of leaves sharing a cell, with the cell's new code.
+        let mut runs: Vec<(u64, usize, usize)> = Vec::new();
+        let mut rest = &self.leaves[..];
+        let mut start = 0;
+        while let Some(first) = rest.first() {
+            let cell = first.code() & !low;
+            let end_code = cell + low + 1;
+            let n = rest.partition_point(|l| l.packed() < end_code << 1);
+            if all_inside || inside(cell) {
+                runs.push((arith::add(cell, t), start, start + n));
+            }
+            start += n;
+            rest = &rest[n..];
         }
-        let mut out = Vec::with_capacity(moved.len());
-        for l in moved {
-            push_merging(&mut out, l);
+        if !runs.is_sorted_by_key(|r| r.0) {
+            runs.sort_unstable_by_key(|r| r.0);
+        }
+        let mut out = Vec::with_capacity(self.leaves.len());
+        for (cell, i, j) in runs {
+            let part = &self.leaves[i..j];
+            if part.len() == 1 && part[0].size_log2() == a {
+                // A full cell: it may complete a parent with its new neighbours.
+                push_merging(&mut out, Leaf::new(cell, a));
+            } else {
+                // Partly full: canonical inside, and no parent can be completed.
+                out.extend(
+                    part.iter()
+                        .map(|l| Leaf::new(cell | (l.code() & low), l.size_log2())),
+                );
+            }
         }
         Some(out)
     }

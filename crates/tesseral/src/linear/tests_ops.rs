@@ -207,6 +207,14 @@ proptest! {
         let m = offset(&shape(depth, kind, seed), o);
         let a = canonical(depth, o, &m);
         let hi = [lo[0] + ext[0], lo[1] + ext[1], lo[2] + ext[2]];
+        // The bounding box against the model's.
+        let model_bbox = (!m.is_empty()).then(|| {
+            let f = |g: fn(i64, i64) -> i64, init: i64| -> Voxel {
+                std::array::from_fn(|i| m.iter().map(|v| v[i]).fold(init, g))
+            };
+            (f(i64::min, i64::MAX), f(i64::max, i64::MIN))
+        });
+        prop_assert_eq!(a.bbox(), model_bbox);
         let c = a.crop(lo, hi);
         c.assert_valid();
         let want: Model = m.iter().copied().filter(|v| (0..3).all(|i| v[i] >= lo[i] && v[i] <= hi[i])).collect();
@@ -335,4 +343,42 @@ fn errors_are_reported_not_panics() {
         LinearOctree::from_dense(1, [0, 0, 0], [3, 2, 2], &[0]),
         Err(OctreeError::OutOfBounds(_))
     ));
+}
+
+#[test]
+fn fast_sibling_check_matches_the_reference() {
+    let mut s = 0x7777_1234_u64;
+    let mut next = move || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    };
+    for _ in 0..20_000 {
+        // Mostly near-sibling runs: a random parent, sizes and gaps perturbed.
+        let k = (next() % 4) as u8;
+        let parent = (next() % 64) << (3 * (u32::from(k) + 1));
+        let mut run = Vec::new();
+        let mut code = parent;
+        for _ in 0..8 {
+            let kk = if next() % 10 == 0 {
+                k.saturating_sub(1)
+            } else {
+                k
+            };
+            if next() % 12 == 0 {
+                code += 1 << (3 * u32::from(kk));
+            }
+            run.push(Leaf::new(code, kk));
+            code += 1 << (3 * u32::from(kk));
+        }
+        if next() % 5 == 0 {
+            run[0] = Leaf::new(parent + (1 << (3 * u32::from(k))), k);
+        }
+        assert_eq!(
+            super::completes_parent_fast(&run),
+            super::completes_parent(&run),
+            "{run:?}"
+        );
+    }
 }

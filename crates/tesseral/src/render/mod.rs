@@ -705,14 +705,14 @@ fn shade_hit(
     if opts.outline {
         let size = (1i64 << h.size_log2) as f64;
         let mut edge = f64::INFINITY;
-        for ax in 0..3 {
+        for (ax, (&pa, &ba)) in p.iter().zip(&h.block_min).enumerate() {
             if ax == h.axis && !cut {
                 continue;
             }
             if cut && ax == opts.clip.map_or(3, |c| c.axis) {
                 continue;
             }
-            let u = p[ax] - h.block_min[ax] as f64;
+            let u = pa - ba as f64;
             edge = edge.min(u.abs()).min((size - u).abs());
         }
         let width = frame.pixel_size(h.t, opts.height) * 0.75;

@@ -137,10 +137,10 @@ fn traversal_equals_brute_force_over_blocks() {
                     // The hit point lies in the block reported.
                     let p = ray.at(h.t);
                     let s = (1i64 << h.size_log2) as f64;
-                    for a in 0..3 {
-                        let lo = h.block_min[a] as f64;
+                    for (&pa, &b) in p.iter().zip(&h.block_min) {
+                        let lo = b as f64;
                         assert!(
-                            p[a] >= lo - 1e-6 && p[a] <= lo + s + 1e-6,
+                            pa >= lo - 1e-6 && pa <= lo + s + 1e-6,
                             "trial {trial} ray {i}"
                         );
                     }
@@ -541,4 +541,67 @@ fn section_shows_the_layer_and_its_blocks() {
     assert!(lines > 0);
     let empty = section(&tree, Surface::default(), 2, 15, 1);
     assert!(empty.pixels.iter().all(|&p| p == [255, 255, 255]));
+}
+
+/// The beams only skip space: every primary ray hits what a ray cast alone hits.
+#[test]
+fn beams_change_no_hit() {
+    let seed = 0xbea4_u64;
+    println!("seed {seed:#x}");
+    let mut rng = Rng(seed);
+    for trial in 0..8 {
+        let tree = random_tree(&mut rng, 6, [0, 0, 0]);
+        let rt = RayTree::new(&tree);
+        let camera = Camera {
+            azimuth_deg: rng.range(-180.0, 180.0),
+            elevation_deg: rng.range(-80.0, 80.0),
+            zoom: rng.range(0.8, 2.5),
+            projection: if trial % 2 == 0 {
+                Projection::Orthographic
+            } else {
+                Projection::Perspective {
+                    fov_deg: rng.range(20.0, 70.0),
+                }
+            },
+        };
+        let clip = (trial % 3 == 0).then(|| Clip {
+            axis: trial % 3,
+            at: rng.range(10.0, 50.0),
+            keep_above: trial % 4 == 0,
+        });
+        let opts = RenderOptions {
+            width: 90,
+            height: 70,
+            camera,
+            clip,
+            ..Default::default()
+        };
+        let frame = Frame::new(&rt, &opts);
+        let mut stack = TraversalStack::default();
+        let mut checked = 0;
+        trace_block(
+            &rt,
+            &frame,
+            &opts,
+            [0, 90],
+            [0, 70],
+            &mut stack,
+            |x, y, ray, hit| {
+                let (t0, t1) = clip_interval(ray, opts.clip);
+                let alone = if t0 <= t1 { rt.cast(ray, t0, t1) } else { None };
+                match (hit, alone) {
+                    (None, None) => {}
+                    (Some(a), Some(b)) => assert!(
+                        (a.t - b.t).abs() < 1e-6 * (1.0 + b.t.abs()) && a.at_start == b.at_start,
+                        "seed {seed:#x} trial {trial} pixel {x},{y}: {a:?} vs {b:?}"
+                    ),
+                    (a, b) => panic!(
+                        "seed {seed:#x} trial {trial} pixel {x},{y}: beam {a:?}, alone {b:?}"
+                    ),
+                }
+                checked += 1;
+            },
+        );
+        assert_eq!(checked, 90 * 70);
+    }
 }

@@ -457,17 +457,9 @@ impl RayTree {
 }
 
 /// Scratch space for [`RayTree::cast_with`]: one entry per tree depth.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub struct TraversalStack {
     levels: [Level; 22],
-}
-
-impl Default for TraversalStack {
-    fn default() -> Self {
-        Self {
-            levels: [Level::default(); 22],
-        }
-    }
 }
 
 /// One node on the traversal stack.
@@ -550,8 +542,8 @@ fn min3(t: [f64; 3]) -> f64 {
 fn first_child(t0: [f64; 3], tm: [f64; 3]) -> u8 {
     let (entry_axis, t) = argmax(t0);
     let mut c = 0u8;
-    for ax in 0..3 {
-        if ax != entry_axis && tm[ax] < t {
+    for (ax, &m) in tm.iter().enumerate() {
+        if ax != entry_axis && m < t {
             c |= 1 << ax;
         }
     }

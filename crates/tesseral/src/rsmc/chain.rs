@@ -389,6 +389,39 @@ impl<L: Lattice> Chain<L> {
         self.lattice = fresh;
     }
 
+    /// Checks the chain's bookkeeping against its lattice: the counters add up, the
+    /// coordinate sums match the voxels, the voxel count and area match, and the
+    /// surface passes the global sphere check. O(V log V).
+    ///
+    /// # Panics
+    /// When something does not hold.
+    pub fn assert_valid(&self) {
+        let k = self.counters;
+        assert_eq!(
+            k.steps,
+            k.accepted + k.illegal + k.capped + k.refused,
+            "counters {k:?}"
+        );
+        assert!(k.grown <= k.accepted, "counters {k:?}");
+        let voxels = self.voxels();
+        assert_eq!(
+            voxels.len() as u64,
+            self.lattice.voxel_count(),
+            "voxel count"
+        );
+        let mut sum = [0i128; 3];
+        let mut sum_sq = 0i128;
+        for v in &voxels {
+            for a in 0..3 {
+                sum[a] += i128::from(v[a]);
+                sum_sq += i128::from(v[a]) * i128::from(v[a]);
+            }
+        }
+        assert_eq!((sum, sum_sq), (self.sum, self.sum_sq), "coordinate sums");
+        let report = topology::check_sphere(&voxels).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(report.faces, self.area(), "area");
+    }
+
     /// Canonicalizes (see [`Chain::canonicalize`]) and returns the state.
     #[must_use]
     pub fn checkpoint(&mut self) -> Checkpoint {

@@ -45,6 +45,27 @@ fn normalize(mut cells: Cells) -> Cells {
     cells
 }
 
+/// Every fixed polycube with one voxel more than those of `level`, normalized.
+fn grow_level(level: &[Cells]) -> Vec<Cells> {
+    let mut next: HashSet<Cells> = HashSet::new();
+    for cells in level {
+        let set: HashSet<[i8; 3]> = cells.iter().copied().collect();
+        for c in cells {
+            for d in DIRS {
+                let q = [c[0] + d[0] as i8, c[1] + d[1] as i8, c[2] + d[2] as i8];
+                if !set.contains(&q) {
+                    let mut grown = cells.clone();
+                    grown.push(q);
+                    next.insert(normalize(grown));
+                }
+            }
+        }
+    }
+    let mut out: Vec<Cells> = next.into_iter().collect();
+    out.sort_unstable();
+    out
+}
+
 /// The largest voxel count that can have area `max_area` or less.
 #[must_use]
 pub fn max_volume_for_area(max_area: u64) -> usize {
@@ -94,21 +115,7 @@ pub fn sphere_surfaces(max_area: u64) -> Result<Vec<Vec<Voxel>>, RsmcError> {
         if n == n_max {
             break;
         }
-        let mut next: HashSet<Cells> = HashSet::new();
-        for cells in &level {
-            let set: HashSet<[i8; 3]> = cells.iter().copied().collect();
-            for c in cells {
-                for d in DIRS {
-                    let q = [c[0] + d[0] as i8, c[1] + d[1] as i8, c[2] + d[2] as i8];
-                    if !set.contains(&q) {
-                        let mut grown = cells.clone();
-                        grown.push(q);
-                        next.insert(normalize(grown));
-                    }
-                }
-            }
-        }
-        level = next.into_iter().collect();
+        level = grow_level(&level);
     }
     Ok(out)
 }
@@ -151,6 +158,17 @@ pub fn area_distribution(counts: &[u64], beta: f64) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fixed_polycube_counts_match_oeis_a001931() {
+        let mut level: Vec<Cells> = vec![vec![[0, 0, 0]]];
+        let mut sizes = vec![level.len()];
+        for _ in 2..=6 {
+            level = grow_level(&level);
+            sizes.push(level.len());
+        }
+        assert_eq!(sizes, vec![1, 3, 15, 86, 534, 3481]);
+    }
 
     #[test]
     fn polycube_totals_match_known_counts() {

@@ -128,6 +128,7 @@ fn trajectories_keep_sphere_topology() {
             assert_eq!(report.volume, chain.volume(), "seed {seed}");
             assert_eq!(report.euler(), 2);
             chain.lattice().assert_valid();
+            chain.assert_valid();
         }
         let c = chain.counters();
         assert_eq!(c.steps, 20_000);
@@ -395,6 +396,7 @@ fn octree_and_dense_give_identical_trajectories() {
             b.radius_of_gyration().to_bits()
         );
         b.lattice().assert_valid();
+        b.assert_valid();
         // And after a checkpoint round trip on the other backend.
         let cp = a.checkpoint();
         let mut c = Chain::from_checkpoint(DynamicOctree::with_faces(), cp).unwrap();
@@ -405,4 +407,76 @@ fn octree_and_dense_give_identical_trajectories() {
         assert_eq!(b.faces(), c.faces());
         println!("seed {seed}: area {} volume {}", b.area(), b.volume());
     }
+}
+
+/// Libes §6, rule (i) as worded in the paper: "if the east and south neighbors do
+/// not exist, the east-south neighbor is retrieved from the octree. If it exists, the
+/// operation is rejected". Rule (ii), Fig. 4: creating a voxel whose only neighbours
+/// are its top and bottom ones would make a hole.
+#[test]
+fn libes_worked_examples_on_the_octree() {
+    use crate::dynamic::DynamicOctree;
+    use legality::{legal_grow, legal_shrink};
+    let p = [0, 0, 0];
+    // East = +x, south = −y, up = +z (DESIGN.md axes).
+    let mut t = DynamicOctree::with_faces();
+    t.insert([0, 0, -1]); // below p: p is proposed from this voxel's top face
+    t.insert([0, -1, -1]);
+    t.insert([1, -1, -1]);
+    t.insert([1, -1, 0]); // east-south of p, joined to the rest below
+    assert!(topology::check_sphere(&t.voxels()).is_ok());
+    assert!(!t.contains([1, 0, 0]) && !t.contains([0, -1, 0]));
+    assert!(
+        !legal_grow(t.neighbourhood(p)),
+        "rule (i): east and south empty, east-south black"
+    );
+    // Fill the east neighbour: now p and the east-south voxel share a face neighbour.
+    t.insert([1, 0, -1]);
+    t.insert([1, 0, 0]);
+    assert!(topology::check_sphere(&t.voxels()).is_ok());
+    assert!(legal_grow(t.neighbourhood(p)));
+    // Fig. 4: a column with a gap of one; only the top and bottom neighbours exist.
+    let mut c = DynamicOctree::with_faces();
+    for v in [
+        [0, 0, -1],
+        [0, 1, -1],
+        [0, 2, -1],
+        [0, 2, 0],
+        [0, 2, 1],
+        [0, 1, 1],
+        [0, 0, 1],
+    ] {
+        c.insert(v);
+    }
+    assert!(topology::check_sphere(&c.voxels()).is_ok());
+    assert!(
+        !legal_grow(c.neighbourhood(p)),
+        "rule (ii): would close a ring"
+    );
+    // Fig. 3 (deletion, rule (i)): deleting a voxel that would leave two voxels
+    // sharing only an edge.
+    let mut s = DynamicOctree::with_faces();
+    for v in [
+        [1, 0, 0],
+        [0, 0, 0],
+        [0, 1, 0],
+        [-1, 1, 0],
+        [1, 1, -1],
+        [1, 1, 0],
+    ] {
+        s.insert(v);
+    }
+    // (0,0,0) joins (1,0,0) and (0,1,0); with (1,1,0) black too, removing (0,0,0)
+    // leaves the square's other three: legal.
+    assert!(topology::check_sphere(&s.voxels()).is_ok());
+    assert!(legal_shrink(s.neighbourhood([0, 0, 0])));
+    // Removing (1,1,0) instead leaves (1,0,0) and (0,1,0) joined through (0,0,0):
+    // still legal; but without (0,0,0), removing (1,1,0) would leave (1,0,0) and
+    // (0,1,0) sharing only an edge.
+    s.remove([0, 0, 0]);
+    assert!(topology::check_sphere(&s.voxels()).is_ok());
+    assert!(
+        !legal_shrink(s.neighbourhood([1, 1, 0])),
+        "rule (i) on deletion"
+    );
 }
