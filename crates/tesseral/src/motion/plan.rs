@@ -563,7 +563,12 @@ pub fn plan(
     let search = astar(&space, start_cell, from, goal_cell, to, options.max_states)?;
     let raw = search.points;
     let waypoints = if options.smooth {
-        smooth(&BoxTree::new(environment), &BoxTree::new(object), rotation, &raw)
+        smooth(
+            &BoxTree::new(environment),
+            &BoxTree::new(object),
+            rotation,
+            &raw,
+        )
     } else {
         raw.clone()
     };
@@ -717,13 +722,7 @@ fn push_point(points: &mut Vec<Voxel>, p: Voxel) {
 
 /// Whether the object moves from `p` to `q` in a straight line without sharing a
 /// voxel with the environment at any instant.
-fn segment_free(
-    env: &BoxTree,
-    obj: &BoxTree,
-    rotation: Rotation,
-    p: Voxel,
-    q: Voxel,
-) -> bool {
+fn segment_free(env: &BoxTree, obj: &BoxTree, rotation: Rotation, p: Voxel, q: Voxel) -> bool {
     let mv = [0, 1, 2].map(|a| q[a] - p[a]);
     first_contact(
         Placed::fixed(env),

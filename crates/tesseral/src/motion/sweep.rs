@@ -115,10 +115,9 @@ pub struct SweptContact {
 fn slab_interval(a: &IBox, b: &IBox, v: Voxel) -> Option<(Option<Fraction>, Option<Fraction>)> {
     let mut lo: Option<Fraction> = None;
     let mut hi: Option<Fraction> = None;
-    for ax in 0..3 {
+    for (ax, &s) in v.iter().enumerate() {
         // Overlap on this axis: b.lo + t v < a.hi and a.lo < b.hi + t v.
         let (p, q) = (a.hi[ax] - b.lo[ax], a.lo[ax] - b.hi[ax]); // t v < p, t v > q
-        let s = v[ax];
         let (l, h) = match s.cmp(&0) {
             Ordering::Equal => {
                 if q < 0 && 0 < p {

@@ -244,8 +244,16 @@ fn prepared_trees_without_rotation_match_brute_force() {
         pa.assert_valid();
         pb.assert_valid();
         assert_eq!(intersects(&pa, &pb, place), shared > 0, "seed {seed}");
-        assert_eq!(interference(&pa, &pb, place, false).overlap_voxels, shared, "seed {seed}");
-        assert_eq!(interference(&a, &pb, place, false).overlap_voxels, shared, "seed {seed}");
+        assert_eq!(
+            interference(&pa, &pb, place, false).overlap_voxels,
+            shared,
+            "seed {seed}"
+        );
+        assert_eq!(
+            interference(&a, &pb, place, false).overlap_voxels,
+            shared,
+            "seed {seed}"
+        );
         hits[usize::from(shared > 0)] += 1;
     }
     assert!(hits[0] > 100 && hits[1] > 100, "{hits:?}");

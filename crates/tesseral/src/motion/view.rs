@@ -71,8 +71,16 @@ const fn axis_masks(axis: u32, at_least: bool) -> [u64; 5] {
     out
 }
 
-const GE: [[u64; 5]; 3] = [axis_masks(0, true), axis_masks(1, true), axis_masks(2, true)];
-const LT: [[u64; 5]; 3] = [axis_masks(0, false), axis_masks(1, false), axis_masks(2, false)];
+const GE: [[u64; 5]; 3] = [
+    axis_masks(0, true),
+    axis_masks(1, true),
+    axis_masks(2, true),
+];
+const LT: [[u64; 5]; 3] = [
+    axis_masks(0, false),
+    axis_masks(1, false),
+    axis_masks(2, false),
+];
 
 /// The 4³ mask `m` moved by `d` (each component in `-3..=3`); voxels leaving the cell
 /// are dropped.
@@ -96,7 +104,11 @@ fn cube_mask(min: [i32; 3], side: i32, cell: [i32; 3]) -> u64 {
     for z in 0..side {
         for y in 0..side {
             for x in 0..side {
-                let (i, j, k) = (min[0] - cell[0] + x, min[1] - cell[1] + y, min[2] - cell[2] + z);
+                let (i, j, k) = (
+                    min[0] - cell[0] + x,
+                    min[1] - cell[1] + y,
+                    min[2] - cell[2] + z,
+                );
                 m |= 1u64 << (i + 4 * j + 16 * k);
             }
         }
@@ -353,8 +365,8 @@ impl Traversable for BoxTree {
     #[inline]
     fn node_children(&self, n: &BoxRef, out: &mut [BoxRef; 8]) -> usize {
         let b = &self.nodes[n.0 as usize];
-        for i in 0..usize::from(b.count) {
-            out[i] = BoxRef(b.first + i as u32);
+        for (i, slot) in out.iter_mut().take(usize::from(b.count)).enumerate() {
+            *slot = BoxRef(b.first + i as u32);
         }
         usize::from(b.count)
     }

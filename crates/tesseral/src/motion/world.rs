@@ -15,8 +15,8 @@ use serde::Serialize;
 use super::interfere::{interference_placed, Aabb, Placed, Placement};
 use super::orient::Rotation;
 use super::plan::rotated;
-use super::view::BoxTree;
 use super::sweep::{first_contact, Fraction};
+use super::view::BoxTree;
 use crate::linear::{LinearOctree, OctreeError};
 use crate::pointer::PointerOctree;
 use crate::Voxel;
@@ -386,7 +386,7 @@ impl World {
                     between_steps: !still.intersects,
                 });
             }
-            step_contacts.sort_by(|x, y| x.fraction.cmp(&y.fraction));
+            step_contacts.sort_by_key(|x| x.fraction);
             contacts.extend(step_contacts);
             match self.method {
                 TranslationMethod::Offset => {}
