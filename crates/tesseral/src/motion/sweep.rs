@@ -261,9 +261,8 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Sweep<'_, A, B> {
 
 /// The first contact time of two voxel sets by brute force over every pair of voxels
 /// (for tests: obviously right, quadratic).
-#[doc(hidden)]
-#[must_use]
-pub fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fraction> {
+#[cfg(test)]
+pub(crate) fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fraction> {
     let unit = |p: Voxel| IBox {
         lo: p,
         hi: [p[0] + 1, p[1] + 1, p[2] + 1],
