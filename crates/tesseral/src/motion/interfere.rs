@@ -11,7 +11,7 @@ use serde::Serialize;
 
 use super::orient::Rotation;
 use super::traverse::Node;
-use super::view::Traversable;
+use super::view::{shift_mask, Traversable};
 use crate::linear::{Leaf, LinearOctree};
 use crate::Voxel;
 
@@ -200,6 +200,8 @@ struct Overlap<'t, A: Traversable + ?Sized, B: Traversable + ?Sized> {
     a: Placed<'t, A>,
     b: Placed<'t, B>,
     mode: Mode,
+    /// Whether 4³ masks may be compared (no rotation, no contact boxes wanted).
+    masks: bool,
     out: Interference,
 }
 
@@ -233,6 +235,27 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Overlap<'_, A, B> {
 
     /// Visits a pair of nodes whose placed boxes `ba` and `bb` overlap.
     fn visit(&mut self, na: A::Node, ba: IBox, nb: B::Node, bb: IBox) -> ControlFlow<()> {
+        if self.masks {
+            if let (Some((ca, ma)), Some((cb, mb))) =
+                (self.a.tree.small_mask(&na), self.b.tree.small_mask(&nb))
+            {
+                // Both nodes fit 4³ cells: compare them as bit masks at once.
+                let d = [0, 1, 2]
+                    .map(|i| cb[i] + self.b.place.offset[i] - ca[i] - self.a.place.offset[i]);
+                if d.iter().any(|c| c.abs() >= 4) {
+                    return ControlFlow::Continue(());
+                }
+                let m = ma & shift_mask(mb, d);
+                if m != 0 {
+                    self.out.intersects = true;
+                    if self.mode == Mode::Any {
+                        return ControlFlow::Break(());
+                    }
+                    self.out.overlap_voxels += u64::from(m.count_ones());
+                }
+                return ControlFlow::Continue(());
+            }
+        }
         let fa = self.a.tree.is_black(&na);
         let fb = self.b.tree.is_black(&nb);
         if fa && fb {
@@ -287,6 +310,9 @@ fn run_overlap<A: Traversable + ?Sized, B: Traversable + ?Sized>(
         a,
         b,
         mode,
+        masks: mode != Mode::Contacts
+            && a.place.rotation.is_identity()
+            && b.place.rotation.is_identity(),
         out: Interference::default(),
     };
     if let (Some(ra), Some(rb)) = (a.tree.root_node(), b.tree.root_node()) {

@@ -29,6 +29,7 @@ use super::interfere::{clearance_at, interference, IBox, Placed, Placement};
 use super::orient::Rotation;
 use super::sweep::first_contact;
 use super::traverse::Node;
+use super::view::BoxTree;
 use super::Aabb;
 use crate::code;
 use crate::linear::{Block, CellClass, Classifier, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
@@ -562,7 +563,12 @@ pub fn plan(
     let search = astar(&space, start_cell, from, goal_cell, to, options.max_states)?;
     let raw = search.points;
     let waypoints = if options.smooth {
-        smooth(environment, object, rotation, &raw)
+        smooth(
+            &BoxTree::new(environment),
+            &BoxTree::new(object),
+            rotation,
+            &raw,
+        )
     } else {
         raw.clone()
     };
@@ -716,13 +722,7 @@ fn push_point(points: &mut Vec<Voxel>, p: Voxel) {
 
 /// Whether the object moves from `p` to `q` in a straight line without sharing a
 /// voxel with the environment at any instant.
-fn segment_free(
-    env: &LinearOctree,
-    obj: &LinearOctree,
-    rotation: Rotation,
-    p: Voxel,
-    q: Voxel,
-) -> bool {
+fn segment_free(env: &BoxTree, obj: &BoxTree, rotation: Rotation, p: Voxel, q: Voxel) -> bool {
     let mv = [0, 1, 2].map(|a| q[a] - p[a]);
     first_contact(
         Placed::fixed(env),
@@ -741,7 +741,7 @@ fn segment_free(
 
 /// String pulling: from each kept waypoint, go straight to the farthest later
 /// waypoint reachable by a chain of free straight segments checked one at a time.
-fn smooth(env: &LinearOctree, obj: &LinearOctree, rotation: Rotation, raw: &[Voxel]) -> Vec<Voxel> {
+fn smooth(env: &BoxTree, obj: &BoxTree, rotation: Rotation, raw: &[Voxel]) -> Vec<Voxel> {
     let Some(&first) = raw.first() else {
         return Vec::new();
     };

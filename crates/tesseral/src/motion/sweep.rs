@@ -115,10 +115,9 @@ pub struct SweptContact {
 fn slab_interval(a: &IBox, b: &IBox, v: Voxel) -> Option<(Option<Fraction>, Option<Fraction>)> {
     let mut lo: Option<Fraction> = None;
     let mut hi: Option<Fraction> = None;
-    for ax in 0..3 {
+    for (ax, &s) in v.iter().enumerate() {
         // Overlap on this axis: b.lo + t v < a.hi and a.lo < b.hi + t v.
         let (p, q) = (a.hi[ax] - b.lo[ax], a.lo[ax] - b.hi[ax]); // t v < p, t v > q
-        let s = v[ax];
         let (l, h) = match s.cmp(&0) {
             Ordering::Equal => {
                 if q < 0 && 0 < p {
@@ -262,9 +261,8 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Sweep<'_, A, B> {
 
 /// The first contact time of two voxel sets by brute force over every pair of voxels
 /// (for tests: obviously right, quadratic).
-#[doc(hidden)]
-#[must_use]
-pub fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fraction> {
+#[cfg(test)]
+pub(crate) fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fraction> {
     let unit = |p: Voxel| IBox {
         lo: p,
         hi: [p[0] + 1, p[1] + 1, p[2] + 1],

@@ -224,6 +224,62 @@ fn interference_matches_brute_force() {
 }
 
 #[test]
+fn prepared_trees_without_rotation_match_brute_force() {
+    // Identity rotations let prepared trees compare 4³ cells as bit masks.
+    let mut hits = [0; 2];
+    for seed in 0..600u64 {
+        let mut rng = seeded("prepared_trees_without_rotation_match_brute_force", seed);
+        let (da, db) = (rng.random_range(0..=4), rng.random_range(0..=4));
+        let (xa, yb) = (rng.random_range(-9..9), rng.random_range(-9..9));
+        let (a, va) = random_solid(&mut rng, da, [xa, 0, 3]);
+        let (b, vb) = random_solid(&mut rng, db, [1, yb, -2]);
+        let offset = offset_near(&mut rng, &va, &vb, Rotation::IDENTITY, 3);
+        let place = Placement::at(offset);
+        let sa: HashSet<Voxel> = va.iter().copied().collect();
+        let shared = vb
+            .iter()
+            .filter(|v| sa.contains(&place.apply_voxel(**v)))
+            .count() as u64;
+        let (pa, pb) = (BoxTree::new(&a), BoxTree::new(&b));
+        pa.assert_valid();
+        pb.assert_valid();
+        assert_eq!(intersects(&pa, &pb, place), shared > 0, "seed {seed}");
+        assert_eq!(
+            interference(&pa, &pb, place, false).overlap_voxels,
+            shared,
+            "seed {seed}"
+        );
+        assert_eq!(
+            interference(&a, &pb, place, false).overlap_voxels,
+            shared,
+            "seed {seed}"
+        );
+        hits[usize::from(shared > 0)] += 1;
+    }
+    assert!(hits[0] > 100 && hits[1] > 100, "{hits:?}");
+}
+
+#[test]
+fn mask_shifts_match_moving_voxels() {
+    let mut rng = seeded("mask_shifts_match_moving_voxels", 7);
+    for _ in 0..2000 {
+        let m: u64 = rng.random();
+        let d = [0, 1, 2].map(|_| rng.random_range(-3..=3));
+        let mut want = 0u64;
+        for i in 0..64i64 {
+            if m >> i & 1 == 1 {
+                let p = [i & 3, (i >> 2) & 3, i >> 4];
+                let q = [0, 1, 2].map(|a| p[a] + d[a]);
+                if q.iter().all(|c| (0..4).contains(c)) {
+                    want |= 1 << (q[0] + 4 * q[1] + 16 * q[2]);
+                }
+            }
+        }
+        assert_eq!(super::view::shift_mask(m, d), want, "{m:x} by {d:?}");
+    }
+}
+
+#[test]
 fn first_contact_matches_brute_force_and_sampling() {
     let mut hits = [0; 3];
     for seed in 0..1000u64 {

@@ -43,6 +43,77 @@ pub trait Traversable: sealed::Sealed + Sync {
     /// The number of black voxels under the node.
     #[doc(hidden)]
     fn node_voxels(&self, n: &Self::Node) -> u64;
+    /// For a node inside a 4³ cell: that cell's lowest voxel (tree coordinates) and
+    /// the node's voxels in it as a 64-bit mask (bit `x + 4y + 16z`).
+    #[doc(hidden)]
+    #[inline]
+    fn small_mask(&self, _n: &Self::Node) -> Option<(Voxel, u64)> {
+        None
+    }
+}
+
+/// Bits of a 4³ mask whose coordinate on an axis is at least `s` (`GE`) or below `s`
+/// (`LT`), for x, y and z.
+const fn axis_masks(axis: u32, at_least: bool) -> [u64; 5] {
+    let mut out = [0u64; 5];
+    let mut s = 0;
+    while s < 5 {
+        let mut i = 0;
+        while i < 64 {
+            let c = (i >> (2 * axis)) & 3;
+            if (at_least && c >= s) || (!at_least && c < s) {
+                out[s as usize] |= 1 << i;
+            }
+            i += 1;
+        }
+        s += 1;
+    }
+    out
+}
+
+const GE: [[u64; 5]; 3] = [
+    axis_masks(0, true),
+    axis_masks(1, true),
+    axis_masks(2, true),
+];
+const LT: [[u64; 5]; 3] = [
+    axis_masks(0, false),
+    axis_masks(1, false),
+    axis_masks(2, false),
+];
+
+/// The 4³ mask `m` moved by `d` (each component in `-3..=3`); voxels leaving the cell
+/// are dropped.
+#[inline]
+pub(crate) fn shift_mask(mut m: u64, d: Voxel) -> u64 {
+    for a in 0..3 {
+        let s = d[a];
+        let unit = 2 * a as u32; // log2 of the bit stride: 1, 4, 16
+        if s > 0 {
+            m = (m << ((s as u32) << unit)) & GE[a][s as usize];
+        } else if s < 0 {
+            m = (m >> (((-s) as u32) << unit)) & LT[a][(4 + s) as usize];
+        }
+    }
+    m
+}
+
+/// The mask of the cube `[min, min + side)` inside the 4³ cell at `cell`.
+fn cube_mask(min: [i32; 3], side: i32, cell: [i32; 3]) -> u64 {
+    let mut m = 0;
+    for z in 0..side {
+        for y in 0..side {
+            for x in 0..side {
+                let (i, j, k) = (
+                    min[0] - cell[0] + x,
+                    min[1] - cell[1] + y,
+                    min[2] - cell[2] + z,
+                );
+                m |= 1u64 << (i + 4 * j + 16 * k);
+            }
+        }
+    }
+    m
 }
 
 impl Traversable for LinearOctree {
@@ -92,7 +163,11 @@ struct BoxNode {
     first: u32,
     /// Number of children; 0 for a black node.
     count: u8,
+    /// The cell's side as a power of two.
+    k: u8,
     voxels: u64,
+    /// For `k <= 2`: the node's voxels in its 4³ cell (see [`shift_mask`]).
+    mask: u64,
 }
 
 /// An octree prepared for repeated interference queries: every node carries the
@@ -141,7 +216,9 @@ impl BoxTree {
                 hi: [0; 3],
                 first: 0,
                 count: 0,
+                k: 0,
                 voxels: 0,
+                mask: 0,
             });
             t.fill(tree.leaves(), root, 0);
         }
@@ -154,12 +231,20 @@ impl BoxTree {
         let rel = |v: Voxel, o: Voxel| -> [i32; 3] { [0, 1, 2].map(|a| (v[a] - o[a]) as i32) };
         if n.is_full(leaves) {
             let s = n.side();
+            let lo = rel(n.min, self.origin);
+            let mask = if n.k <= 2 {
+                cube_mask(lo, s as i32, lo.map(|c| c & !3))
+            } else {
+                0
+            };
             self.nodes[at] = BoxNode {
-                lo: rel(n.min, self.origin),
+                lo,
                 hi: rel([n.min[0] + s, n.min[1] + s, n.min[2] + s], self.origin),
                 first: 0,
                 count: 0,
+                k: n.k,
                 voxels: 1u64 << (3 * u32::from(n.k)),
+                mask,
             };
             return;
         }
@@ -172,6 +257,7 @@ impl BoxTree {
         let mut lo = [i32::MAX; 3];
         let mut hi = [i32::MIN; 3];
         let mut voxels = 0;
+        let mut mask = 0;
         for (i, kid) in kids[..k].iter().enumerate() {
             self.fill(leaves, *kid, first + i);
             let c = self.nodes[first + i];
@@ -180,13 +266,16 @@ impl BoxTree {
                 hi[a] = hi[a].max(c.hi[a]);
             }
             voxels += c.voxels;
+            mask |= c.mask;
         }
         self.nodes[at] = BoxNode {
             lo,
             hi,
             first: first as u32,
             count: k as u8,
+            k: n.k,
             voxels,
+            mask: if n.k <= 2 { mask } else { 0 },
         };
     }
 
@@ -276,8 +365,8 @@ impl Traversable for BoxTree {
     #[inline]
     fn node_children(&self, n: &BoxRef, out: &mut [BoxRef; 8]) -> usize {
         let b = &self.nodes[n.0 as usize];
-        for i in 0..usize::from(b.count) {
-            out[i] = BoxRef(b.first + i as u32);
+        for (i, slot) in out.iter_mut().take(usize::from(b.count)).enumerate() {
+            *slot = BoxRef(b.first + i as u32);
         }
         usize::from(b.count)
     }
@@ -285,5 +374,14 @@ impl Traversable for BoxTree {
     #[inline]
     fn node_voxels(&self, n: &BoxRef) -> u64 {
         self.nodes[n.0 as usize].voxels
+    }
+
+    #[inline]
+    fn small_mask(&self, n: &BoxRef) -> Option<(Voxel, u64)> {
+        let b = &self.nodes[n.0 as usize];
+        (b.k <= 2).then(|| {
+            let o = self.origin;
+            ([0, 1, 2].map(|a| o[a] + i64::from(b.lo[a] & !3)), b.mask)
+        })
     }
 }

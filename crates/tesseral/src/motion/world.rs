@@ -16,6 +16,7 @@ use super::interfere::{interference_placed, Aabb, Placed, Placement};
 use super::orient::Rotation;
 use super::plan::rotated;
 use super::sweep::{first_contact, Fraction};
+use super::view::BoxTree;
 use crate::linear::{LinearOctree, OctreeError};
 use crate::pointer::PointerOctree;
 use crate::Voxel;
@@ -97,6 +98,12 @@ impl TranslationMethod {
     fn keeps_trees(self) -> bool {
         self != TranslationMethod::Offset
     }
+}
+
+/// The bodies of a world prepared for queries.
+struct Prepared {
+    environment: BoxTree,
+    objects: Vec<BoxTree>,
 }
 
 /// One moving object.
@@ -207,17 +214,19 @@ impl World {
         }
     }
 
+    /// Body `i` (`None`: the environment) where it stands at `offsets`; `boxes` holds
+    /// the prepared environment and objects.
     fn placed<'s>(
-        &'s self,
-        current: &'s [LinearOctree],
+        &self,
+        boxes: &'s Prepared,
         i: Option<usize>,
         offsets: &[Voxel],
-    ) -> Placed<'s> {
+    ) -> Placed<'s, BoxTree> {
         match i {
-            None => Placed::fixed(&self.environment),
-            Some(i) if self.method.keeps_trees() => Placed::fixed(&current[i]),
+            None => Placed::fixed(&boxes.environment),
+            Some(i) if self.method.keeps_trees() => Placed::fixed(&boxes.objects[i]),
             Some(i) => Placed::new(
-                &self.objects[i].tree,
+                &boxes.objects[i],
                 Placement {
                     rotation: self.objects[i].rotation,
                     offset: offsets[i],
@@ -276,6 +285,16 @@ impl World {
         if self.method == TranslationMethod::Labels {
             pointers = current.iter().map(PointerOctree::from_linear).collect();
         }
+        // Each body is prepared once (the objects again after each move when their
+        // trees are kept current), so every query runs on tight boxes.
+        let mut boxes = Prepared {
+            environment: BoxTree::new(&self.environment),
+            objects: if self.method.keeps_trees() {
+                current.iter().map(BoxTree::new).collect()
+            } else {
+                self.objects.iter().map(|o| BoxTree::new(&o.tree)).collect()
+            },
+        };
         let mut overlapping = vec![false; pairs.len()];
         for n in 0..=steps {
             let time = n as f64 * time_step;
@@ -288,8 +307,8 @@ impl World {
             };
             for (p, &(i, j)) in pairs.iter().enumerate() {
                 let hit = interference_placed(
-                    self.placed(&current, i, &offsets),
-                    self.placed(&current, Some(j), &offsets),
+                    self.placed(&boxes, i, &offsets),
+                    self.placed(&boxes, Some(j), &offsets),
                     true,
                 );
                 if hit.intersects {
@@ -298,9 +317,9 @@ impl World {
                     if n == 0 {
                         // In contact from the start.
                         let c = first_contact(
-                            self.placed(&current, i, &offsets),
+                            self.placed(&boxes, i, &offsets),
                             [0; 3],
-                            self.placed(&current, Some(j), &offsets),
+                            self.placed(&boxes, Some(j), &offsets),
                             [0; 3],
                         );
                         if let Some(c) = c {
@@ -334,24 +353,24 @@ impl World {
                 }
                 let a_move = i.map_or([0; 3], |i| moves[i]);
                 let Some(c) = first_contact(
-                    self.placed(&current, i, &offsets),
+                    self.placed(&boxes, i, &offsets),
                     a_move,
-                    self.placed(&current, Some(j), &offsets),
+                    self.placed(&boxes, Some(j), &offsets),
                     moves[j],
                 ) else {
                     continue;
                 };
                 let still = match self.method {
                     TranslationMethod::Offset => interference_placed(
-                        self.placed(&current, i, &next),
-                        self.placed(&current, Some(j), &next),
+                        self.placed(&boxes, i, &next),
+                        self.placed(&boxes, Some(j), &next),
                         false,
                     ),
                     TranslationMethod::Linear | TranslationMethod::Labels => {
                         // The trees stand at the step's start: place them by the moves.
                         let at = |k: Option<usize>| match k {
-                            None => Placed::fixed(&self.environment),
-                            Some(k) => Placed::new(&current[k], Placement::at(moves[k])),
+                            None => Placed::fixed(&boxes.environment),
+                            Some(k) => Placed::new(&boxes.objects[k], Placement::at(moves[k])),
                         };
                         interference_placed(at(i), at(Some(j)), false)
                     }
@@ -367,23 +386,24 @@ impl World {
                     between_steps: !still.intersects,
                 });
             }
-            step_contacts.sort_by(|x, y| x.fraction.cmp(&y.fraction));
+            step_contacts.sort_by_key(|x| x.fraction);
             contacts.extend(step_contacts);
             match self.method {
                 TranslationMethod::Offset => {}
                 TranslationMethod::Linear => {
-                    for (tree, mv) in current.iter_mut().zip(&moves) {
+                    for (k, mv) in moves.iter().enumerate() {
                         if *mv != [0; 3] {
-                            *tree = tree.translate(*mv)?;
+                            current[k] = current[k].translate(*mv)?;
+                            boxes.objects[k] = BoxTree::new(&current[k]);
                         }
                     }
                 }
                 TranslationMethod::Labels => {
-                    for ((ptr, tree), mv) in pointers.iter_mut().zip(current.iter_mut()).zip(&moves)
-                    {
+                    for (k, mv) in moves.iter().enumerate() {
                         if *mv != [0; 3] {
-                            ptr.translate(*mv)?;
-                            *tree = ptr.to_linear();
+                            pointers[k].translate(*mv)?;
+                            current[k] = pointers[k].to_linear();
+                            boxes.objects[k] = BoxTree::new(&current[k]);
                         }
                     }
                 }
