@@ -96,6 +96,13 @@ same from_ours from_om "binvox2bt output == our binvox import"
 same ref from_ours "our binvox import == the original voxels"
 "$T" convert m.bt m.tess --json | sed 's/^/  /'
 
+echo "== ColorOcTree: a coloured .vox written as .ot, read by OctoMap"
+"$T" convert a.xyz a.vox
+"$T" convert a.vox col.ot
+"$B" col.ot --dump omcol.xyz | sed 's/^/  /'
+sort omcol.xyz > omcol; voxels a.vox ours_vox
+same ours_vox omcol "OctoMap reading our ColorOcTree .ot"
+
 if [ "$quick" = "--quick" ]; then echo "all checks passed"; exit 0; fi
 
 echo "== timing: a .bt with about 1M leaves (1M random voxels in 512^3)"

@@ -187,6 +187,8 @@ fn bad_arguments_and_files_fail_cleanly() {
     r(&["--size", "12"], "--size");
     r(&["--size", "0x5"], "--size");
     r(&["--size", "99999x5"], "--size");
+    r(&["--size", "8000x8000"], "--size");
+    r(&["--slice", "z=3", "--slice-scale", "100"], "--slice");
     r(&["--view", "isometric"], "--view");
     r(&["--zoom", "0"], "--zoom");
     r(&["--fov", "200", "--perspective"], "--fov");

@@ -105,7 +105,7 @@ fn translation(c: &mut Criterion) {
                 let moved = voxels
                     .iter()
                     .map(|v| [v[0] + by[0], v[1] + by[1], v[2] + by[2]]);
-                black_box(LinearOctree::from_voxels(9, [-256, -256, 0], moved).unwrap())
+                black_box(LinearOctree::from_voxels(10, [-256, -256, -256], moved).unwrap())
             })
         });
     }

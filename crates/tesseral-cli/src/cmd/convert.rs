@@ -8,7 +8,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use tesseral::io::{self, ReadOptions, WriteOptions};
 use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
@@ -66,10 +66,8 @@ pub fn run(args: Args) -> Result<()> {
             smooth: args.smooth,
         },
     };
-    let model = io::read_model_with(&args.input, &read)
-        .with_context(|| format!("reading {}", args.input.display()))?;
-    io::write_model_with(&args.output, &model, &write)
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    let model = io::read_model_with(&args.input, &read).map_err(|e| anyhow::anyhow!("{e}"))?;
+    io::write_model_with(&args.output, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
     if args.json {
         let bbox = model.tree.bbox();
         let summary = serde_json::json!({

@@ -79,7 +79,9 @@ pub struct Args {
 }
 
 /// The largest image side we draw.
-const MAX_SIDE: usize = 16384;
+const MAX_SIDE: usize = 8192;
+/// The most pixels in one view (a contact sheet has four).
+const MAX_PIXELS: usize = 16 << 20;
 
 fn parse_size(s: &str) -> Result<(usize, usize)> {
     let (w, h) = s
@@ -95,6 +97,9 @@ fn parse_size(s: &str) -> Result<(usize, usize)> {
         .with_context(|| format!("--size {s:?}: bad height"))?;
     if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
         bail!("--size {s:?}: each side must be from 1 to {MAX_SIDE}");
+    }
+    if w * h > MAX_PIXELS {
+        bail!("--size {s:?}: more than {MAX_PIXELS} pixels");
     }
     Ok((w, h))
 }
@@ -230,7 +235,13 @@ pub fn run(args: Args) -> Result<()> {
     let image = if let Some((axis, _, c)) = slice {
         let layer = to_voxel(axis, c).floor() as i64;
         let side = tree.side() as usize;
-        let scale = args.slice_scale.clamp(1, (MAX_SIDE / side.max(1)).max(1));
+        if side.saturating_mul(args.slice_scale.max(1)) > MAX_SIDE {
+            bail!(
+                "--slice: the tree is {side} voxels across; at {} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)",
+                args.slice_scale.max(1)
+            );
+        }
+        let scale = args.slice_scale.max(1);
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)

@@ -493,7 +493,7 @@ impl Csg {
                         if k > PARALLEL_MIN_SIZE_LOG2 {
                             self.build_par(cc, cm, k - 1, learn, budget)
                         } else {
-                            let mut part = Vec::new();
+                            let mut part = Vec::with_capacity(256);
                             self.build_cell(cc, cm, k - 1, learn, &mut part);
                             let n = part.len();
                             if budget.used.fetch_add(n, Ordering::Relaxed) + n > budget.max {

@@ -9,7 +9,7 @@
 //!   y and z applied in that order, a uniform scale, then a position) and colours.
 //! - [`Csg`]: a solid compiled for evaluation: a flat list of primitives, each with its
 //!   world-to-local map, and the operation tree over them. It classifies octree cells
-//!   conservatively ([`Classifier`]) and builds the octree ([`Csg::build`]).
+//!   conservatively ([`crate::linear::Classifier`]) and builds the octree ([`Csg::build`]).
 //! - [`scene`]: the `.tss` scene text format and its parser.
 //!
 //! # Exactness

@@ -999,3 +999,56 @@ fn closest_names() {
         Some("box")
     );
 }
+
+/// Seeded mutations of the shipped scenes: the parser answers every one with a scene
+/// or a located error, never a panic, and the location lies inside the text.
+#[test]
+fn mutated_scenes_never_panic() {
+    let sources = [
+        include_str!("../../../../scenes/tank.tss"),
+        include_str!("../../../../scenes/truck.tss"),
+        include_str!("../../../../scenes/aircraft.tss"),
+        include_str!("../../../../scenes/showcase.tss"),
+        include_str!("../../../../scenes/fig4a-cone.tss"),
+    ];
+    let alphabet: Vec<char> = "()[]{},=+-*/#\"\n 0123456789.eE_abcxyzrh-éλ\u{0}"
+        .chars()
+        .collect();
+    let seed = 0xf022_u64;
+    println!("seed {seed:#x}");
+    let mut rng = Rng(seed);
+    for round in 0..600 {
+        let src = sources[round % sources.len()];
+        let mut chars: Vec<char> = src.chars().collect();
+        for _ in 0..1 + rng.next() % 4 {
+            let i = (rng.next() % (chars.len() as u64 + 1)) as usize;
+            let c = alphabet[(rng.next() % alphabet.len() as u64) as usize];
+            match rng.next() % 3 {
+                0 if i < chars.len() => {
+                    chars.remove(i);
+                }
+                1 if i < chars.len() => chars[i] = c,
+                _ => chars.insert(i, c),
+            }
+        }
+        let text: String = chars.into_iter().collect();
+        match Scene::parse(&text, "m.tss".as_ref()) {
+            Ok(scene) => {
+                // Small enough ones also build.
+                if scene.depth <= 7 {
+                    let _ = scene.build();
+                }
+            }
+            Err(e) => {
+                let d = e.diagnostic().expect("a parse error");
+                let lines: Vec<&str> = text.split('\n').collect();
+                assert!(
+                    d.line >= 1 && d.line <= lines.len(),
+                    "round {round}: line {}",
+                    d.line
+                );
+                let _ = e.to_string();
+            }
+        }
+    }
+}

@@ -90,7 +90,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
             "dim" => {
                 let d =
                     parse_n::<u64>(&values, 3).map_err(|m| syntax(line_no, format!("dim: {m}")))?;
-                if d.iter().any(|&v| v == 0) {
+                if d.contains(&0) {
                     return Err(syntax(line_no, "dim: extents must be positive".into()));
                 }
                 dims = Some([d[0], d[1], d[2]]);

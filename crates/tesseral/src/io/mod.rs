@@ -333,31 +333,6 @@ pub fn write_atomic(
     result.map_err(wrap)
 }
 
-/// Like [`write_atomic`], for a body whose own errors are [`FormatError`]s (a format
-/// that can refuse an octree before writing a byte).
-///
-/// # Errors
-/// The body's error, or [`FormatError::Io`] naming `path`.
-pub fn write_atomic_checked(
-    path: &Path,
-    body: impl FnOnce(&mut dyn Write) -> Result<(), FormatError>,
-) -> Result<(), FormatError> {
-    let mut inner: Option<FormatError> = None;
-    let result = write_atomic(path, |w| {
-        body(w).map_err(|e| match e {
-            FormatError::Io { source, .. } => source,
-            other => {
-                inner = Some(other);
-                io::Error::other("refused")
-            }
-        })
-    });
-    match inner {
-        Some(e) => Err(e),
-        None => result,
-    }
-}
-
 /// Reads a whole file, refusing files larger than `limit` bytes.
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
     let meta = fs::metadata(path).map_err(|e| FormatError::io(path, e))?;
@@ -368,11 +343,6 @@ pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatErr
         ));
     }
     fs::read(path).map_err(|e| FormatError::io(path, e))
-}
-
-/// Reads a whole file up to the reader limit (for the mesh parsers).
-pub(crate) fn read_limited_pub(path: &Path) -> Result<Vec<u8>, FormatError> {
-    read_limited(path, MAX_FILE_BYTES)
 }
 
 /// The largest file the whole-file readers load (4 GiB).

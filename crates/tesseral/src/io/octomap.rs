@@ -352,7 +352,12 @@ fn to_key_space(model: &VoxelModel) -> Result<(LinearOctree, f64, [i64; 3]), Str
     let shift = frame
         .translate
         .map(|t| (t / frame.voxel_size).round() as i64);
-    let shifted_origin = [0, 1, 2].map(|a| model.tree.origin()[a] + shift[a]);
+    let mut shifted_origin = [0i64; 3];
+    for a in 0..3 {
+        shifted_origin[a] = model.tree.origin()[a]
+            .checked_add(shift[a])
+            .ok_or("the frame's translate moves the octree out of range")?;
+    }
     let shifted = LinearOctree::from_sorted_leaves(
         model.tree.depth(),
         shifted_origin,

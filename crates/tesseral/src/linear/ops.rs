@@ -300,27 +300,49 @@ fn emit_gap(out: &mut Vec<Leaf>, mut s: u64, e: u64, merge: bool) {
 /// siblings coming from both operands may merge.
 fn union(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
     let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
-        if xe <= ys {
-            push_m(out, a[i]);
-            i += 1;
-        } else if ye <= xs {
-            push_m(out, b[j]);
-            j += 1;
-        } else if xs <= ys && ye <= xe {
-            push_m(out, a[i]);
-            i += 1;
-            j += 1;
-            while j < b.len() && span2(b[j]).0 < xe {
-                j += 1;
-            }
-        } else {
-            push_m(out, b[j]);
-            j += 1;
-            i += 1;
-            while i < a.len() && span2(a[i]).0 < ye {
+    if !a.is_empty() && !b.is_empty() {
+        // The current leaves' spans, reloaded only when a cursor moves.
+        let ((mut xs, mut xe), (mut ys, mut ye)) = (span2(a[0]), span2(b[0]));
+        loop {
+            if xe <= ys {
+                push_m(out, a[i]);
                 i += 1;
+                if i == a.len() {
+                    break;
+                }
+                (xs, xe) = span2(a[i]);
+            } else if ye <= xs {
+                push_m(out, b[j]);
+                j += 1;
+                if j == b.len() {
+                    break;
+                }
+                (ys, ye) = span2(b[j]);
+            } else if xs <= ys && ye <= xe {
+                // b's leaf lies in a's: skip every b leaf inside it.
+                push_m(out, a[i]);
+                i += 1;
+                j += 1;
+                while j < b.len() && span2(b[j]).0 < xe {
+                    j += 1;
+                }
+                if i == a.len() || j == b.len() {
+                    break;
+                }
+                (xs, xe) = span2(a[i]);
+                (ys, ye) = span2(b[j]);
+            } else {
+                push_m(out, b[j]);
+                j += 1;
+                i += 1;
+                while i < a.len() && span2(a[i]).0 < ye {
+                    i += 1;
+                }
+                if i == a.len() || j == b.len() {
+                    break;
+                }
+                (xs, xe) = span2(a[i]);
+                (ys, ye) = span2(b[j]);
             }
         }
     }
@@ -333,18 +355,37 @@ fn union(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
 /// No merge can occur: a full parent in both operands is inside a leaf of each.
 fn intersection(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
     let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
+    if a.is_empty() || b.is_empty() {
+        return;
+    }
+    let ((mut xs, mut xe), (mut ys, mut ye)) = (span2(a[0]), span2(b[0]));
+    loop {
         if xe <= ys {
             i += 1;
+            if i == a.len() {
+                return;
+            }
+            (xs, xe) = span2(a[i]);
         } else if ye <= xs {
             j += 1;
+            if j == b.len() {
+                return;
+            }
+            (ys, ye) = span2(b[j]);
         } else if xs <= ys && ye <= xe {
             out.push(b[j]);
             j += 1;
+            if j == b.len() {
+                return;
+            }
+            (ys, ye) = span2(b[j]);
         } else {
             out.push(a[i]);
             i += 1;
+            if i == a.len() {
+                return;
+            }
+            (xs, xe) = span2(a[i]);
         }
     }
 }

@@ -18,7 +18,7 @@ pub const MAX_MESH_ELEMENTS: usize = 1 << 26;
 /// [`FormatError::Syntax`] or [`FormatError::Corrupt`] naming where the file is bad;
 /// [`FormatError::TooLarge`] past [`MAX_MESH_ELEMENTS`].
 pub fn read(path: &Path) -> Result<TriMesh, FormatError> {
-    let bytes = crate::io::read_limited_pub(path)?;
+    let bytes = crate::io::read_limited(path, crate::io::MAX_FILE_BYTES)?;
     parse(&bytes, &extension(path), path)
 }
 

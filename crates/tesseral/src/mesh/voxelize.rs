@@ -652,15 +652,14 @@ impl Classifier for MeshClassifier {
             }
         };
         if self.surface_only {
+            // Triangle bin ranges carry a one-unit margin, so a triangle that only
+            // touches the cell's faces is still among the cell's own bins.
             let lo = rel.map(|r| r * ONE);
             let hi = rel.map(|r| (r + s) * ONE);
-            let hit = self
-                .bins
-                .query(rel.map(|r| (r - 1).max(0)), last)
-                .is_some_and(|r| {
-                    self.bins
-                        .any(r, |t| tri_box_overlap(lo, hi, &self.tris[t as usize]))
-                });
+            let hit = self.bins.query(rel, last).is_some_and(|r| {
+                self.bins
+                    .any(r, |t| tri_box_overlap(lo, hi, &self.tris[t as usize]))
+            });
             return match (hit, k) {
                 (false, _) => CellClass::Outside,
                 (true, 0) => CellClass::Inside,
@@ -882,6 +881,147 @@ mod tests {
                     }
                 }
             }
+        }
+    }
+
+    #[test]
+    fn surface_only_matches_brute_force() {
+        for seed in 0..40u64 {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let n = rng.random_range(1..12);
+            let positions: Vec<[f64; 3]> = (0..3 * n)
+                .map(|_| {
+                    // Some coordinates on voxel boundaries, to exercise touching.
+                    std::array::from_fn(|_| {
+                        if rng.random_bool(0.3) {
+                            f64::from(rng.random_range(0..8))
+                        } else {
+                            rng.random_range(0.0..8.0)
+                        }
+                    })
+                })
+                .collect();
+            let triangles = (0..n as u32)
+                .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+                .collect();
+            let mesh = TriMesh {
+                positions,
+                triangles,
+            };
+            let opts = VoxelizeOptions {
+                resolution: Resolution::VoxelSize(1.0),
+                surface_only: true,
+            };
+            let got = voxelize(&mesh, &opts, Path::new("s")).unwrap();
+            got.tree.assert_valid();
+            let o = got.tree.origin();
+            let side = got.tree.side() as i64;
+            let q: Vec<[i64; 3]> = mesh
+                .positions
+                .iter()
+                .map(|p| [0, 1, 2].map(|a| ((p[a] - o[a] as f64) * ONE as f64).round() as i64))
+                .collect();
+            let tris: Vec<Tri> = mesh
+                .triangles
+                .iter()
+                .map(|t| t.map(|i| q[i as usize]))
+                .collect();
+            for x in 0..side {
+                for y in 0..side {
+                    for z in 0..side {
+                        let lo = [x * ONE, y * ONE, z * ONE];
+                        let hi = [(x + 1) * ONE, (y + 1) * ONE, (z + 1) * ONE];
+                        let want = tris.iter().any(|t| tri_box_overlap(lo, hi, t));
+                        let v = [x + o[0], y + o[1], z + o[2]];
+                        assert_eq!(got.tree.contains(v), want, "seed {seed}, voxel {v:?}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn solid_matches_brute_force_parity() {
+        // A closed but irregular mesh: a jittered sphere, voxelized and compared with
+        // a column-by-column parity count over all triangles.
+        for seed in 0..6u64 {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let (lat, lon) = (7usize, 9usize);
+            let mut positions = vec![[4.0, 4.0, 0.6]];
+            for i in 1..lat {
+                let th = std::f64::consts::PI * i as f64 / lat as f64;
+                for j in 0..lon {
+                    let ph = 2.0 * std::f64::consts::PI * j as f64 / lon as f64;
+                    let r = 3.4 + rng.random_range(-0.4..0.4);
+                    positions.push([
+                        4.0 + r * th.sin() * ph.cos(),
+                        4.0 + r * th.sin() * ph.sin(),
+                        4.0 - r * th.cos(),
+                    ]);
+                }
+            }
+            positions.push([4.0, 4.0, 7.4]);
+            let top = (positions.len() - 1) as u32;
+            let at = |i: usize, j: usize| (1 + (i - 1) * lon + j % lon) as u32;
+            let mut triangles = Vec::new();
+            for j in 0..lon {
+                triangles.push([0, at(1, j + 1), at(1, j)]);
+                triangles.push([top, at(lat - 1, j), at(lat - 1, j + 1)]);
+            }
+            for i in 1..lat - 1 {
+                for j in 0..lon {
+                    triangles.push([at(i, j), at(i, j + 1), at(i + 1, j + 1)]);
+                    triangles.push([at(i, j), at(i + 1, j + 1), at(i + 1, j)]);
+                }
+            }
+            let mesh = TriMesh {
+                positions,
+                triangles,
+            };
+            let h = 0.25;
+            let opts = VoxelizeOptions {
+                resolution: Resolution::VoxelSize(h),
+                surface_only: false,
+            };
+            let got = voxelize(&mesh, &opts, Path::new("s")).unwrap();
+            got.tree.assert_valid();
+            // Brute force in f64 (no centre lies exactly on the jittered surface).
+            let o = got.tree.origin();
+            let side = got.tree.side() as i64;
+            let mut count = 0u64;
+            for x in 0..side {
+                for y in 0..side {
+                    for z in 0..side {
+                        let c = [
+                            (x + o[0]) as f64 + 0.5,
+                            (y + o[1]) as f64 + 0.5,
+                            (z + o[2]) as f64 + 0.5,
+                        ]
+                        .map(|v| v * h);
+                        let mut crossings = 0;
+                        for t in &mesh.triangles {
+                            let [a, b, d] = t.map(|i| mesh.positions[i as usize]);
+                            let e = |p: [f64; 3], q: [f64; 3]| {
+                                (q[0] - p[0]) * (c[1] - p[1]) - (q[1] - p[1]) * (c[0] - p[0])
+                            };
+                            let (w0, w1, w2) = (e(b, d), e(d, a), e(a, b));
+                            let inside = (w0 > 0.0 && w1 > 0.0 && w2 > 0.0)
+                                || (w0 < 0.0 && w1 < 0.0 && w2 < 0.0);
+                            if inside {
+                                let zc = (w0 * a[2] + w1 * b[2] + w2 * d[2]) / (w0 + w1 + w2);
+                                if zc < c[2] {
+                                    crossings += 1;
+                                }
+                            }
+                        }
+                        let want = crossings % 2 == 1;
+                        let v = [x + o[0], y + o[1], z + o[2]];
+                        assert_eq!(got.tree.contains(v), want, "seed {seed}, voxel {v:?}");
+                        count += u64::from(want);
+                    }
+                }
+            }
+            assert!(count > 1000, "seed {seed}: {count}");
         }
     }
 }

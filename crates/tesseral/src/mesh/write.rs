@@ -126,9 +126,24 @@ pub fn write_ply(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
 /// # Errors
 /// I/O errors of `w`.
 pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    if m.triangles.is_empty() {
+        // glTF accessors and buffers may not be empty: an empty scene instead.
+        let json = br#"{"asset":{"version":"2.0","generator":"tesseral"},"scene":0,"scenes":[{"nodes":[]}]}"#;
+        let mut json = json.to_vec();
+        while json.len() % 4 != 0 {
+            json.push(b' ');
+        }
+        w.write_all(b"glTF")?;
+        w.write_all(&2u32.to_le_bytes())?;
+        w.write_all(&((12 + 8 + json.len()) as u32).to_le_bytes())?;
+        w.write_all(&(json.len() as u32).to_le_bytes())?;
+        w.write_all(b"JSON")?;
+        return w.write_all(&json);
+    }
     let mut bin = Vec::with_capacity(12 * m.positions.len() + 12 * m.triangles.len());
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
+    debug_assert!(!m.positions.is_empty());
     for p in &m.positions {
         for a in 0..3 {
             let x = p[a] as f32;
@@ -146,10 +161,6 @@ pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
     let idx_len = bin.len() - pos_len;
     while bin.len() % 4 != 0 {
         bin.push(0);
-    }
-    if m.positions.is_empty() {
-        lo = [0.0; 3];
-        hi = [0.0; 3];
     }
     let json = serde_json::json!({
         "asset": {"version": "2.0", "generator": "tesseral"},
@@ -182,4 +193,44 @@ pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
     w.write_all(&(bin.len() as u32).to_le_bytes())?;
     w.write_all(b"BIN\0")?;
     w.write_all(&bin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn glb_is_well_formed() {
+        let tree =
+            crate::linear::LinearOctree::from_voxels(2, [0; 3], [[0, 0, 0], [1, 1, 1]]).unwrap();
+        let m = crate::mesh::boundary_mesh(&tree);
+        let mut b = Vec::new();
+        write_glb(&mut b, &m).unwrap();
+        let u = |i: usize| u32::from_le_bytes([b[i], b[i + 1], b[i + 2], b[i + 3]]) as usize;
+        assert_eq!(&b[..4], b"glTF");
+        assert_eq!((u(4), u(8)), (2, b.len()));
+        let json_len = u(12);
+        assert_eq!(&b[16..20], b"JSON");
+        assert_eq!(json_len % 4, 0);
+        let json: serde_json::Value = serde_json::from_slice(&b[20..20 + json_len]).unwrap();
+        let bin_at = 20 + json_len;
+        assert_eq!(&b[bin_at + 4..bin_at + 8], b"BIN\0");
+        let bin_len = u(bin_at);
+        assert_eq!(bin_at + 8 + bin_len, b.len());
+        assert_eq!(json["buffers"][0]["byteLength"], bin_len);
+        assert_eq!(json["accessors"][0]["count"], m.positions.len());
+        assert_eq!(json["accessors"][1]["count"], 3 * m.triangles.len());
+        let views = &json["bufferViews"];
+        let end =
+            views[1]["byteOffset"].as_u64().unwrap() + views[1]["byteLength"].as_u64().unwrap();
+        assert!(end as usize <= bin_len);
+        assert_eq!(views[0]["byteLength"], 12 * m.positions.len());
+        // An empty solid gives an empty scene, still a valid file.
+        let mut e = Vec::new();
+        write_glb(&mut e, &TriMesh::default()).unwrap();
+        let n = u32::from_le_bytes([e[12], e[13], e[14], e[15]]) as usize;
+        let json: serde_json::Value = serde_json::from_slice(&e[20..20 + n]).unwrap();
+        assert_eq!(json["scenes"][0]["nodes"], serde_json::json!([]));
+        assert_eq!(e.len(), 20 + n);
+    }
 }

@@ -38,9 +38,9 @@ pub use orient::{Rotation, RotationError};
 pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
-pub use sweep::{first_contact, Fraction, SweptContact};
 #[cfg(test)]
 use sweep::first_contact_brute;
+pub use sweep::{first_contact, Fraction, SweptContact};
 pub use view::{BoxTree, Traversable};
 pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,

@@ -164,6 +164,7 @@ fn ray_tree_contains_equals_the_linear_octree() {
     for _ in 0..4 {
         let tree = random_tree(&mut rng, 5, [3, -2, 0]);
         let rt = RayTree::new(&tree);
+        assert!(rt.same_tree(&RayTree::new_by_partition(&tree)));
         for x in -1..34 {
             for y in -3..32 {
                 for z in -1..33 {
@@ -174,6 +175,20 @@ fn ray_tree_contains_equals_the_linear_octree() {
                     );
                 }
             }
+        }
+    }
+    // The one-pass index against the top-down one, on many shapes and depths.
+    for depth in 1..7u8 {
+        for seed in 1..6u64 {
+            let mut r = Rng(seed * 7919 + u64::from(depth));
+            let side = 1i64 << depth;
+            let voxels: Vec<[i64; 3]> = (0..(r.next() % 300))
+                .map(|_| [0, 1, 2].map(|_| (r.next() % side as u64) as i64))
+                .collect();
+            let tree = LinearOctree::from_voxels(depth, [0, 0, 0], voxels).unwrap();
+            let (a, b) = (RayTree::new(&tree), RayTree::new_by_partition(&tree));
+            assert!(a.same_tree(&b), "depth {depth} seed {seed}");
+            assert_eq!(a.gray_nodes(), b.gray_nodes());
         }
     }
     let full = LinearOctree::full(3, [0, 0, 0]).unwrap();

@@ -45,7 +45,57 @@ pub struct RayTree {
     origin: [i64; 3],
     root: Root,
     nodes: Vec<Node>,
+    root_node: u32,
     bbox: Option<([i64; 3], [i64; 3])>,
+}
+
+/// A node still open in the one-pass index build: its children so far.
+struct Open {
+    code: u64,
+    k: u8,
+    gray: u8,
+    black: u8,
+    n: u8,
+    kids: [Node; 8],
+}
+
+impl Open {
+    fn new(code: u64, k: u8) -> Self {
+        Open {
+            code,
+            k,
+            gray: 0,
+            black: 0,
+            n: 0,
+            kids: [Node {
+                first: 0,
+                gray: 0,
+                black: 0,
+            }; 8],
+        }
+    }
+
+    /// Whether the node's code range holds `code`.
+    fn holds(&self, code: u64) -> bool {
+        let shift = 3 * u32::from(self.k);
+        shift >= 64 || code >> shift == self.code >> shift
+    }
+}
+
+/// Closes the node on top of the stack: stores its gray children together and
+/// records it as a gray child of its parent.
+fn close(stack: &mut Vec<Open>, nodes: &mut Vec<Node>) {
+    let o = stack.pop().expect("a node to close");
+    let first = nodes.len() as u32;
+    nodes.extend_from_slice(&o.kids[..usize::from(o.n)]);
+    let parent = stack.last_mut().expect("the root is never closed here");
+    parent.gray |= 1 << ((o.code >> (3 * u32::from(o.k))) & 7);
+    parent.kids[usize::from(parent.n)] = Node {
+        first,
+        gray: o.gray,
+        black: o.black,
+    };
+    parent.n += 1;
 }
 
 /// A ray `origin + t · dir`, in the voxel coordinates of the tree.
@@ -94,10 +144,13 @@ pub struct Hit {
 }
 
 impl RayTree {
-    /// Indexes the gray nodes of `tree`.
+    /// Indexes the gray nodes of `tree` in one pass over its sorted leaves: the open
+    /// ancestors of the current leaf are kept on a stack; a node is closed when the
+    /// leaves leave it, and its gray children's records are then stored together.
     ///
     /// # Runtime
-    /// O(g log n) for g gray nodes and n leaves.
+    /// O(n) for n leaves (each leaf opens and closes at most `depth` nodes, and every
+    /// node is opened once).
     #[must_use]
     pub fn new(tree: &LinearOctree) -> Self {
         let depth = tree.depth();
@@ -107,6 +160,63 @@ impl RayTree {
             origin: tree.origin(),
             root: Root::White,
             nodes: Vec::new(),
+            root_node: 0,
+            bbox: tree.bbox(),
+        };
+        rt.root = match colour_of(leaves, 0, depth) {
+            Colour::White => Root::White,
+            Colour::Black => Root::Black,
+            Colour::Gray => Root::Gray,
+        };
+        if rt.root != Root::Gray {
+            return rt;
+        }
+        let mut nodes = Vec::with_capacity(leaves.len() / 3 + 1);
+        let mut stack = vec![Open::new(0, depth)];
+        for leaf in leaves {
+            let (c, s) = (leaf.code(), leaf.size_log2());
+            while !stack[stack.len() - 1].holds(c) {
+                close(&mut stack, &mut nodes);
+            }
+            loop {
+                let top = &stack[stack.len() - 1];
+                if top.k == s + 1 {
+                    break;
+                }
+                let k = top.k - 1;
+                stack.push(Open::new(c >> (3 * u32::from(k)) << (3 * u32::from(k)), k));
+            }
+            let top = stack.last_mut().expect("the root stays open");
+            top.black |= 1 << ((c >> (3 * u32::from(s))) & 7);
+        }
+        while stack.len() > 1 {
+            close(&mut stack, &mut nodes);
+        }
+        let root = stack.pop().expect("the root");
+        let first = nodes.len() as u32;
+        nodes.extend_from_slice(&root.kids[..usize::from(root.n)]);
+        nodes.push(Node {
+            first,
+            gray: root.gray,
+            black: root.black,
+        });
+        rt.root_node = nodes.len() as u32 - 1;
+        rt.nodes = nodes;
+        rt
+    }
+
+    /// The same index built top-down by partitioning the leaf slice: the reference the
+    /// one-pass builder is tested against.
+    #[cfg(test)]
+    pub(crate) fn new_by_partition(tree: &LinearOctree) -> Self {
+        let depth = tree.depth();
+        let leaves = tree.leaves();
+        let mut rt = RayTree {
+            depth,
+            origin: tree.origin(),
+            root: Root::White,
+            nodes: Vec::new(),
+            root_node: 0,
             bbox: tree.bbox(),
         };
         rt.root = match colour_of(leaves, 0, depth) {
@@ -125,6 +235,20 @@ impl RayTree {
         rt
     }
 
+    /// Whether two indexes describe the same tree (layouts may differ).
+    #[cfg(test)]
+    pub(crate) fn same_tree(&self, other: &RayTree) -> bool {
+        fn eq(a: &RayTree, i: u32, b: &RayTree, j: u32) -> bool {
+            let (x, y) = (a.nodes[i as usize], b.nodes[j as usize]);
+            x.gray == y.gray
+                && x.black == y.black
+                && (0..x.gray.count_ones()).all(|c| eq(a, x.first + c, b, y.first + c))
+        }
+        self.root == other.root
+            && (self.root != Root::Gray || eq(self, self.root_node, other, other.root_node))
+    }
+
+    #[cfg(test)]
     fn index(&mut self, at: usize, code: u64, k: u8, leaves: &[Leaf]) {
         let child_cells = 1u64 << (3 * u32::from(k - 1));
         let mut ranges = [(0usize, 0usize); 8];
@@ -208,7 +332,7 @@ impl RayTree {
             Root::Black => return true,
             Root::Gray => {}
         }
-        let mut node = self.nodes[0];
+        let mut node = self.nodes[self.root_node as usize];
         let mut k = self.depth;
         loop {
             k -= 1;
@@ -220,7 +344,7 @@ impl RayTree {
             if node.gray & bit == 0 {
                 return false;
             }
-            let j = (node.gray & (bit - 1)).count_ones();
+            let j = rank(node.gray, bit);
             node = self.nodes[(node.first + j) as usize];
         }
     }
@@ -270,8 +394,9 @@ impl RayTree {
         let mut t0 = [0.0; 3];
         let mut t1 = [0.0; 3];
         for ax in 0..3 {
-            t0[ax] = (lo[ax] - o[ax]) / d[ax];
-            t1[ax] = (lo[ax] + side - o[ax]) / d[ax];
+            let inv = 1.0 / d[ax];
+            t0[ax] = (lo[ax] - o[ax]) * inv;
+            t1[ax] = (lo[ax] + side - o[ax]) * inv;
         }
         let enter = t0[0].max(t0[1]).max(t0[2]);
         let exit = t1[0].min(t1[1]).min(t1[2]);
@@ -308,7 +433,7 @@ impl RayTree {
             return None;
         }
         let mut sp = 0usize;
-        stack[0] = Level::new(0, t0, t1, self.origin, self.depth);
+        stack[0] = Level::new(self.root_node, t0, t1, 0, self.depth);
         loop {
             let lv = &mut stack[sp];
             let cur = lv.cur;
@@ -322,27 +447,23 @@ impl RayTree {
                 if (node.black | node.gray) & bit != 0 {
                     let exit = min3(c1);
                     if exit >= tmin {
-                        let half = 1i64 << (lv.k - 1);
-                        let cmin = [
-                            lv.min[0] + half * i64::from(label & 1),
-                            lv.min[1] + half * i64::from((label >> 1) & 1),
-                            lv.min[2] + half * i64::from((label >> 2) & 1),
-                        ];
+                        let path = (lv.path << 3) | u64::from(label);
+                        let k = lv.k - 1;
                         if node.black & bit != 0 {
                             let (axis, t) = argmax(c0);
                             let at_start = t < tmin;
+                            let rel = crate::code::decode(path << (3 * u32::from(k)));
                             return Some(Hit {
                                 t: if at_start { tmin } else { t },
                                 axis,
-                                block_min: cmin,
-                                size_log2: lv.k - 1,
+                                block_min: [0, 1, 2].map(|i| self.origin[i] + i64::from(rel[i])),
+                                size_log2: k,
                                 at_start,
                             });
                         }
-                        let j = (node.gray & (bit - 1)).count_ones();
-                        let k = lv.k - 1;
+                        let j = rank(node.gray, bit);
                         sp += 1;
-                        stack[sp] = Level::new(node.first + j, c0, c1, cmin, k);
+                        stack[sp] = Level::new(node.first + j, c0, c1, path, k);
                         descended = true;
                     }
                 }
@@ -399,7 +520,14 @@ impl RayTree {
                     return f64::INFINITY;
                 }
                 let mut best = f64::INFINITY;
-                self.beam_rec(0, self.origin, self.depth, stop_log2, near, &mut best);
+                self.beam_rec(
+                    self.root_node,
+                    self.origin,
+                    self.depth,
+                    stop_log2,
+                    near,
+                    &mut best,
+                );
                 best
             }
         }
@@ -449,7 +577,7 @@ impl RayTree {
             if node.black & bit != 0 || k - 1 <= stop {
                 *best = t;
             } else {
-                let j = (node.gray & (bit - 1)).count_ones();
+                let j = rank(node.gray, bit);
                 self.beam_rec(node.first + j, cmin, k - 1, stop, near, best);
             }
         }
@@ -468,7 +596,8 @@ struct Level {
     t0: [f64; 3],
     tm: [f64; 3],
     t1: [f64; 3],
-    min: [i64; 3],
+    /// The node's path from the root, one octal digit per level.
+    path: u64,
     node: u32,
     k: u8,
     cur: u8,
@@ -476,7 +605,7 @@ struct Level {
 
 impl Level {
     #[inline]
-    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], min: [i64; 3], k: u8) -> Self {
+    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
         let tm = [
             0.5 * (t0[0] + t1[0]),
             0.5 * (t0[1] + t1[1]),
@@ -486,7 +615,7 @@ impl Level {
             t0,
             tm,
             t1,
-            min,
+            path,
             node,
             k,
             cur: first_child(t0, tm),
@@ -535,6 +664,24 @@ fn min3(t: [f64; 3]) -> f64 {
     } else {
         t[2]
     }
+}
+
+/// Bit counts of the bytes: `x.count_ones()` without relying on the POPCNT
+/// instruction, which the baseline x86-64 target lacks.
+const POPCOUNT: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).count_ones() as u8;
+        i += 1;
+    }
+    t
+};
+
+/// The index of the gray child `bit` among its gray siblings.
+#[inline]
+fn rank(gray: u8, bit: u8) -> u32 {
+    u32::from(POPCOUNT[usize::from(gray & (bit - 1))])
 }
 
 /// The first child a ray enters (Revelles Table 1, in our labels `x + 2y + 4z`).

@@ -100,7 +100,7 @@ fn params(beta: f64) -> Params {
 #[test]
 fn trajectories_keep_sphere_topology() {
     // Growing (β < 0), neutral, shrinking-biased and Libes's rule; global checks
-    // every 500 steps and at the end.
+    // every 1000 steps.
     for (i, p) in [
         params(-0.3),
         params(0.0),
@@ -119,8 +119,8 @@ fn trajectories_keep_sphere_topology() {
     {
         let seed = 1000 + i as u64;
         let mut chain = Chain::new(DenseLattice::new(), p, seed, &[[0, 0, 0]]).unwrap();
-        for round in 0..40 {
-            chain.run(500);
+        for round in 0..20 {
+            chain.run(1000);
             let voxels = chain.voxels();
             let report = topology::check_sphere(&voxels)
                 .unwrap_or_else(|e| panic!("seed {seed} params {p:?} round {round}: {e}"));
@@ -128,7 +128,9 @@ fn trajectories_keep_sphere_topology() {
             assert_eq!(report.volume, chain.volume(), "seed {seed}");
             assert_eq!(report.euler(), 2);
             chain.lattice().assert_valid();
-            chain.assert_valid();
+            if round % 5 == 4 {
+                chain.assert_valid();
+            }
         }
         let c = chain.counters();
         assert_eq!(c.steps, 20_000);
