@@ -400,7 +400,10 @@ impl Traversable for BoxTree {
         let hi = [0, 1, 2].map(|a| clamp(q.hi[a] - o[a]));
         let first = b.first as usize;
         let mut m = 0;
-        for (i, c) in self.nodes[first..first + usize::from(b.count)].iter().enumerate() {
+        for (i, c) in self.nodes[first..first + usize::from(b.count)]
+            .iter()
+            .enumerate()
+        {
             if c.lo[0] < hi[0]
                 && lo[0] < c.hi[0]
                 && c.lo[1] < hi[1]
