@@ -46,6 +46,18 @@ impl Placement {
         ]
     }
 
+    /// The world box `w` seen in the placed tree's own coordinates (the inverse map).
+    #[inline]
+    pub(crate) fn unplace_box(&self, w: &IBox) -> IBox {
+        let lo = [0, 1, 2].map(|a| w.lo[a] - self.offset[a]);
+        let hi = [0, 1, 2].map(|a| w.hi[a] - self.offset[a]);
+        if self.rotation.is_identity() {
+            return IBox { lo, hi };
+        }
+        let (lo, hi) = self.rotation.inverse().apply_box(lo, hi);
+        IBox { lo, hi }
+    }
+
     /// The half-open box `b` (in the tree's coordinates) placed in the world.
     #[inline]
     pub(crate) fn place_box(&self, b: &IBox) -> IBox {
@@ -278,23 +290,23 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Overlap<'_, A, B> {
             let (a, v) = (self.a, self.a.tree.node_voxels(&na));
             return self.covered(v, |out| push_leaves(a, na, out));
         }
+        // Split the larger node; its children are filtered against the other box
+        // seen in its own coordinates, so only the survivors are placed.
         if !fa && (fb || self.a.tree.node_size(&na) >= self.b.tree.node_size(&nb)) {
             let mut kids = [na; 8];
-            let n = self.a.tree.node_children(&na, &mut kids);
+            let q = self.a.place.unplace_box(&bb);
+            let n = self.a.tree.children_meeting(&na, &q, &mut kids);
             for &c in &kids[..n] {
                 let bc = self.a.world_box(&c);
-                if bc.overlaps(&bb) {
-                    self.visit(c, bc, nb, bb)?;
-                }
+                self.visit(c, bc, nb, bb)?;
             }
         } else {
             let mut kids = [nb; 8];
-            let n = self.b.tree.node_children(&nb, &mut kids);
+            let q = self.b.place.unplace_box(&ba);
+            let n = self.b.tree.children_meeting(&nb, &q, &mut kids);
             for &c in &kids[..n] {
                 let bc = self.b.world_box(&c);
-                if ba.overlaps(&bc) {
-                    self.visit(na, ba, c, bc)?;
-                }
+                self.visit(na, ba, c, bc)?;
             }
         }
         ControlFlow::Continue(())

@@ -43,6 +43,20 @@ pub trait Traversable: sealed::Sealed + Sync {
     /// The number of black voxels under the node.
     #[doc(hidden)]
     fn node_voxels(&self, n: &Self::Node) -> u64;
+    /// The non-empty children whose boxes meet `q` (in the tree's coordinates).
+    #[doc(hidden)]
+    #[inline]
+    fn children_meeting(&self, n: &Self::Node, q: &IBox, out: &mut [Self::Node; 8]) -> usize {
+        let k = self.node_children(n, out);
+        let mut m = 0;
+        for i in 0..k {
+            if self.node_box(&out[i]).overlaps(q) {
+                out[m] = out[i];
+                m += 1;
+            }
+        }
+        m
+    }
     /// For a node inside a 4³ cell: that cell's lowest voxel (tree coordinates) and
     /// the node's voxels in it as a 64-bit mask (bit `x + 4y + 16z`).
     #[doc(hidden)]
@@ -374,6 +388,34 @@ impl Traversable for BoxTree {
     #[inline]
     fn node_voxels(&self, n: &BoxRef) -> u64 {
         self.nodes[n.0 as usize].voxels
+    }
+
+    #[inline]
+    fn children_meeting(&self, n: &BoxRef, q: &IBox, out: &mut [BoxRef; 8]) -> usize {
+        let b = &self.nodes[n.0 as usize];
+        let o = self.origin;
+        // The query relative to the origin, clamped into i32 (the nodes' range).
+        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
+        let lo = [0, 1, 2].map(|a| clamp(q.lo[a] - o[a]));
+        let hi = [0, 1, 2].map(|a| clamp(q.hi[a] - o[a]));
+        let first = b.first as usize;
+        let mut m = 0;
+        for (i, c) in self.nodes[first..first + usize::from(b.count)]
+            .iter()
+            .enumerate()
+        {
+            if c.lo[0] < hi[0]
+                && lo[0] < c.hi[0]
+                && c.lo[1] < hi[1]
+                && lo[1] < c.hi[1]
+                && c.lo[2] < hi[2]
+                && lo[2] < c.hi[2]
+            {
+                out[m] = BoxRef((first + i) as u32);
+                m += 1;
+            }
+        }
+        m
     }
 
     #[inline]
