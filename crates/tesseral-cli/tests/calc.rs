@@ -1,14 +1,13 @@
 //! Runs the real `tesseral` binary: `calc` and `tables`, good and bad input.
 
-use std::process::{Command, Output};
+use std::process::Output;
 
+mod common;
+
+/// Runs `tesseral args...` in a fresh temporary directory.
 fn run(args: &[&str]) -> Output {
     let dir = tempfile::tempdir().expect("temp dir");
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .args(args)
-        .current_dir(dir.path())
-        .output()
-        .expect("run tesseral")
+    common::run(dir.path(), args)
 }
 
 fn stdout(o: &Output) -> String {

@@ -1,6 +1,6 @@
 //! Error reporting shared by every command: one line, each cause once, exit code 2.
 
-use std::process::Command;
+mod common;
 
 #[test]
 fn a_missing_file_is_named_once_with_its_cause_once() {
@@ -11,11 +11,7 @@ fn a_missing_file_is_named_once_with_its_cause_once() {
         &["collide", "missing.tess", "missing.tess"],
         &["render", "missing.tss", "-o", "x.png"],
     ] {
-        let out = Command::new(env!("CARGO_BIN_EXE_tesseral"))
-            .args(args)
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
+        let out = common::run(dir.path(), args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8(out.stderr).unwrap();
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");

@@ -3,25 +3,9 @@
 
 use std::collections::BTreeSet;
 use std::path::Path;
-use std::process::{Command, Output};
 
-fn tesseral(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("run tesseral")
-}
-
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = tesseral(dir, args);
-    assert!(
-        out.status.success(),
-        "tesseral {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
+mod common;
+use common::{ok, run};
 
 /// The voxels listed in a `.xyz` file.
 fn voxel_set(path: &Path) -> BTreeSet<[i64; 3]> {
@@ -188,7 +172,7 @@ fn open_meshes_need_surface_only() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     std::fs::write(d.join("open.stl"), box_stl([0.0; 3], [4.0; 3], true)).unwrap();
-    let out = tesseral(
+    let out = run(
         d,
         &["convert", "open.stl", "open.tess", "--voxel-size", "1"],
     );
@@ -334,7 +318,7 @@ fn bad_input_gives_one_line_errors_and_exit_2() {
             "--depth",
         ),
     ] {
-        let out = tesseral(d, &args);
+        let out = run(d, &args);
         assert_eq!(out.status.code(), Some(2), "{args:?}");
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(err.contains(needle), "{args:?}: {err}");

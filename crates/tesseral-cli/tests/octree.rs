@@ -3,31 +3,15 @@
 use std::collections::BTreeSet;
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output};
+
+mod common;
+use common::{ok, run};
 
 type Voxels = BTreeSet<[i64; 3]>;
 
-fn tesseral(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("the binary runs")
-}
-
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let out = tesseral(dir, args);
-    assert!(
-        out.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).unwrap()
-}
-
 /// Runs a command that must fail with exit code 2 without panicking; returns stderr.
 fn fails(dir: &Path, args: &[&str]) -> String {
-    let out = tesseral(dir, args);
+    let out = run(dir, args);
     assert_eq!(out.status.code(), Some(2), "{args:?} should fail with 2");
     let err = String::from_utf8(out.stderr).unwrap();
     assert!(!err.contains("panicked"), "{args:?} panicked: {err}");

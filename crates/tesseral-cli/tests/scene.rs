@@ -1,7 +1,9 @@
 //! Runs the real `tesseral` binary: `build` and `render`, good and bad input.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+
+mod common;
+use common::{ok, run};
 
 const TANK: &str = include_str!("../../../scenes/tank.tss");
 
@@ -9,27 +11,9 @@ fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
 }
 
-fn run_in(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tesseral")
-}
-
-fn ok(dir: &Path, args: &[&str]) -> String {
-    let o = run_in(dir, args);
-    assert!(
-        o.status.success(),
-        "{args:?} failed: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    String::from_utf8(o.stdout).expect("utf-8")
-}
-
 /// Fails with exit code 2, naming `names`, without a panic; returns stderr.
 fn bad(dir: &Path, args: &[&str], names: &str) -> String {
-    let o = run_in(dir, args);
+    let o = run(dir, args);
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
     assert!(err.starts_with("error: "), "{args:?}: {err}");

@@ -151,7 +151,7 @@ impl<W: CodeWord> Space<W> {
     }
 
     #[inline]
-    fn add_axis(&self, a: W, b: W, m: W) -> (W, bool) {
+    fn add_axis(a: W, b: W, m: W) -> (W, bool) {
         // Ones in every bit outside this axis carry straight through them; the carry
         // out of the axis's top bit runs through the ones above and leaves the word.
         let (s, c) = (a | !m).overflowing_add(b & m);
@@ -159,10 +159,37 @@ impl<W: CodeWord> Space<W> {
     }
 
     #[inline]
-    fn sub_axis(&self, a: W, b: W, m: W) -> (W, bool) {
+    fn sub_axis(a: W, b: W, m: W) -> (W, bool) {
         // Zeros outside the axis pass a borrow on (0 - 0 - 1 = 1, borrow 1).
         let (s, c) = (a & m).overflowing_sub(b & m);
         (s & m, c)
+    }
+
+    /// `op` (one of [`Self::add_axis`], [`Self::sub_axis`]) on every axis, with the
+    /// carries out of the top collected into a digit.
+    #[inline]
+    fn overflowing_per_axis(&self, a: W, b: W, op: impl Fn(W, W, W) -> (W, bool)) -> Carried<W> {
+        let mut code = W::ZERO;
+        let mut carry = 0;
+        for (i, &m) in self.axis.iter().enumerate() {
+            let (s, c) = op(a, b, m);
+            code = code | s;
+            carry |= u8::from(c) << i;
+        }
+        Carried { code, carry }
+    }
+
+    /// `op` (one of [`Self::add_axis`], [`Self::sub_axis`]) of a unit along `axis`,
+    /// the other axes unchanged; a depth-0 space has no unit, so the step is lost.
+    #[inline]
+    fn overflowing_step(&self, a: W, axis: Axis, op: impl Fn(W, W, W) -> (W, bool)) -> Carried<W> {
+        let m = self.axis[axis as usize];
+        let (s, c) = op(a, m & W::low_bits(3), m);
+        let unit_missing = self.depth == 0;
+        Carried {
+            code: (a & self.all & !m) | s,
+            carry: u8::from(c || unit_missing) << axis.shift(),
+        }
     }
 
     /// `a + b`, the translation of `a` by the vector `0b`, with the carry out of the
@@ -193,14 +220,7 @@ impl<W: CodeWord> Space<W> {
     #[inline]
     #[must_use]
     pub fn overflowing_add(&self, a: W, b: W) -> Carried<W> {
-        let mut code = W::ZERO;
-        let mut carry = 0;
-        for (i, &m) in self.axis.iter().enumerate() {
-            let (s, c) = self.add_axis(a, b, m);
-            code = code | s;
-            carry |= u8::from(c) << i;
-        }
-        Carried { code, carry }
+        self.overflowing_per_axis(a, b, Self::add_axis)
     }
 
     /// `a + b`, or `None` when a coordinate leaves `[0, 2^depth)`. O(1).
@@ -231,14 +251,7 @@ impl<W: CodeWord> Space<W> {
     #[inline]
     #[must_use]
     pub fn overflowing_sub(&self, a: W, b: W) -> Carried<W> {
-        let mut code = W::ZERO;
-        let mut carry = 0;
-        for (i, &m) in self.axis.iter().enumerate() {
-            let (s, c) = self.sub_axis(a, b, m);
-            code = code | s;
-            carry |= u8::from(c) << i;
-        }
-        Carried { code, carry }
+        self.overflowing_per_axis(a, b, Self::sub_axis)
     }
 
     /// `a - b`, or `None` when a coordinate would go below 0. O(1).
@@ -268,13 +281,7 @@ impl<W: CodeWord> Space<W> {
     #[inline]
     #[must_use]
     pub fn overflowing_inc(&self, a: W, axis: Axis) -> Carried<W> {
-        let m = self.axis[axis as usize];
-        let (s, c) = self.add_axis(a, m & W::low_bits(3), m);
-        let unit_missing = self.depth == 0;
-        Carried {
-            code: (a & self.all & !m) | s,
-            carry: u8::from(c || unit_missing) << axis.shift(),
-        }
+        self.overflowing_step(a, axis, Self::add_axis)
     }
 
     /// One step in the positive direction of `axis`, wrapping. O(1).
@@ -303,14 +310,7 @@ impl<W: CodeWord> Space<W> {
     #[inline]
     #[must_use]
     pub fn overflowing_dec(&self, a: W, axis: Axis) -> Carried<W> {
-        let m = self.axis[axis as usize];
-        let unit = m & W::low_bits(3);
-        let (s, c) = self.sub_axis(a, unit, m);
-        let unit_missing = self.depth == 0;
-        Carried {
-            code: (a & self.all & !m) | s,
-            carry: u8::from(c || unit_missing) << axis.shift(),
-        }
+        self.overflowing_step(a, axis, Self::sub_axis)
     }
 
     /// One step in the negative direction of `axis`, wrapping. O(1).

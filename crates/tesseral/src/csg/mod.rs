@@ -27,7 +27,7 @@ pub mod scene;
 mod shape;
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;
 
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};
 pub use scene::{Scene, SceneError};

@@ -6,10 +6,11 @@ use super::*;
 use crate::linear::{CellClass, Classifier, LinearOctree};
 use crate::Voxel;
 
-/// A small xorshift generator; every test prints its seed.
-struct Rng(u64);
+/// A small xorshift generator; every test prints its seed. Shared with the render
+/// tests.
+pub(crate) struct Rng(pub(crate) u64);
 impl Rng {
-    fn next(&mut self) -> u64 {
+    pub(crate) fn next(&mut self) -> u64 {
         self.0 ^= self.0 << 13;
         self.0 ^= self.0 >> 7;
         self.0 ^= self.0 << 17;
@@ -18,7 +19,7 @@ impl Rng {
     fn unit(&mut self) -> f64 {
         (self.next() >> 11) as f64 / (1u64 << 53) as f64
     }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
+    pub(crate) fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.unit()
     }
 }

@@ -335,7 +335,7 @@ fn put_runs(out: &mut Vec<u8>, value: u8, mut n: u64) {
 mod tests {
     use super::*;
     use crate::Voxel;
-    use rand::{Rng, SeedableRng};
+    use rand::SeedableRng;
     use std::collections::HashSet;
 
     #[test]
@@ -375,20 +375,8 @@ mod tests {
     fn random_round_trips_match_a_voxel_set() {
         for seed in 0..50u64 {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let origin = [
-                rng.random_range(-9..9),
-                rng.random_range(-9..9),
-                rng.random_range(-9..9),
-            ];
-            let voxels: HashSet<Voxel> = (0..rng.random_range(0..500))
-                .map(|_| {
-                    [
-                        origin[0] + rng.random_range(0..16),
-                        origin[1] + rng.random_range(0..16),
-                        origin[2] + rng.random_range(0..16),
-                    ]
-                })
-                .collect();
+            let (origin, voxels) = crate::io::random_voxels(&mut rng, 9, 16, 500);
+            let voxels: HashSet<Voxel> = voxels.into_iter().collect();
             let tree = LinearOctree::from_voxels(4, origin, voxels.iter().copied()).unwrap();
             let bytes = encode(&VoxelModel::new(tree)).unwrap();
             let back = decode(&bytes, Path::new("t.binvox"))

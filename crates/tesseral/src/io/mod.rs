@@ -354,3 +354,29 @@ pub const MAX_DENSE_VOXELS: u64 = 1 << 26;
 /// The most per-voxel colours a reader expands (a colour map entry takes about 40
 /// bytes).
 pub const MAX_COLORED_VOXELS: u64 = 1 << 24;
+
+/// Random test solids: an origin in `[-spread, spread)^3` and up to `max_count - 1`
+/// voxels drawn uniformly from the cube of side `side` above it (repeats possible).
+#[cfg(test)]
+pub(crate) fn random_voxels(
+    rng: &mut impl rand::Rng,
+    spread: i64,
+    side: i64,
+    max_count: i32,
+) -> (Voxel, Vec<Voxel>) {
+    let origin = [
+        rng.random_range(-spread..spread),
+        rng.random_range(-spread..spread),
+        rng.random_range(-spread..spread),
+    ];
+    let voxels = (0..rng.random_range(0..max_count))
+        .map(|_| {
+            [
+                origin[0] + rng.random_range(0..side),
+                origin[1] + rng.random_range(0..side),
+                origin[2] + rng.random_range(0..side),
+            ]
+        })
+        .collect();
+    (origin, voxels)
+}

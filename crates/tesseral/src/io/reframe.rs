@@ -118,20 +118,7 @@ mod tests {
     fn reframe_keeps_voxels_for_random_offsets() {
         for seed in 0..60u64 {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let origin = [
-                rng.random_range(-5..5),
-                rng.random_range(-5..5),
-                rng.random_range(-5..5),
-            ];
-            let voxels: Vec<Voxel> = (0..rng.random_range(0..400))
-                .map(|_| {
-                    [
-                        origin[0] + rng.random_range(0..8),
-                        origin[1] + rng.random_range(0..8),
-                        origin[2] + rng.random_range(0..8),
-                    ]
-                })
-                .collect();
+            let (origin, voxels) = crate::io::random_voxels(&mut rng, 5, 8, 400);
             let tree = LinearOctree::from_voxels(3, origin, voxels.iter().copied()).unwrap();
             let new_origin = [
                 origin[0] - rng.random_range(0..8),

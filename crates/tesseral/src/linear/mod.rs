@@ -6,7 +6,6 @@
 //! canonical form: sorted, disjoint, and with no eight black siblings left unmerged.
 //! Two equal solids in the same space therefore have equal leaf lists.
 
-pub(crate) mod arith;
 mod build;
 pub(crate) mod grow;
 mod leaf;

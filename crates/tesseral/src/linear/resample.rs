@@ -25,8 +25,8 @@
 
 use rayon::prelude::*;
 
-use super::{arith, grow, push_merging, Leaf, LinearOctree, OctreeError};
-use crate::code;
+use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};
+use crate::code::{self, Space};
 use crate::Voxel;
 
 const EMPTY: u32 = 0;
@@ -598,7 +598,8 @@ impl LinearOctree {
         // The tesseral sum is taken modulo 2^21 per axis; kept cells land inside
         // [0, 2^depth), where it is exact. The displacement's low `a` digits are
         // zero, so a leaf's digits below `a` ride along unchanged.
-        let t = arith::displacement_code([-delta[0], -delta[1], -delta[2]]);
+        let space = Space::<u64>::full();
+        let t = space.encode_wrapping([-delta[0], -delta[1], -delta[2]]);
         let shift = 3 * u32::from(a);
         let low = (1u64 << shift) - 1;
         let inside = |cell: u64| {
@@ -617,7 +618,7 @@ impl LinearOctree {
             let end_code = cell + low + 1;
             let n = rest.partition_point(|l| l.packed() < end_code << 1);
             if all_inside || inside(cell) {
-                runs.push((arith::add(cell, t), start, start + n));
+                runs.push((space.add(cell, t), start, start + n));
             }
             start += n;
             rest = &rest[n..];

@@ -189,3 +189,41 @@ fn fitted_space_holds_the_voxels() {
     assert!(vs.iter().all(|&v| tree.contains(v)));
     assert_eq!(tree.voxel_count(), 3);
 }
+
+/// Translation moves aligned leaves with `Space::<u64>::full()`: its `add` of a code
+/// and `encode_wrapping` of a displacement is per-axis addition modulo `2^21`.
+#[test]
+fn translation_code_sum_is_per_axis_modular_addition() {
+    use crate::code::{decode, encode, Space};
+    let space = Space::<u64>::full();
+    let mut s = 0x1234_5678_9abc_def1_u64;
+    for _ in 0..10_000 {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        let a = [
+            s as u32 & 0x1f_ffff,
+            (s >> 21) as u32 & 0x1f_ffff,
+            (s >> 42) as u32 & 0x1f_ffff,
+        ];
+        let t = [
+            (s >> 3) as i64 % 5000 - 2500,
+            (s >> 17) as i64 % 70,
+            -((s >> 29) as i64 % 1000),
+        ];
+        let sum = space.add(encode(a[0], a[1], a[2]), space.encode_wrapping(t));
+        let want: [u32; 3] =
+            std::array::from_fn(|i| ((i64::from(a[i]) + t[i]).rem_euclid(1 << 21)) as u32);
+        assert_eq!(decode(sum), want, "seed-free xorshift, a={a:?} t={t:?}");
+    }
+}
+
+/// The x-bit mask the transforms use is every third bit of the low 63.
+#[test]
+fn x_mask_is_every_third_bit() {
+    use crate::code::CodeWord;
+    assert_eq!(
+        <u64 as CodeWord>::X_MASK,
+        0x9249_2492_4924_9249 & ((1 << 63) - 1)
+    );
+}

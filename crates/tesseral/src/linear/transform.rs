@@ -10,9 +10,12 @@
 // Per-axis loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
-use super::arith::MASK_X;
 use super::{push_merging, sort, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
+use crate::code::CodeWord;
 use crate::Voxel;
+
+/// The x bits of a code: bit `3i` for every digit `i`.
+const MASK_X: u64 = <u64 as CodeWord>::X_MASK;
 
 /// A coordinate axis.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]

@@ -66,6 +66,29 @@ fn parse_coord(path: &Path, line: usize, col: usize, w: &str) -> Result<f64, For
     }
 }
 
+/// The three coordinates after `key` on line number `line_no` (text `line`).
+fn parse_point<'a>(
+    ws: &mut impl Iterator<Item = (usize, &'a str)>,
+    path: &Path,
+    line_no: usize,
+    line: &str,
+    key: &str,
+) -> Result<[f64; 3], FormatError> {
+    let mut p = [0.0; 3];
+    for x in &mut p {
+        let (c, w) = ws.next().ok_or_else(|| {
+            syntax(
+                path,
+                line_no,
+                line.len() + 1,
+                format!("`{key}` needs three numbers"),
+            )
+        })?;
+        *x = parse_coord(path, line_no, c, w)?;
+    }
+    Ok(p)
+}
+
 /// Parses STL, binary when the size matches its triangle count, ASCII otherwise.
 ///
 /// # Errors
@@ -145,13 +168,7 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         match key {
             "solid" => saw_solid = true,
             "vertex" => {
-                let mut p = [0.0; 3];
-                for x in &mut p {
-                    let (c, w) = ws.next().ok_or_else(|| {
-                        syntax(path, i + 1, line.len() + 1, "`vertex` needs three numbers")
-                    })?;
-                    *x = parse_coord(path, i + 1, c, w)?;
-                }
+                let p = parse_point(&mut ws, path, i + 1, line, "vertex")?;
                 if m.positions.len() >= 3 * MAX_MESH_ELEMENTS {
                     return Err(FormatError::too_large(path, "too many vertices"));
                 }
@@ -203,13 +220,7 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         let Some((_, key)) = ws.next() else { continue };
         match key {
             "v" => {
-                let mut p = [0.0; 3];
-                for x in &mut p {
-                    let (c, w) = ws.next().ok_or_else(|| {
-                        syntax(path, i + 1, line.len() + 1, "`v` needs three numbers")
-                    })?;
-                    *x = parse_coord(path, i + 1, c, w)?;
-                }
+                let p = parse_point(&mut ws, path, i + 1, line, "v")?;
                 if m.positions.len() >= MAX_MESH_ELEMENTS {
                     return Err(FormatError::too_large(path, "too many vertices"));
                 }
@@ -641,6 +652,14 @@ mod tests {
         let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
         let m = parse_ply(ply.as_bytes(), Path::new("t.ply")).unwrap();
         assert_eq!((m.positions.len(), m.triangles.len()), (3, 1));
+    }
+
+    #[test]
+    fn a_short_point_names_its_keyword() {
+        let e = parse_obj(b"v 1 2\n", Path::new("a.obj")).unwrap_err();
+        assert_eq!(e.to_string(), "a.obj:1:6: `v` needs three numbers");
+        let e = parse_stl(b"solid x\nvertex 1 2\n", Path::new("a.stl")).unwrap_err();
+        assert_eq!(e.to_string(), "a.stl:2:11: `vertex` needs three numbers");
     }
 
     #[test]

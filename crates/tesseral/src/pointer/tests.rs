@@ -76,8 +76,8 @@ fn path_addition_is_tesseral_addition() {
         let code = path.iter().fold(0u64, |c, &d| (c << 3) | u64::from(d));
         let mut tv = [0i64; 3];
         tv[axis] = t;
-        let want = crate::linear::arith::add(code, crate::linear::arith::displacement_code(tv))
-            & ((1u64 << (3 * digits)) - 1);
+        let space = crate::code::Space::<u64>::full();
+        let want = space.add(code, space.encode_wrapping(tv)) & ((1u64 << (3 * digits)) - 1);
         let got = add_along_axis(&path, axis, t)
             .iter()
             .fold(0u64, |c, &d| (c << 3) | u64::from(d));

@@ -2,20 +2,8 @@
 //! silhouettes.
 
 use super::*;
+use crate::csg::tests::Rng;
 use crate::csg::{Shape, Solid};
-
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn range(&mut self, lo: f64, hi: f64) -> f64 {
-        lo + (hi - lo) * ((self.next() >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
 
 fn random_tree(rng: &mut Rng, depth: u8, origin: [i64; 3]) -> LinearOctree {
     let side = f64::from(1u32 << depth);

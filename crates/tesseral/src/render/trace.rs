@@ -144,6 +144,23 @@ pub struct Hit {
 }
 
 impl RayTree {
+    /// The index of `tree` with its root classified and no nodes yet. O(1).
+    fn unindexed(tree: &LinearOctree) -> Self {
+        let depth = tree.depth();
+        RayTree {
+            depth,
+            origin: tree.origin(),
+            root: match colour_of(tree.leaves(), 0, depth) {
+                Colour::White => Root::White,
+                Colour::Black => Root::Black,
+                Colour::Gray => Root::Gray,
+            },
+            nodes: Vec::new(),
+            root_node: 0,
+            bbox: tree.bbox(),
+        }
+    }
+
     /// Indexes the gray nodes of `tree` in one pass over its sorted leaves: the open
     /// ancestors of the current leaf are kept on a stack; a node is closed when the
     /// leaves leave it, and its gray children's records are then stored together.
@@ -155,19 +172,7 @@ impl RayTree {
     pub fn new(tree: &LinearOctree) -> Self {
         let depth = tree.depth();
         let leaves = tree.leaves();
-        let mut rt = RayTree {
-            depth,
-            origin: tree.origin(),
-            root: Root::White,
-            nodes: Vec::new(),
-            root_node: 0,
-            bbox: tree.bbox(),
-        };
-        rt.root = match colour_of(leaves, 0, depth) {
-            Colour::White => Root::White,
-            Colour::Black => Root::Black,
-            Colour::Gray => Root::Gray,
-        };
+        let mut rt = Self::unindexed(tree);
         if rt.root != Root::Gray {
             return rt;
         }
@@ -209,29 +214,15 @@ impl RayTree {
     /// one-pass builder is tested against.
     #[cfg(test)]
     pub(crate) fn new_by_partition(tree: &LinearOctree) -> Self {
-        let depth = tree.depth();
-        let leaves = tree.leaves();
-        let mut rt = RayTree {
-            depth,
-            origin: tree.origin(),
-            root: Root::White,
-            nodes: Vec::new(),
-            root_node: 0,
-            bbox: tree.bbox(),
-        };
-        rt.root = match colour_of(leaves, 0, depth) {
-            Colour::White => Root::White,
-            Colour::Black => Root::Black,
-            Colour::Gray => {
-                rt.nodes.push(Node {
-                    first: 0,
-                    gray: 0,
-                    black: 0,
-                });
-                rt.index(0, 0, depth, leaves);
-                Root::Gray
-            }
-        };
+        let mut rt = Self::unindexed(tree);
+        if rt.root == Root::Gray {
+            rt.nodes.push(Node {
+                first: 0,
+                gray: 0,
+                black: 0,
+            });
+            rt.index(0, 0, tree.depth(), tree.leaves());
+        }
         rt
     }
 
