@@ -1003,7 +1003,7 @@ impl DynamicOctree {
         let u = self.offsets(v);
         let phys = self.phys_log2();
         if !within(u, phys) {
-            return self.neighbourhood_slow(u, NONE, 0);
+            return self.neighbourhood_slow(u, NONE, 0, &ZERO_BLOCK);
         }
         let (cur, level, parent) = self.descend(self.root, phys, NONE, u);
         let m = if level >= 64 {
@@ -1022,7 +1022,14 @@ impl DynamicOctree {
                 _ => extract27(&self.leaves[cur as usize].0, u),
             };
         }
-        self.neighbourhood_slow(u, parent, level + 1)
+        // The block of `u` itself is the one just found (a uniform octant stands for
+        // every block inside it): the slow path reuses it.
+        let own = match cur {
+            EMPTY => &ZERO_BLOCK,
+            FULL => &FULL_BLOCK,
+            _ => &self.leaves[cur as usize].0,
+        };
+        self.neighbourhood_slow(u, parent, level + 1, own)
     }
 
     /// The block (8³ voxels) whose minimum corner has offsets `t`, found from node
@@ -1047,7 +1054,8 @@ impl DynamicOctree {
     }
 
     #[inline(never)]
-    fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32) -> u32 {
+    fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32, own: &[u64; 8]) -> u32 {
+        let home = [u[0] >> 3, u[1] >> 3, u[2] >> 3];
         let lo = [
             u[0].wrapping_sub(1) >> 3,
             u[1].wrapping_sub(1) >> 3,
@@ -1065,7 +1073,11 @@ impl DynamicOctree {
                 continue;
             }
             let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
-            blocks[i] = self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level);
+            blocks[i] = if b == home {
+                own
+            } else {
+                self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level)
+            };
         }
         // Row by row: the three cells (x−1, x, x+1) of a row come from one block
         // word, or from two when the row crosses a block boundary in x.
