@@ -570,7 +570,7 @@ impl DynamicOctree {
     }
 
     /// Sets the bit of `v` and counts it; no face update. True when `v` is new.
-    #[inline]
+    #[inline(always)]
     fn insert_bit(&mut self, v: Voxel) -> bool {
         if self.root == EMPTY {
             self.root_min = v;
@@ -766,7 +766,7 @@ impl DynamicOctree {
 
     /// Clears the bit of `v`, counts it and contracts the root; no face update. True
     /// when `v` was black.
-    #[inline]
+    #[inline(always)]
     fn remove_bit(&mut self, v: Voxel) -> bool {
         if self.root == EMPTY {
             return false;
