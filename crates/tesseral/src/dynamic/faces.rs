@@ -204,33 +204,41 @@ impl VoxelTable {
 /// No face in that direction.
 const NO_FACE: u32 = u32::MAX;
 
-/// One entry of the dense face list: the face and the back-pointer record of its
-/// voxel, so that a face moved by `swap_remove` updates its back-pointer without
-/// hashing.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct Entry {
-    pub(crate) voxel: Voxel,
-    pub(crate) dir: u8,
-    pub(crate) owner: u32,
+/// One entry of the dense face list, packed in 4 bytes: `owner << 3 | dir`, where
+/// `owner` is the back-pointer record of the face's voxel. The voxel itself is read
+/// from the record, so a face costs 4 bytes in the list instead of a full voxel, and
+/// a face moved by `swap_remove` updates its back-pointer without hashing.
+pub(crate) type Entry = u32;
+
+/// The record index of a packed entry.
+#[inline]
+pub(crate) fn entry_owner(e: Entry) -> u32 {
+    e >> 3
 }
 
-impl Entry {
-    #[inline]
-    pub(crate) fn face(&self) -> Face {
-        Face {
-            voxel: self.voxel,
-            dir: self.dir,
-        }
-    }
+/// The direction of a packed entry.
+#[inline]
+pub(crate) fn entry_dir(e: Entry) -> u8 {
+    (e & 7) as u8
 }
 
-/// The back-pointers of one surface voxel: the voxel, where each of its six faces
-/// sits in the list (`NO_FACE` when covered), and how many it has.
+/// The most records a face list can hold (the owner takes 29 bits of an entry).
+const MAX_RECORDS: usize = 1 << 29;
+
+/// The back-pointers of one surface voxel: the voxel, and where each of its six faces
+/// sits in the list (`NO_FACE` when covered). 48 bytes.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Record {
     pub(crate) voxel: Voxel,
     pub(crate) at: [u32; 6],
-    pub(crate) count: u32,
+}
+
+impl Record {
+    /// How many faces the voxel has.
+    #[inline]
+    fn count(&self) -> usize {
+        self.at.iter().filter(|&&a| a != NO_FACE).count()
+    }
 }
 
 /// The dense face list and its back-pointers. A surface voxel has one record (six
@@ -256,14 +264,17 @@ impl FaceList {
         let rec = Record {
             voxel: v,
             at: [NO_FACE; 6],
-            count: 0,
         };
         let r = if let Some(i) = self.free.pop() {
             self.records[i as usize] = rec;
             i
         } else {
+            assert!(
+                self.records.len() < MAX_RECORDS,
+                "more than 2^29 surface voxels"
+            );
             self.records.push(rec);
-            u32::try_from(self.records.len() - 1).expect("more than 2^32 surface voxels")
+            (self.records.len() - 1) as u32
         };
         self.owners.insert(v, r);
         r
@@ -280,17 +291,22 @@ impl FaceList {
 
     /// Appends face (`v`, `dir`) owned by record `rec`. O(1) amortised.
     #[inline]
-    pub(crate) fn push(&mut self, rec: u32, v: Voxel, dir: u8) {
+    pub(crate) fn push(&mut self, rec: u32, dir: u8) {
         let i = u32::try_from(self.list.len()).expect("more than 2^32 faces");
         let r = &mut self.records[rec as usize];
         debug_assert_eq!(r.at[usize::from(dir)], NO_FACE, "face pushed twice");
         r.at[usize::from(dir)] = i;
-        r.count += 1;
-        self.list.push(Entry {
-            voxel: v,
-            dir,
-            owner: rec,
-        });
+        self.list.push(rec << 3 | u32::from(dir));
+    }
+
+    /// The face at list position `i`. O(1).
+    #[inline]
+    pub(crate) fn face(&self, i: usize) -> Face {
+        let e = self.list[i];
+        Face {
+            voxel: self.records[entry_owner(e) as usize].voxel,
+            dir: entry_dir(e),
+        }
     }
 
     /// Removes face (`v`, `dir`) owned by record `rec` by `swap_remove`: the last face
@@ -301,12 +317,11 @@ impl FaceList {
         let i = r.at[usize::from(dir)];
         assert!(i != NO_FACE, "face {v:?} {dir} missing from the face list");
         r.at[usize::from(dir)] = NO_FACE;
-        r.count -= 1;
-        let gone = r.count == 0;
+        let gone = r.at == [NO_FACE; 6];
         let last = self.list.pop().expect("face list is empty");
         if (i as usize) < self.list.len() {
             self.list[i as usize] = last;
-            self.records[last.owner as usize].at[usize::from(last.dir)] = i;
+            self.records[entry_owner(last) as usize].at[usize::from(entry_dir(last))] = i;
         }
         if gone {
             let records = &self.records;
@@ -319,24 +334,23 @@ impl FaceList {
     pub(crate) fn assert_valid(&self) {
         let records = &self.records;
         let key_of = |r: u32| records[r as usize].voxel;
-        for (i, e) in self.list.iter().enumerate() {
-            assert!(e.dir < 6, "face {i} has direction {}", e.dir);
-            assert_eq!(
-                self.owners.get(e.voxel, key_of),
-                Some(e.owner),
-                "owner of face {i}"
+        let free: std::collections::HashSet<u32> = self.free.iter().copied().collect();
+        for (i, &e) in self.list.iter().enumerate() {
+            let (owner, dir) = (entry_owner(e), entry_dir(e));
+            assert!(dir < 6, "face {i} has direction {dir}");
+            assert!(
+                (owner as usize) < records.len(),
+                "owner of face {i} out of range"
             );
+            assert!(!free.contains(&owner), "face {i} owned by a free record");
+            let v = records[owner as usize].voxel;
+            assert_eq!(self.owners.get(v, key_of), Some(owner), "owner of face {i}");
             assert_eq!(
-                records[e.owner as usize].voxel, e.voxel,
-                "record voxel of face {i}"
-            );
-            assert_eq!(
-                records[e.owner as usize].at[usize::from(e.dir)],
+                records[owner as usize].at[usize::from(dir)],
                 i as u32,
                 "back-pointer of face {i}"
             );
         }
-        let free: std::collections::HashSet<u32> = self.free.iter().copied().collect();
         assert_eq!(
             free.len(),
             self.free.len(),
@@ -356,9 +370,21 @@ impl FaceList {
                 Some(r),
                 "index of record {r}"
             );
-            let n = rec.at.iter().filter(|&&a| a != NO_FACE).count();
-            assert_eq!(n as u32, rec.count, "face count in record {r}");
+            let n = rec.count();
             assert!(n > 0, "record {r} has no face");
+            for (d, &a) in rec.at.iter().enumerate() {
+                if a != NO_FACE {
+                    assert!(
+                        (a as usize) < self.list.len(),
+                        "record {r} points past the list"
+                    );
+                    assert_eq!(
+                        self.list[a as usize],
+                        r << 3 | d as u32,
+                        "record {r} dir {d}"
+                    );
+                }
+            }
             total += n;
         }
         assert_eq!(total, self.list.len(), "faces in records vs list");

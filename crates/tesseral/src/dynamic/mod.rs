@@ -265,6 +265,16 @@ fn extract27(l: &[u64; 8], u: [u64; 3]) -> u32 {
     r
 }
 
+/// The six face-neighbour bits (bit `dir`) of a 27-bit neighbourhood.
+#[inline]
+fn six(n: u32) -> u8 {
+    let mut m = 0u8;
+    for (dir, &bit) in NEIGHBOUR_BIT.iter().enumerate() {
+        m |= ((n >> bit & 1) as u8) << dir;
+    }
+    m
+}
+
 impl DynamicOctree {
     /// An empty tree without face bookkeeping (the occupancy-map use). O(1).
     ///
@@ -526,6 +536,42 @@ impl DynamicOctree {
     /// assert_eq!(t.voxel_count(), 1);
     /// ```
     pub fn insert(&mut self, v: Voxel) -> bool {
+        if !self.insert_bit(v) {
+            return false;
+        }
+        if self.faces.is_some() {
+            let nb = self.face_neighbours(v);
+            self.faces_after_insert(v, nb);
+        }
+        true
+    }
+
+    /// [`insert`](Self::insert) for a caller that already holds `nb`, the
+    /// [`neighbourhood`](Self::neighbourhood) of `v` taken since the last change: the
+    /// face update then needs no second search. A wrong `nb` corrupts the face list
+    /// (debug builds check it). O(depth) plus six O(1) face updates.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::with_faces();
+    /// t.insert([0, 0, 0]);
+    /// let nb = t.neighbourhood([1, 0, 0]);
+    /// assert!(t.insert_with_neighbourhood([1, 0, 0], nb));
+    /// assert_eq!(t.face_count(), 10);
+    /// ```
+    pub fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        debug_assert_eq!(nb, self.neighbourhood(v), "stale neighbourhood");
+        if !self.insert_bit(v) {
+            return false;
+        }
+        if self.faces.is_some() {
+            self.faces_after_insert(v, six(nb));
+        }
+        true
+    }
+
+    /// Sets the bit of `v` and counts it; no face update. True when `v` is new.
+    #[inline(always)]
+    fn insert_bit(&mut self, v: Voxel) -> bool {
         if self.root == EMPTY {
             self.root_min = v;
             self.size_log2 = 0;
@@ -543,9 +589,6 @@ impl DynamicOctree {
         }
         self.voxels += 1;
         self.version += 1;
-        if self.faces.is_some() {
-            self.faces_after_insert(v);
-        }
         true
     }
 
@@ -687,6 +730,44 @@ impl DynamicOctree {
     /// assert_eq!(t.voxel_count(), 0);
     /// ```
     pub fn remove(&mut self, v: Voxel) -> bool {
+        if !self.remove_bit(v) {
+            return false;
+        }
+        if self.faces.is_some() {
+            let nb = self.face_neighbours(v);
+            self.faces_after_remove(v, nb);
+        }
+        true
+    }
+
+    /// [`remove`](Self::remove) for a caller that already holds `nb`, the
+    /// [`neighbourhood`](Self::neighbourhood) of `v` taken since the last change: the
+    /// face update then needs no second search. A wrong `nb` corrupts the face list
+    /// (debug builds check it). O(depth) plus six O(1) face updates.
+    ///
+    /// ```
+    /// let mut t = tesseral::dynamic::DynamicOctree::with_faces();
+    /// t.insert([0, 0, 0]);
+    /// t.insert([1, 0, 0]);
+    /// let nb = t.neighbourhood([1, 0, 0]);
+    /// assert!(t.remove_with_neighbourhood([1, 0, 0], nb));
+    /// assert_eq!(t.face_count(), 6);
+    /// ```
+    pub fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        debug_assert_eq!(nb, self.neighbourhood(v), "stale neighbourhood");
+        if !self.remove_bit(v) {
+            return false;
+        }
+        if self.faces.is_some() {
+            self.faces_after_remove(v, six(nb));
+        }
+        true
+    }
+
+    /// Clears the bit of `v`, counts it and contracts the root; no face update. True
+    /// when `v` was black.
+    #[inline(always)]
+    fn remove_bit(&mut self, v: Voxel) -> bool {
         if self.root == EMPTY {
             return false;
         }
@@ -703,9 +784,6 @@ impl DynamicOctree {
             self.root_min = [0; 3];
         } else {
             self.contract();
-        }
-        if self.faces.is_some() {
-            self.faces_after_remove(v);
         }
         true
     }
@@ -925,7 +1003,7 @@ impl DynamicOctree {
         let u = self.offsets(v);
         let phys = self.phys_log2();
         if !within(u, phys) {
-            return self.neighbourhood_slow(u, NONE, 0);
+            return self.neighbourhood_slow(u, NONE, 0, &ZERO_BLOCK);
         }
         let (cur, level, parent) = self.descend(self.root, phys, NONE, u);
         let m = if level >= 64 {
@@ -944,7 +1022,14 @@ impl DynamicOctree {
                 _ => extract27(&self.leaves[cur as usize].0, u),
             };
         }
-        self.neighbourhood_slow(u, parent, level + 1)
+        // The block of `u` itself is the one just found (a uniform octant stands for
+        // every block inside it): the slow path reuses it.
+        let own = match cur {
+            EMPTY => &ZERO_BLOCK,
+            FULL => &FULL_BLOCK,
+            _ => &self.leaves[cur as usize].0,
+        };
+        self.neighbourhood_slow(u, parent, level + 1, own)
     }
 
     /// The block (8³ voxels) whose minimum corner has offsets `t`, found from node
@@ -969,7 +1054,8 @@ impl DynamicOctree {
     }
 
     #[inline(never)]
-    fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32) -> u32 {
+    fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32, own: &[u64; 8]) -> u32 {
+        let home = [u[0] >> 3, u[1] >> 3, u[2] >> 3];
         let lo = [
             u[0].wrapping_sub(1) >> 3,
             u[1].wrapping_sub(1) >> 3,
@@ -987,7 +1073,11 @@ impl DynamicOctree {
                 continue;
             }
             let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
-            blocks[i] = self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level);
+            blocks[i] = if b == home {
+                own
+            } else {
+                self.block_bits([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level)
+            };
         }
         // Row by row: the three cells (x−1, x, x+1) of a row come from one block
         // word, or from two when the row crosses a block boundary in x.
@@ -1029,18 +1119,13 @@ impl DynamicOctree {
     /// ```
     #[must_use]
     pub fn face_neighbours(&self, v: Voxel) -> u8 {
-        let n = self.neighbourhood(v);
-        let mut m = 0u8;
-        for (dir, &bit) in NEIGHBOUR_BIT.iter().enumerate() {
-            m |= ((n >> bit & 1) as u8) << dir;
-        }
-        m
+        six(self.neighbourhood(v))
     }
 
     // ----- faces (Libes §4, §5) -------------------------------------------------------
 
-    fn faces_after_insert(&mut self, v: Voxel) {
-        let nb = self.face_neighbours(v);
+    /// Face passing after `v` was created; `nb` is its face-neighbour mask.
+    fn faces_after_insert(&mut self, v: Voxel, nb: u8) {
         let f = self.faces.as_mut().expect("face bookkeeping");
         let mut own = None;
         for dir in 0..6u8 {
@@ -1050,13 +1135,13 @@ impl DynamicOctree {
                 f.remove(r, n, opposite(dir));
             } else {
                 let r = *own.get_or_insert_with(|| f.record_of(v));
-                f.push(r, v, dir);
+                f.push(r, dir);
             }
         }
     }
 
-    fn faces_after_remove(&mut self, v: Voxel) {
-        let nb = self.face_neighbours(v);
+    /// Face passing after `v` was deleted; `nb` is its face-neighbour mask.
+    fn faces_after_remove(&mut self, v: Voxel, nb: u8) {
         let f = self.faces.as_mut().expect("face bookkeeping");
         // A black voxel with a white neighbour has a record; one with six black
         // neighbours has no face to remove.
@@ -1069,7 +1154,7 @@ impl DynamicOctree {
             if nb >> dir & 1 == 1 {
                 let n = step(v, dir);
                 let r = f.record_of(n);
-                f.push(r, n, opposite(dir));
+                f.push(r, opposite(dir));
             } else {
                 f.remove(own, v, dir);
             }
@@ -1109,13 +1194,9 @@ impl DynamicOctree {
     /// When `i >= face_count()`.
     #[must_use]
     pub fn face(&self, i: usize) -> Face {
-        let f = self.faces.as_ref().map_or(&[][..], |f| &f.list[..]);
-        assert!(
-            i < f.len(),
-            "face index {i} out of range (face_count {})",
-            f.len()
-        );
-        f[i].face()
+        let n = self.face_count();
+        assert!(i < n, "face index {i} out of range (face_count {n})");
+        self.faces.as_ref().expect("face bookkeeping").face(i)
     }
 
     /// The whole face list, in face-list order (empty without face bookkeeping).
@@ -1124,7 +1205,7 @@ impl DynamicOctree {
     pub fn faces(&self) -> Vec<Face> {
         self.faces
             .as_ref()
-            .map_or_else(Vec::new, |f| f.list.iter().map(|e| e.face()).collect())
+            .map_or_else(Vec::new, |f| (0..f.list.len()).map(|i| f.face(i)).collect())
     }
 
     /// A uniformly random exposed face, or `None` when there is none. O(1).
@@ -1596,9 +1677,10 @@ impl DynamicOctree {
         }
         if let Some(f) = &self.faces {
             f.assert_valid();
-            for (i, e) in f.list.iter().enumerate() {
+            for i in 0..f.list.len() {
+                let e = f.face(i);
                 assert!(self.contains(e.voxel), "face {i} on a white voxel");
-                assert!(!self.contains(e.face().outside()), "face {i} is covered");
+                assert!(!self.contains(e.outside()), "face {i} is covered");
             }
             let all = self.voxels();
             let pairs: u64 = all

@@ -113,10 +113,24 @@ fn random_ops(seed: u64, lo: Voxel, side: i64, steps: usize, p_insert: f64, face
         } else {
             pick(&mut rng)
         };
+        // Every other step goes through the variants that take the neighbourhood
+        // from the caller (as the RS/MC chain does).
+        let known = step_no % 2 == 1;
+        let nb = t.neighbourhood(v);
         if rng.random_bool(p_insert) {
-            assert_eq!(t.insert(v), m.insert(v), "insert {v:?} at step {step_no}");
+            let got = if known {
+                t.insert_with_neighbourhood(v, nb)
+            } else {
+                t.insert(v)
+            };
+            assert_eq!(got, m.insert(v), "insert {v:?} at step {step_no}");
         } else {
-            assert_eq!(t.remove(v), m.remove(v), "remove {v:?} at step {step_no}");
+            let got = if known {
+                t.remove_with_neighbourhood(v, nb)
+            } else {
+                t.remove(v)
+            };
+            assert_eq!(got, m.remove(v), "remove {v:?} at step {step_no}");
         }
         t.assert_valid();
         let probes: Vec<Voxel> = (0..4)

@@ -243,12 +243,13 @@ impl<L: Lattice> Chain<L> {
         let r = self.below(2 * area as u64);
         let face = self.lattice.face((r >> 1) as usize);
         let shrink = r & 1 == 1;
-        let (p, joins) = if shrink {
-            (face.voxel, !self.lattice.neighbourhood(face.voxel) & ALL27)
+        let p = if shrink {
+            face.voxel
         } else {
-            let p = step_dir(face.voxel, face.dir);
-            (p, self.lattice.neighbourhood(p))
+            step_dir(face.voxel, face.dir)
         };
+        let nb = self.lattice.neighbourhood(p);
+        let joins = if shrink { !nb & ALL27 } else { nb };
         if !legal_join(joins) {
             self.counters.illegal += 1;
             return false;
@@ -276,9 +277,9 @@ impl<L: Lattice> Chain<L> {
             self.sum_sq += sign * i128::from(x) * i128::from(x);
         }
         if shrink {
-            self.lattice.remove(p);
+            self.lattice.remove_with_neighbourhood(p, nb);
         } else {
-            self.lattice.insert(p);
+            self.lattice.insert_with_neighbourhood(p, nb);
             self.counters.grown += 1;
         }
         self.counters.accepted += 1;

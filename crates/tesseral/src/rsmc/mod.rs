@@ -102,6 +102,20 @@ pub trait Lattice {
     /// The 27-bit occupancy of the 3×3×3 block around `v`: bit
     /// `(dx+1) + 3(dy+1) + 9(dz+1)`.
     fn neighbourhood(&self, v: Voxel) -> u32;
+    /// [`insert`](Self::insert) for a caller that holds `nb = neighbourhood(v)`,
+    /// taken since the last change; a backend may use it to skip a search. The
+    /// default ignores `nb`.
+    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        let _ = nb;
+        self.insert(v)
+    }
+    /// [`remove`](Self::remove) for a caller that holds `nb = neighbourhood(v)`,
+    /// taken since the last change; a backend may use it to skip a search. The
+    /// default ignores `nb`.
+    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        let _ = nb;
+        self.remove(v)
+    }
 }
 
 /// Errors of the random-surface Monte Carlo.

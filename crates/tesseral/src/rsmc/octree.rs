@@ -42,4 +42,12 @@ impl Lattice for DynamicOctree {
     fn neighbourhood(&self, v: Voxel) -> u32 {
         DynamicOctree::neighbourhood(self, v)
     }
+    #[inline]
+    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        DynamicOctree::insert_with_neighbourhood(self, v, nb)
+    }
+    #[inline]
+    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+        DynamicOctree::remove_with_neighbourhood(self, v, nb)
+    }
 }
