@@ -430,7 +430,6 @@ impl RayTree {
             let cur = lv.cur;
             let (c0, c1) = lv.child(cur);
             let entry = max3(c0);
-            let mut descended = false;
             if entry <= tmax {
                 let node = self.nodes[lv.node as usize];
                 let label = cur ^ a;
@@ -455,31 +454,31 @@ impl RayTree {
                         let j = rank(node.gray, bit);
                         sp += 1;
                         stack[sp] = Level::new(node.first + j, c0, c1, path, k);
-                        descended = true;
+                        continue;
                     }
                 }
-            } else {
-                // Every later child of this node starts later still: leave it.
-                stack[sp].cur = 8;
+                // Not entered: cross the nearest exit plane of this child, reusing
+                // the slab parameters just computed.
+                let ax = argmin(c1).0;
+                if cur & (1 << ax) == 0 {
+                    lv.cur = cur | (1 << ax);
+                    continue;
+                }
             }
-            if descended {
-                continue;
-            }
-            // Advance: across the nearest exit plane, popping finished nodes.
+            // Every later child of this node starts later still (or the ray leaves
+            // it): pop finished nodes and advance the parent past the child it was in.
             loop {
-                let lv = &mut stack[sp];
-                if lv.cur < 8 {
-                    let (_, c1) = lv.child(lv.cur);
-                    let ax = argmin(c1).0;
-                    if lv.cur & (1 << ax) == 0 {
-                        lv.cur |= 1 << ax;
-                        break;
-                    }
-                }
                 if sp == 0 {
                     return None;
                 }
                 sp -= 1;
+                let lv = &mut stack[sp];
+                let (_, c1) = lv.child(lv.cur);
+                let ax = argmin(c1).0;
+                if lv.cur & (1 << ax) == 0 {
+                    lv.cur |= 1 << ax;
+                    break;
+                }
             }
         }
     }
