@@ -1,30 +1,19 @@
 //! Integration tests of `tesseral collide`, `simulate` and `plan`: the real binary in a
 //! temporary folder.
 
+mod common;
+
 use std::collections::HashSet;
 use std::fmt::Write as _;
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
+
+use common::expect_success as ok;
 
 use serde_json::Value;
 
 fn tesseral(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tesseral")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "status {:?}\nstdout {}\nstderr {}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
+    common::run(dir, args)
 }
 
 fn fails(out: &Output, needle: &str) {

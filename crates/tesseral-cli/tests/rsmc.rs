@@ -1,25 +1,14 @@
 //! Integration tests of `tesseral rsmc`: the real binary in a temporary folder.
 
+mod common;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
+
+use common::expect_success as ok;
 
 fn tesseral(args: &[&str], dir: &Path) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .args(args)
-        .current_dir(dir)
-        .output()
-        .expect("run tesseral")
-}
-
-fn ok(out: &Output) -> String {
-    assert!(
-        out.status.success(),
-        "status {:?}\nstdout {}\nstderr {}",
-        out.status,
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout.clone()).unwrap()
+    common::run(dir, args)
 }
 
 fn fails(out: &Output, needle: &str) {
