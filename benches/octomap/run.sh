@@ -13,16 +13,8 @@ root="$(cd "$here/../.." && pwd)"
 build="$here/build"
 mkdir -p "$build"
 
-need=()
-dpkg -s liboctomap-dev >/dev/null 2>&1 || need+=(liboctomap-dev)
-command -v g++ >/dev/null 2>&1 || need+=(g++)
-command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
-if [ "${#need[@]}" -gt 0 ]; then
-  sudo=""
-  [ "$(id -u)" -ne 0 ] && sudo="sudo"
-  $sudo apt-get update -qq
-  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${need[@]}"
-fi
+. "$here/../install-peers.sh"
+install_peers liboctomap-dev
 echo "OctoMap $(dpkg-query -W -f='${Version}' liboctomap-dev)" >&2
 
 # shellcheck disable=SC2046

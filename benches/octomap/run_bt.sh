@@ -2,8 +2,8 @@
 # Checks tesseral's OctoMap files against the real OctoMap tools, and times reading a
 # one-million-leaf .bt with OctoMap's readBinary beside tesseral's reader.
 #
-# Needs: octomap-tools and liboctomap-dev (Debian: apt-get install -y octomap-tools
-# liboctomap-dev), g++, python3, cargo. Run from anywhere:
+# Installs what it uses (octomap-tools, liboctomap-dev, g++) with apt-get; needs
+# python3 and cargo. Run from anywhere (root or sudo for apt):
 #   benches/octomap/run_bt.sh            # checks + timing
 #   benches/octomap/run_bt.sh --quick    # checks only
 # Exits non-zero at the first disagreement.
@@ -14,6 +14,8 @@ work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 quick=${1:-}
 
+. "$here/../install-peers.sh"
+install_peers octomap-tools liboctomap-dev
 for tool in convert_octree bt2vrml binvox2bt g++ python3; do
   command -v "$tool" >/dev/null || { echo "missing $tool (apt-get install -y octomap-tools liboctomap-dev)"; exit 1; }
 done
