@@ -87,6 +87,12 @@ impl VoxelTable {
     /// The value whose key is `key`, if any. O(1) expected.
     #[inline]
     pub(crate) fn get(&self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
+        self.find(key, key_of).map(|i| self.slots[i][1])
+    }
+
+    /// The slot holding `key`, by linear probing from its home slot. O(1) expected.
+    #[inline]
+    fn find(&self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<usize> {
         if self.slots.is_empty() {
             return None;
         }
@@ -99,7 +105,7 @@ impl VoxelTable {
                 return None;
             }
             if sh == h && key_of(val) == key {
-                return Some(val);
+                return Some(i);
             }
             i = (i + 1) & m;
         }
@@ -125,22 +131,8 @@ impl VoxelTable {
 
     /// Removes the entry whose key is `key`; returns its value. O(1) expected.
     pub(crate) fn remove(&mut self, key: Voxel, key_of: impl Fn(u32) -> Voxel) -> Option<u32> {
-        if self.slots.is_empty() {
-            return None;
-        }
+        let i = self.find(key, key_of)?;
         let m = self.slots.len() - 1;
-        let h = mix(key);
-        let mut i = h as usize & m;
-        loop {
-            let [sh, val] = self.slots[i];
-            if val == VACANT {
-                return None;
-            }
-            if sh == h && key_of(val) == key {
-                break;
-            }
-            i = (i + 1) & m;
-        }
         let val = self.slots[i][1];
         // Backward-shift deletion: pull later entries of the probe run into the hole
         // when their home slot does not lie cyclically in (hole, j].
