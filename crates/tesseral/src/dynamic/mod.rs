@@ -18,6 +18,14 @@
 //! - The lowest level is an 8×8×8 block of voxels stored as 512 bits (eight `u64`, one
 //!   per z-slice, bit `x + 8y`), one cache line. So a lookup touches about
 //!   `k − 3` nodes and one block, and a stored voxel costs a bit, not a node.
+//! - Slot values 0 (empty) and 1 (full) are also real pool entries, *sentinels*: node 0
+//!   has eight empty children and node 1 eight full ones, block 0 is all zeros and
+//!   block 1 all ones. A search can therefore run down to the block level without
+//!   testing what it meets on the way ([`DynamicOctree::contains`] is a straight chain
+//!   of loads, with the child indices of up to eight levels read from one interleaved
+//!   word). Short chains matter more than anything else here: on a tree larger than
+//!   the cache, a random lookup waits for one memory access, and the processor can
+//!   only overlap those of consecutive lookups when each lookup is a few instructions.
 //! - With [`DynamicOctree::with_faces`], every exposed face is kept in one dense list
 //!   with back-pointers (one record of six list positions per surface voxel, found
 //!   through a compact hash index), so a random face is drawn
@@ -55,14 +63,35 @@ use crate::Voxel;
 
 /// log2 of the side of a leaf block (8×8×8 voxels, 512 bits).
 const LEAF_LOG2: u32 = 3;
-/// An empty slot (and the "no node" parent; index 0 of each pool is never used).
+/// An empty slot (and the "no node" parent). Also the index of the empty sentinel in
+/// each pool: node 0 has eight empty children, block 0 is all zeros.
 const EMPTY: u32 = 0;
-/// A full slot.
-const FULL: u32 = u32::MAX;
+/// A full slot. Also the index of the full sentinel in each pool: node 1 has eight
+/// full children, block 1 is all ones.
+const FULL: u32 = 1;
+/// Pool entries 0 and 1 are the sentinels; stored nodes and blocks start at 2.
+const SENTINELS: usize = 2;
+/// The most levels the directory skips (8^5 = 32,768 entries, 128 KiB).
+const DIR_MAX_LEVELS: u32 = 6;
 /// No parent: the node is the root.
 const NONE: u32 = 0;
 /// The parent field of a node or block on the free list.
 const FREED: u32 = u32::MAX;
+/// `SPREAD[b]` has bit `i` of `b` at bit `3i`: three lookups interleave eight levels
+/// of child indices into one word.
+static SPREAD: [u32; 256] = {
+    let mut t = [0u32; 256];
+    let mut i = 0;
+    while i < 256 {
+        let mut b = 0;
+        while b < 8 {
+            t[i] |= ((i as u32 >> b) & 1) << (3 * b);
+            b += 1;
+        }
+        i += 1;
+    }
+    t
+};
 static ZERO_BLOCK: [u64; 8] = [0; 8];
 static FULL_BLOCK: [u64; 8] = [!0; 8];
 /// All 27 bits of a 3×3×3 neighbourhood.
@@ -110,6 +139,16 @@ pub struct DynamicOctree {
     contractions: u64,
     /// Bumped by every change; makes stale [`Octant`] handles harmless.
     version: u64,
+    /// The directory: the slots at level `dir_level = phys − dir_levels`, densely, in
+    /// tesseral order of the root's cells at that level, so a search starts there
+    /// instead of at the root. Empty when `dir_levels == 0`. Sized to the tree (at
+    /// most one entry per stored node and block, up to `8^DIR_MAX_LEVELS`).
+    dir: Vec<u32>,
+    dir_levels: u32,
+    dir_level: u32,
+    /// Live node counts at which the directory is resized.
+    dir_grow_at: usize,
+    dir_shrink_below: usize,
     faces: Option<FaceList>,
 }
 
@@ -289,16 +328,21 @@ impl DynamicOctree {
             root: EMPTY,
             root_min: [0; 3],
             size_log2: 0,
-            nodes: vec![Node { child: [EMPTY; 8] }],
-            node_parent: vec![FREED],
+            nodes: vec![Node { child: [EMPTY; 8] }, Node { child: [FULL; 8] }],
+            node_parent: vec![FREED; SENTINELS],
             node_free: Vec::new(),
-            leaves: vec![Leaf([0; 8])],
-            leaf_parent: vec![FREED],
+            leaves: vec![Leaf(ZERO_BLOCK), Leaf(FULL_BLOCK)],
+            leaf_parent: vec![FREED; SENTINELS],
             leaf_free: Vec::new(),
             voxels: 0,
             expansions: 0,
             contractions: 0,
             version: 0,
+            dir: Vec::new(),
+            dir_levels: 0,
+            dir_level: 0,
+            dir_grow_at: 1,
+            dir_shrink_below: 0,
             faces: None,
         }
     }
@@ -348,8 +392,8 @@ impl DynamicOctree {
         } else {
             let i = u32::try_from(self.nodes.len())
                 .ok()
-                .filter(|&i| i < FULL)
-                .expect("DynamicOctree: more than 2^32 - 2 nodes");
+                .filter(|&i| i < FREED)
+                .expect("DynamicOctree: more than 2^32 - 3 nodes");
             grow(&mut self.nodes);
             self.nodes.push(n);
             grow(&mut self.node_parent);
@@ -359,6 +403,7 @@ impl DynamicOctree {
     }
 
     fn free_node(&mut self, i: u32) {
+        debug_assert!(i as usize >= SENTINELS, "freeing a sentinel node");
         self.node_parent[i as usize] = FREED;
         self.node_free.push(i);
     }
@@ -371,8 +416,8 @@ impl DynamicOctree {
         } else {
             let i = u32::try_from(self.leaves.len())
                 .ok()
-                .filter(|&i| i < FULL)
-                .expect("DynamicOctree: more than 2^32 - 2 blocks");
+                .filter(|&i| i < FREED)
+                .expect("DynamicOctree: more than 2^32 - 3 blocks");
             grow(&mut self.leaves);
             self.leaves.push(Leaf([fill; 8]));
             grow(&mut self.leaf_parent);
@@ -382,16 +427,89 @@ impl DynamicOctree {
     }
 
     fn free_leaf(&mut self, i: u32) {
+        debug_assert!(i as usize >= SENTINELS, "freeing a sentinel block");
         self.leaf_parent[i as usize] = FREED;
         self.leaf_free.push(i);
     }
 
+    /// Writes `val` into child slot `ci` of `parent` (the root slot when `parent` is
+    /// NONE). The slot is at `level` and contains offsets `u`; the directory follows.
     #[inline]
-    fn set_slot(&mut self, parent: u32, ci: usize, val: u32) {
+    fn set_slot(&mut self, parent: u32, ci: usize, val: u32, level: u32, u: [u64; 3]) {
         if parent == NONE {
             self.root = val;
         } else {
             self.nodes[parent as usize].child[ci] = val;
+        }
+        if self.dir_levels > 0 && level >= self.dir_level {
+            let i = self.dir_index(u);
+            if level == self.dir_level {
+                self.dir[i] = val;
+            } else if !is_index(val) {
+                // A uniform octant above the directory level: all its entries. (A
+                // node stored there holds the uniform value it replaced, which the
+                // entries already show.)
+                let span = 1usize << (3 * (level - self.dir_level));
+                let base = i & !(span - 1);
+                self.dir[base..base + span].fill(val);
+            }
+        }
+    }
+
+    /// The directory entry of offsets `u` (inside the root).
+    #[inline(always)]
+    fn dir_index(&self, u: [u64; 3]) -> usize {
+        let d = self.dir_level;
+        let spread = |x: u64| SPREAD[(x >> d & 255) as usize] as usize;
+        spread(u[0]) | spread(u[1]) << 1 | spread(u[2]) << 2
+    }
+
+    /// Rebuilds the directory after the root changed (expansion, contraction, a new
+    /// or emptied tree) or the tree outgrew it or shrank well below it. It skips
+    /// `t ≤ 5` levels, the most for which `8^t ≤ 8 · stored nodes` and the directory
+    /// level stays at or above the blocks. O(8^t), at most 32,768 entries.
+    fn rebuild_dir(&mut self) {
+        let live = self.node_count();
+        let max_t = (self.phys_log2() - LEAF_LOG2).min(DIR_MAX_LEVELS);
+        let mut t = 0;
+        while t < max_t && 1usize << (3 * (t + 1)) <= 8 * live {
+            t += 1;
+        }
+        self.dir_levels = t;
+        self.dir_level = self.phys_log2() - t;
+        self.dir_grow_at = if t < max_t {
+            1usize << (3 * t)
+        } else {
+            usize::MAX
+        };
+        self.dir_shrink_below = (1usize << (3 * t)) / 64;
+        self.dir.clear();
+        if t > 0 {
+            self.dir.resize(1 << (3 * t), EMPTY);
+            self.fill_dir(self.root, self.phys_log2(), 0);
+        }
+    }
+
+    /// Writes the directory entries under `slot` at `level`, from entry `base`.
+    fn fill_dir(&mut self, slot: u32, level: u32, base: usize) {
+        if level == self.dir_level || !is_index(slot) {
+            let span = 1usize << (3 * (level - self.dir_level));
+            self.dir[base..base + span].fill(slot);
+        } else {
+            let child = self.nodes[slot as usize].child;
+            let step = 1usize << (3 * (level - 1 - self.dir_level));
+            for (ci, c) in child.into_iter().enumerate() {
+                self.fill_dir(c, level - 1, base + ci * step);
+            }
+        }
+    }
+
+    /// Resizes the directory when the tree has outgrown it or shrunk well below it.
+    #[inline]
+    fn check_dir_size(&mut self) {
+        let live = self.node_count();
+        if live >= self.dir_grow_at || live < self.dir_shrink_below {
+            self.rebuild_dir();
         }
     }
 
@@ -464,11 +582,13 @@ impl DynamicOctree {
     }
 
     /// Shrinks the root while all content lies inside one of its children.
-    fn contract(&mut self) {
+    /// Returns whether it did.
+    fn contract(&mut self) -> bool {
+        let mut changed = false;
         loop {
             let k = self.size_log2;
             if k == 0 || self.root == FULL || self.root == EMPTY {
-                return;
+                return changed;
             }
             let half = 1u64 << (k - 1);
             if k > LEAF_LOG2 {
@@ -483,7 +603,7 @@ impl DynamicOctree {
                     }
                 }
                 if count != 1 {
-                    return;
+                    return changed;
                 }
                 for a in 0..3 {
                     if only >> a & 1 == 1 {
@@ -503,7 +623,7 @@ impl DynamicOctree {
                     let m = u16::from(masks[a]);
                     let (lo, hi) = (m & low != 0, m >> half != 0);
                     if lo && hi {
-                        return;
+                        return changed;
                     }
                     oct[a] = hi;
                 }
@@ -516,6 +636,7 @@ impl DynamicOctree {
             }
             self.size_log2 = k - 1;
             self.contractions += 1;
+            changed = true;
         }
     }
 
@@ -579,9 +700,12 @@ impl DynamicOctree {
             self.leaves[self.root as usize].0[0] = 1;
         } else {
             let mut u = self.offsets(v);
-            while !within(u, self.size_log2) {
-                self.expand(v);
-                u = self.offsets(v);
+            if !within(u, self.size_log2) {
+                while !within(u, self.size_log2) {
+                    self.expand(v);
+                    u = self.offsets(v);
+                }
+                self.rebuild_dir();
             }
             if !self.set_bit(u) {
                 return false;
@@ -592,7 +716,25 @@ impl DynamicOctree {
         true
     }
 
+    /// Sets the bit at offsets `u` (inside the root); false when it was already set.
     fn set_bit(&mut self, u: [u64; 3]) -> bool {
+        // Fast path: the block exists and does not become full.
+        let slot = self.block_slot(u);
+        let (w, b) = leaf_bit(u);
+        let word = self.leaves[slot as usize].0[w];
+        if word & b != 0 {
+            return false; // also a full octant (the full sentinel block)
+        }
+        if is_index(slot) && word | b != !0 {
+            self.leaves[slot as usize].0[w] = word | b;
+            return true;
+        }
+        self.set_bit_slow(u)
+    }
+
+    /// [`set_bit`](Self::set_bit) that creates the nodes and block on the way down and
+    /// collapses a block that becomes full.
+    fn set_bit_slow(&mut self, u: [u64; 3]) -> bool {
         let mut level = self.phys_log2();
         let mut parent = NONE;
         let mut ci = 0usize;
@@ -603,7 +745,7 @@ impl DynamicOctree {
             }
             if cur == EMPTY {
                 cur = self.alloc_node(parent, EMPTY);
-                self.set_slot(parent, ci, cur);
+                self.set_slot(parent, ci, cur, level, u);
             }
             ci = child_index(u, level);
             parent = cur;
@@ -615,7 +757,7 @@ impl DynamicOctree {
         }
         if cur == EMPTY {
             cur = self.alloc_leaf(parent, 0);
-            self.set_slot(parent, ci, cur);
+            self.set_slot(parent, ci, cur, LEAF_LOG2, u);
         }
         let (w, b) = leaf_bit(u);
         let l = &mut self.leaves[cur as usize].0;
@@ -626,6 +768,7 @@ impl DynamicOctree {
         if l[w] == !0 && l.iter().all(|&x| x == !0) {
             self.collapse_full(cur, parent, u);
         }
+        self.check_dir_size();
         true
     }
 
@@ -633,7 +776,7 @@ impl DynamicOctree {
     /// whose eight children are all full.
     fn collapse_full(&mut self, leaf: u32, parent: u32, u: [u64; 3]) {
         self.free_leaf(leaf);
-        self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), FULL);
+        self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), FULL, LEAF_LOG2, u);
         self.collapse_up(parent, LEAF_LOG2 + 1, u);
     }
 
@@ -645,7 +788,7 @@ impl DynamicOctree {
             self.free_node(node);
             level += 1;
             let ci = if p != NONE { child_index(u, level) } else { 0 };
-            self.set_slot(p, ci, FULL);
+            self.set_slot(p, ci, FULL, level - 1, u);
             node = p;
         }
     }
@@ -680,7 +823,7 @@ impl DynamicOctree {
             }
             if cur == EMPTY {
                 cur = self.alloc_node(parent, EMPTY);
-                self.set_slot(parent, ci, cur);
+                self.set_slot(parent, ci, cur, level, u);
             }
             ci = child_index(u, level);
             parent = cur;
@@ -692,13 +835,13 @@ impl DynamicOctree {
         }
         if s >= LEAF_LOG2 {
             self.free_subtree(cur, level);
-            self.set_slot(parent, ci, FULL);
+            self.set_slot(parent, ci, FULL, level, u);
             self.collapse_up(parent, level + 1, u);
             return;
         }
         if cur == EMPTY {
             cur = self.alloc_leaf(parent, 0);
-            self.set_slot(parent, ci, cur);
+            self.set_slot(parent, ci, cur, LEAF_LOG2, u);
         }
         let side = 1u64 << s;
         let (x0, y0, z0) = (u[0] & 7, u[1] & 7, u[2] & 7);
@@ -782,13 +925,32 @@ impl DynamicOctree {
             self.root = EMPTY;
             self.size_log2 = 0;
             self.root_min = [0; 3];
-        } else {
-            self.contract();
+            self.rebuild_dir();
+        } else if self.contract() {
+            self.rebuild_dir();
         }
         true
     }
 
+    /// Clears the bit at offsets `u` (inside the root); false when it was clear.
     fn clear_bit(&mut self, u: [u64; 3]) -> bool {
+        // Fast path: the block exists and does not become empty.
+        let slot = self.block_slot(u);
+        let (w, b) = leaf_bit(u);
+        let word = self.leaves[slot as usize].0[w];
+        if word & b == 0 {
+            return false; // also an empty octant (the empty sentinel block)
+        }
+        if is_index(slot) && word & !b != 0 {
+            self.leaves[slot as usize].0[w] = word & !b;
+            return true;
+        }
+        self.clear_bit_slow(u)
+    }
+
+    /// [`clear_bit`](Self::clear_bit) that instantiates a full octant on the way down
+    /// and releases a block that becomes empty, and its emptied ancestors.
+    fn clear_bit_slow(&mut self, u: [u64; 3]) -> bool {
         let mut level = self.phys_log2();
         let mut parent = NONE;
         let mut ci = 0usize;
@@ -799,7 +961,7 @@ impl DynamicOctree {
             }
             if cur == FULL {
                 cur = self.alloc_node(parent, FULL);
-                self.set_slot(parent, ci, cur);
+                self.set_slot(parent, ci, cur, level, u);
             }
             ci = child_index(u, level);
             parent = cur;
@@ -811,7 +973,7 @@ impl DynamicOctree {
         }
         if cur == FULL {
             cur = self.alloc_leaf(parent, !0);
-            self.set_slot(parent, ci, cur);
+            self.set_slot(parent, ci, cur, LEAF_LOG2, u);
         }
         let (w, b) = leaf_bit(u);
         let l = &mut self.leaves[cur as usize].0;
@@ -822,17 +984,18 @@ impl DynamicOctree {
         if l[w] == 0 && l.iter().all(|&x| x == 0) {
             self.free_leaf(cur);
             let mut level = LEAF_LOG2 + 1;
-            self.set_slot(parent, child_index(u, level), EMPTY);
+            self.set_slot(parent, child_index(u, level), EMPTY, LEAF_LOG2, u);
             let mut node = parent;
             while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == EMPTY) {
                 let p = self.node_parent[node as usize];
                 self.free_node(node);
                 level += 1;
                 let ci = if p != NONE { child_index(u, level) } else { 0 };
-                self.set_slot(p, ci, EMPTY);
+                self.set_slot(p, ci, EMPTY, level - 1, u);
                 node = p;
             }
         }
+        self.check_dir_size();
         true
     }
 
@@ -850,23 +1013,37 @@ impl DynamicOctree {
     #[must_use]
     pub fn contains(&self, v: Voxel) -> bool {
         let u = self.offsets(v);
-        let mut level = self.phys_log2();
-        if !within(u, level) {
+        if !within(u, self.phys_log2()) {
             return false;
         }
-        let mut cur = self.root;
-        while level > LEAF_LOG2 {
-            if cur == EMPTY || cur == FULL {
-                return cur == FULL;
-            }
-            cur = self.nodes[cur as usize].child[child_index(u, level)];
-            level -= 1;
-        }
-        if cur == EMPTY || cur == FULL {
-            return cur == FULL;
-        }
         let (w, b) = leaf_bit(u);
-        self.leaves[cur as usize].0[w] & b != 0
+        self.leaves[self.block_slot(u) as usize].0[w] & b != 0
+    }
+
+    /// The slot at block level on the path to offsets `u` (inside the root): a stored
+    /// block, or the sentinel [`EMPTY`] or [`FULL`] when an empty or full octant holds
+    /// `u` (an empty tree's root is [`EMPTY`]). The sentinels make this a straight
+    /// chain of loads with no test per level; the child indices of up to eight levels
+    /// come from one interleaved word. O(depth).
+    #[inline(always)]
+    fn block_slot(&self, u: [u64; 3]) -> u32 {
+        let (mut cur, mut level) = if self.dir_levels > 0 {
+            (self.dir[self.dir_index(u)], self.dir_level)
+        } else {
+            (self.root, self.phys_log2())
+        };
+        while level > LEAF_LOG2 {
+            let n = (level - LEAF_LOG2).min(8);
+            level -= n;
+            let spread = |x: u64| u64::from(SPREAD[(x >> level & 255) as usize]);
+            let path = spread(u[0]) | spread(u[1]) << 1 | spread(u[2]) << 2;
+            let mut shift = 3 * n;
+            while shift > 0 {
+                shift -= 3;
+                cur = self.nodes[cur as usize].child[(path >> shift) as usize & 7];
+            }
+        }
+        cur
     }
 
     /// Descends from slot `cur` at `level` towards offsets `t`, stopping at the first
@@ -1004,6 +1181,11 @@ impl DynamicOctree {
         let phys = self.phys_log2();
         if !within(u, phys) {
             return self.neighbourhood_slow(u, NONE, 0, &ZERO_BLOCK);
+        }
+        // The common case: the 3×3×3 block lies inside `v`'s block (the sentinels
+        // stand for uniform octants).
+        if (0..3).all(|a| (u[a] & 7).wrapping_sub(1) < 6) {
+            return extract27(&self.leaves[self.block_slot(u) as usize].0, u);
         }
         let (cur, level, parent) = self.descend(self.root, phys, NONE, u);
         let m = if level >= 64 {
@@ -1263,8 +1445,8 @@ impl DynamicOctree {
     /// Stored nodes: interior nodes plus 8³ blocks. O(1).
     #[must_use]
     pub fn node_count(&self) -> usize {
-        (self.nodes.len() - 1 - self.node_free.len())
-            + (self.leaves.len() - 1 - self.leaf_free.len())
+        (self.nodes.len() - SENTINELS - self.node_free.len())
+            + (self.leaves.len() - SENTINELS - self.leaf_free.len())
     }
 
     /// Bytes of memory held: the struct plus every heap allocation at its capacity
@@ -1279,6 +1461,7 @@ impl DynamicOctree {
             + self.leaves.capacity() * std::mem::size_of::<Leaf>()
             + self.leaf_parent.capacity() * 4
             + self.leaf_free.capacity() * 4
+            + self.dir.capacity() * 4
             + self.faces.as_ref().map_or(0, FaceList::heap_bytes)
     }
 
@@ -1291,6 +1474,7 @@ impl DynamicOctree {
         self.leaves.shrink_to_fit();
         self.leaf_parent.shrink_to_fit();
         self.leaf_free.shrink_to_fit();
+        self.dir.shrink_to_fit();
         if let Some(f) = &mut self.faces {
             f.list.shrink_to_fit();
             f.owners.shrink_to_fit();
@@ -1401,6 +1585,7 @@ impl DynamicOctree {
         }
         t.voxels = count;
         t.contract();
+        t.rebuild_dir();
         t
     }
 
@@ -1559,6 +1744,10 @@ impl DynamicOctree {
     /// that every listed face is exposed, its back-pointer is right, and the count is
     /// `6·voxels − 2·(face-adjacent pairs)`. O(voxels · depth).
     pub fn assert_valid(&self) {
+        assert_eq!(self.nodes[EMPTY as usize].child, [EMPTY; 8], "empty sentinel node");
+        assert_eq!(self.nodes[FULL as usize].child, [FULL; 8], "full sentinel node");
+        assert_eq!(self.leaves[EMPTY as usize].0, ZERO_BLOCK, "empty sentinel block");
+        assert_eq!(self.leaves[FULL as usize].0, FULL_BLOCK, "full sentinel block");
         let nfree: std::collections::HashSet<u32> = self.node_free.iter().copied().collect();
         let lfree: std::collections::HashSet<u32> = self.leaf_free.iter().copied().collect();
         assert_eq!(
@@ -1572,12 +1761,14 @@ impl DynamicOctree {
             "block free list has duplicates"
         );
         for &i in &self.node_free {
+            assert!(i as usize >= SENTINELS, "sentinel node {i} on the free list");
             assert_eq!(
                 self.node_parent[i as usize], FREED,
                 "free node {i} not marked"
             );
         }
         for &i in &self.leaf_free {
+            assert!(i as usize >= SENTINELS, "sentinel block {i} on the free list");
             assert_eq!(
                 self.leaf_parent[i as usize], FREED,
                 "free block {i} not marked"
@@ -1650,14 +1841,32 @@ impl DynamicOctree {
             }
         }
         assert_eq!(count, u128::from(self.voxels), "voxel count");
+        // The directory holds exactly the slots at its level.
+        assert!(self.dir_levels <= DIR_MAX_LEVELS, "directory too deep");
+        if self.dir_levels == 0 {
+            assert!(self.dir.is_empty(), "directory without levels");
+        } else {
+            assert_eq!(self.dir_level + self.dir_levels, phys, "directory level");
+            assert_eq!(self.dir.len(), 1 << (3 * self.dir_levels), "directory size");
+            assert!(self.dir_level >= LEAF_LOG2, "directory below the blocks");
+            let mut fresh = self.clone();
+            fresh.fill_dir(self.root, phys, 0);
+            for (i, (&a, &b)) in self.dir.iter().zip(&fresh.dir).enumerate() {
+                assert_eq!(a, b, "directory entry {i}");
+            }
+            assert!(
+                self.dir.len() <= 64 * self.node_count().max(1),
+                "directory larger than the tree"
+            );
+        }
         assert_eq!(
             seen_nodes,
-            self.nodes.len() - 1 - self.node_free.len(),
+            self.nodes.len() - SENTINELS - self.node_free.len(),
             "live node count"
         );
         assert_eq!(
             seen_leaves,
-            self.leaves.len() - 1 - self.leaf_free.len(),
+            self.leaves.len() - SENTINELS - self.leaf_free.len(),
             "live block count"
         );
         // The root cannot contract.
