@@ -133,13 +133,6 @@ impl Small {
     fn count(&self) -> usize {
         self.0.iter().filter(|&&e| e != VACANT).count()
     }
-    /// Word `z` of [`Small::words`].
-    fn word(&self, z: usize) -> u64 {
-        self.0
-            .iter()
-            .filter(|&&e| e != VACANT && usize::from(e >> 6) == z)
-            .fold(0, |w, &e| w | 1 << (e & 63))
-    }
     fn words(&self) -> [u64; 8] {
         let mut l = [0u64; 8];
         for &e in &self.0 {
@@ -353,6 +346,40 @@ fn extract27(l: &[u64; 8], u: [u64; 3]) -> u32 {
         let w = l[lz - 1 + dz] >> sh;
         let plane = (w & 7) | ((w >> 8) & 7) << 3 | ((w >> 16) & 7) << 6;
         r |= (plane as u32) << (9 * dz);
+    }
+    r
+}
+
+/// The 27-bit neighbourhood of offsets `u` from the up to eight blocks around it:
+/// `word(b, z)` is word `z` of block `b` (bit `i` of `b` selects the upper block along
+/// axis `i`; `lo`/`hi` are the block coordinates of `u − 1` and `u + 1`). Row by row:
+/// the three cells (x−1, x, x+1) of a row come from one block word, or from two when
+/// the row crosses a block boundary in x.
+#[inline(always)]
+fn rows27(u: [u64; 3], lo: [u64; 3], hi: [u64; 3], word: impl Fn(usize, usize) -> u64) -> u32 {
+    let lx = u[0] & 7;
+    let mut r = 0u32;
+    for dz in 0..3u64 {
+        let cz = u[2].wrapping_add(dz).wrapping_sub(1);
+        let bz = usize::from(cz >> 3 != lo[2]) << 2;
+        let lz = (cz & 7) as usize;
+        for dy in 0..3u64 {
+            let cy = u[1].wrapping_add(dy).wrapping_sub(1);
+            let b = usize::from(cy >> 3 != lo[1]) << 1 | bz;
+            let sh = 8 * (cy & 7);
+            let row = if lo[0] == hi[0] {
+                (word(b, lz) >> (sh + lx - 1)) & 7
+            } else {
+                let wl = word(b, lz) >> sh;
+                let wh = word(b | 1, lz) >> sh;
+                if lx == 0 {
+                    (wl >> 7 & 1) | (wh & 3) << 1
+                } else {
+                    (wl >> 6 & 3) | (wh & 1) << 2
+                }
+            };
+            r |= (row as u32) << (3 * dy + 9 * dz);
+        }
     }
     r
 }
@@ -1440,16 +1467,6 @@ impl DynamicOctree {
         slot
     }
 
-    /// Word `z` (bits `x + 8y`) of the block in a block-level slot.
-    #[inline(always)]
-    fn block_word(&self, slot: u32, z: usize) -> u64 {
-        if is_small(slot) {
-            self.small[(slot & !SMALL) as usize].word(z)
-        } else {
-            self.leaves[slot as usize].0[z]
-        }
-    }
-
     #[inline(never)]
     fn neighbourhood_slow(&self, u: [u64; 3], start: u32, start_level: u32, own: u32) -> u32 {
         let home = [u[0] >> 3, u[1] >> 3, u[2] >> 3];
@@ -1476,33 +1493,12 @@ impl DynamicOctree {
                 self.block_slot_from([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level)
             };
         }
-        // Row by row: the three cells (x−1, x, x+1) of a row come from one block
-        // word, or from two when the row crosses a block boundary in x.
-        let lx = u[0] & 7;
-        let mut r = 0u32;
-        for dz in 0..3u64 {
-            let cz = u[2].wrapping_add(dz).wrapping_sub(1);
-            let bz = usize::from(cz >> 3 != lo[2]) << 2;
-            let lz = (cz & 7) as usize;
-            for dy in 0..3u64 {
-                let cy = u[1].wrapping_add(dy).wrapping_sub(1);
-                let b = usize::from(cy >> 3 != lo[1]) << 1 | bz;
-                let sh = 8 * (cy & 7);
-                let row = if lo[0] == hi[0] {
-                    (self.block_word(blocks[b], lz) >> (sh + lx - 1)) & 7
-                } else {
-                    let wl = self.block_word(blocks[b], lz) >> sh;
-                    let wh = self.block_word(blocks[b | 1], lz) >> sh;
-                    if lx == 0 {
-                        (wl >> 7 & 1) | (wh & 3) << 1
-                    } else {
-                        (wl >> 6 & 3) | (wh & 1) << 2
-                    }
-                };
-                r |= (row as u32) << (3 * dy + 9 * dz);
-            }
+        if blocks.iter().any(|&slot| is_small(slot)) {
+            let words: [[u64; 8]; 8] = std::array::from_fn(|i| self.block_words(blocks[i]));
+            rows27(u, lo, hi, |b, z| words[b][z])
+        } else {
+            rows27(u, lo, hi, |b, z| self.leaves[blocks[b] as usize].0[z])
         }
-        r
     }
 
     /// The six face-neighbours of `v` as a mask: bit `dir` is set when the neighbour
