@@ -93,13 +93,28 @@ fn check_against(t: &DynamicOctree, m: &Model, probes: &[Voxel]) {
 /// Random create/delete sequences in a box `[lo, lo + side)³`, checked after every
 /// operation.
 fn random_ops(seed: u64, lo: Voxel, side: i64, steps: usize, p_insert: f64, faces: bool) {
-    eprintln!("random_ops seed {seed} lo {lo:?} side {side}");
+    random_ops_in(seed, lo, side, steps, p_insert, faces, !faces);
+}
+
+/// [`random_ops`] with the block form chosen: `small` makes new blocks start small
+/// (the default without faces), otherwise they are bitmaps (the default with faces).
+fn random_ops_in(
+    seed: u64,
+    lo: Voxel,
+    side: i64,
+    steps: usize,
+    p_insert: f64,
+    faces: bool,
+    small: bool,
+) {
+    eprintln!("random_ops seed {seed} lo {lo:?} side {side} faces {faces} small {small}");
     let mut rng = Pcg64::seed_from_u64(seed);
     let mut t = if faces {
         DynamicOctree::with_faces()
     } else {
         DynamicOctree::new()
     };
+    t.set_small_blocks(small);
     let mut m = Model::default();
     let pick = |rng: &mut Pcg64| -> Voxel {
         std::array::from_fn(|a| lo[a].wrapping_add(rng.random_range(0..side)))
@@ -165,6 +180,112 @@ fn random_sequences_without_faces() {
     for seed in 20..24 {
         random_ops(seed, [-20, -20, -20], 40, 1500, 0.65, false);
     }
+}
+
+#[test]
+fn random_sequences_with_the_other_block_form() {
+    // Faces over small blocks, and bitmap blocks without faces.
+    for seed in 30..33 {
+        random_ops_in(seed, [-6, -6, -6], 14, 1200, 0.7, true, true);
+        random_ops_in(seed, [-20, -20, -20], 40, 1200, 0.65, false, false);
+    }
+    // Sparse: most blocks stay small, some are promoted, all are released again.
+    random_ops_in(34, [-100, -100, -100], 200, 2000, 0.55, true, true);
+}
+
+#[test]
+fn small_blocks_grow_into_bitmaps_and_go_away() {
+    let mut t = DynamicOctree::new();
+    let cells: Vec<Voxel> = (0..12).map(|i| [i % 8, i / 8, 3]).collect();
+    // The first block is the root (a bitmap); its corner makes the blocks world-aligned.
+    t.insert([-1024, -1024, -1024]);
+    for (n, &c) in cells.iter().enumerate() {
+        assert!(t.insert(c));
+        assert!(!t.insert(c));
+        t.assert_valid();
+        let small = t.small.len() - t.small_free.len();
+        let bitmaps = t.leaves.len() - SENTINELS - t.leaf_free.len();
+        // Up to eight voxels the new block is small; the ninth makes it a bitmap.
+        if n < SMALL_CAP {
+            assert_eq!((small, bitmaps), (1, 1), "after {} voxels", n + 1);
+        } else {
+            assert_eq!((small, bitmaps), (0, 2), "after {} voxels", n + 1);
+        }
+        for &d in &cells {
+            assert_eq!(t.contains(d), cells[..=n].contains(&d));
+        }
+    }
+    for &c in &cells {
+        assert!(t.remove(c));
+        assert!(!t.remove(c));
+        t.assert_valid();
+    }
+    assert_eq!(t.voxel_count(), 1);
+    assert_eq!(t.node_count(), 1); // the far voxel's block, the root again
+    assert_eq!(t.small.len() - t.small_free.len(), 0);
+}
+
+#[test]
+fn the_root_contracts_onto_a_small_block() {
+    let mut t = DynamicOctree::new();
+    t.insert([1, 2, 3]);
+    t.insert([4, 2, 3]);
+    t.insert([1 << 20, 0, 0]);
+    t.assert_valid();
+    assert!(t.small.len() - t.small_free.len() >= 1);
+    t.remove([1 << 20, 0, 0]);
+    t.assert_valid();
+    assert!(t.root_size_log2() <= 3);
+    assert!(t.contains([1, 2, 3]) && t.contains([4, 2, 3]));
+    assert!(!t.contains([2, 2, 3]));
+    // The root block shifts inside itself when it grows and shrinks again.
+    t.insert([-3, 2, 3]);
+    t.remove([4, 2, 3]);
+    t.assert_valid();
+    assert_eq!(t.voxels(), vec![[-3, 2, 3], [1, 2, 3]]);
+}
+
+#[test]
+fn the_directory_follows_a_large_tree_up_and_down() {
+    let mut rng = Pcg64::seed_from_u64(77);
+    let mut t = DynamicOctree::new();
+    let mut m: HashSet<Voxel> = HashSet::new();
+    let mut deepest = 0;
+    let cells: Vec<Voxel> = (0..40_000)
+        .map(|_| std::array::from_fn(|_| rng.random_range(-256..256)))
+        .collect();
+    for (i, &c) in cells.iter().enumerate() {
+        assert_eq!(t.insert(c), m.insert(c));
+        deepest = deepest.max(t.dir_levels);
+        if i % 10_000 == 0 {
+            t.assert_valid();
+        }
+    }
+    t.assert_valid();
+    assert!(deepest >= 5, "directory skipped only {deepest} levels");
+    for _ in 0..20_000 {
+        let q: Voxel = std::array::from_fn(|_| rng.random_range(-260..260));
+        assert_eq!(t.contains(q), m.contains(&q), "{q:?}");
+    }
+    // Drain in random order: the directory shrinks with the tree.
+    let mut order: Vec<Voxel> = m.iter().copied().collect();
+    order.sort_unstable();
+    for i in (1..order.len()).rev() {
+        order.swap(i, rng.random_range(0..=i));
+    }
+    for (i, &c) in order.iter().enumerate() {
+        assert!(t.remove(c));
+        m.remove(&c);
+        if i % 5_000 == 0 || m.len() < 50 {
+            t.assert_valid();
+            for &d in order.iter().skip(i).take(20) {
+                assert_eq!(t.contains(d), m.contains(&d));
+            }
+        }
+    }
+    assert!(t.is_empty());
+    assert_eq!(t.dir_levels, 0);
+    assert_eq!(t.node_count(), 0);
 }
 
 #[test]
