@@ -122,7 +122,8 @@ struct Node {
 struct Leaf([u64; 8]);
 
 /// A sparse 8×8×8 block: up to eight voxels as local indices `x + 8y + 64z` (the
-/// bit numbers of a [`Leaf`]), vacant lanes [`VACANT`], in any order. 16 bytes, a
+/// bit numbers of a [`Leaf`]) in the first lanes, in any order, then vacant lanes
+/// ([`VACANT`]). 16 bytes, a
 /// quarter of a bitmap block: sparse content (scattered points, thin structures)
 /// takes a quarter of the memory, and more of it stays in the cache.
 #[derive(Clone, Copy)]
@@ -130,8 +131,41 @@ struct Leaf([u64; 8]);
 struct Small([u16; SMALL_CAP]);
 
 impl Small {
+    /// Whether lane value `key` is present. Branch-free (all eight lanes are
+    /// compared), so a hit does not mispredict a loop exit.
+    #[inline(always)]
+    fn has(&self, key: u16) -> bool {
+        self.0.iter().fold(false, |found, &e| found | (e == key))
+    }
+    /// Occupied lanes (they come first). Branch-free.
+    #[inline(always)]
     fn count(&self) -> usize {
-        self.0.iter().filter(|&&e| e != VACANT).count()
+        self.0.iter().map(|&e| usize::from(e != VACANT)).sum()
+    }
+    /// Adds `key`: `Some(true)` when it is new, `Some(false)` when it was there, `None`
+    /// when the block is full (it must become a bitmap block first).
+    #[inline]
+    fn insert(&mut self, key: u16) -> Option<bool> {
+        if self.has(key) {
+            return Some(false);
+        }
+        let n = self.count();
+        if n == SMALL_CAP {
+            return None;
+        }
+        self.0[n] = key;
+        Some(true)
+    }
+    /// Removes `key` (the last occupied lane fills its place); false when absent.
+    #[inline]
+    fn remove(&mut self, key: u16) -> bool {
+        let Some(lane) = self.0.iter().position(|&e| e == key) else {
+            return false;
+        };
+        let last = self.count() - 1;
+        self.0[lane] = self.0[last];
+        self.0[last] = VACANT;
+        true
     }
     fn words(&self) -> [u64; 8] {
         let mut l = [0u64; 8];
@@ -580,7 +614,7 @@ impl DynamicOctree {
     #[inline(always)]
     fn block_has(&self, slot: u32, u: [u64; 3]) -> bool {
         if is_small(slot) {
-            self.small[(slot & !SMALL) as usize].0.contains(&local_index(u))
+            self.small[(slot & !SMALL) as usize].has(local_index(u))
         } else {
             let (w, b) = leaf_bit(u);
             self.leaves[slot as usize].0[w] & b != 0
@@ -892,16 +926,10 @@ impl DynamicOctree {
         // Fast path: the block exists and does not become full.
         let slot = self.block_slot(u);
         if is_small(slot) {
-            let key = local_index(u);
-            let lanes = &mut self.small[(slot & !SMALL) as usize].0;
-            if lanes.contains(&key) {
-                return false;
-            }
-            if let Some(lane) = lanes.iter().position(|&e| e == VACANT) {
-                lanes[lane] = key;
-                return true;
-            }
-            return self.set_bit_slow(u); // it becomes a bitmap block
+            return match self.small[(slot & !SMALL) as usize].insert(local_index(u)) {
+                Some(new) => new,
+                None => self.set_bit_slow(u), // it becomes a bitmap block
+            };
         }
         let (w, b) = leaf_bit(u);
         let word = self.leaves[slot as usize].0[w];
@@ -950,14 +978,8 @@ impl DynamicOctree {
             self.set_slot(parent, ci, cur, LEAF_LOG2, u);
         }
         if is_small(cur) {
-            let key = local_index(u);
-            let lanes = &mut self.small[(cur & !SMALL) as usize].0;
-            if lanes.contains(&key) {
-                return false;
-            }
-            if let Some(lane) = lanes.iter().position(|&e| e == VACANT) {
-                lanes[lane] = key;
-                return true;
+            if let Some(new) = self.small[(cur & !SMALL) as usize].insert(local_index(u)) {
+                return new;
             }
             cur = self.promote(cur, parent, ci, u);
         }
@@ -1144,14 +1166,9 @@ impl DynamicOctree {
         // Fast path: the block exists and does not become empty.
         let slot = self.block_slot(u);
         if is_small(slot) {
-            let key = local_index(u);
             let small = &mut self.small[(slot & !SMALL) as usize];
-            let Some(lane) = small.0.iter().position(|&e| e == key) else {
-                return false;
-            };
-            if small.count() > 1 {
-                small.0[lane] = VACANT;
-                return true;
+            if small.count() > 1 || !small.has(local_index(u)) {
+                return small.remove(local_index(u));
             }
             return self.clear_bit_slow(u); // the block goes
         }
@@ -1195,12 +1212,10 @@ impl DynamicOctree {
             self.set_slot(parent, ci, cur, LEAF_LOG2, u);
         }
         let emptied = if is_small(cur) {
-            let key = local_index(u);
             let small = &mut self.small[(cur & !SMALL) as usize];
-            let Some(lane) = small.0.iter().position(|&e| e == key) else {
+            if !small.remove(local_index(u)) {
                 return false;
-            };
-            small.0[lane] = VACANT;
+            }
             let emptied = small.count() == 0;
             if emptied {
                 self.free_small(cur);
@@ -2072,6 +2087,10 @@ impl DynamicOctree {
                     );
                     assert_eq!(level, LEAF_LOG2, "small block {i} above the block level");
                     let keys: Vec<u16> = lanes.iter().copied().filter(|&e| e != VACANT).collect();
+                    assert!(
+                        lanes[keys.len()..].iter().all(|&e| e == VACANT),
+                        "small block {i} has a vacant lane before an occupied one"
+                    );
                     assert!(!keys.is_empty(), "small block {i} is empty");
                     assert!(keys.iter().all(|&e| e < 512), "small block {i} lane out of range");
                     let distinct: std::collections::HashSet<u16> = keys.iter().copied().collect();
