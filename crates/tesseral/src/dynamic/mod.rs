@@ -418,6 +418,29 @@ fn rows27(u: [u64; 3], lo: [u64; 3], hi: [u64; 3], word: impl Fn(usize, usize) -
     r
 }
 
+/// Checks one pool for [`DynamicOctree::assert_valid`]: one parent link per entry, a
+/// free list without repeats or sentinels (the first `reserved` entries) whose entries
+/// are marked freed. Returns the free entries.
+fn check_pool(
+    what: &str,
+    free: &[u32],
+    parent: &[u32],
+    len: usize,
+    reserved: usize,
+) -> std::collections::HashSet<u32> {
+    assert_eq!(len, parent.len(), "{what} parent array length");
+    let set: std::collections::HashSet<u32> = free.iter().copied().collect();
+    assert_eq!(set.len(), free.len(), "{what} free list has duplicates");
+    for &i in free {
+        assert!(
+            i as usize >= reserved,
+            "sentinel {what} {i} on the free list"
+        );
+        assert_eq!(parent[i as usize], FREED, "free {what} {i} not marked");
+    }
+    set
+}
+
 /// The six face-neighbour bits (bit `dir`) of a 27-bit neighbourhood.
 #[inline]
 fn six(n: u32) -> u8 {
@@ -1977,62 +2000,42 @@ impl DynamicOctree {
     /// that every listed face is exposed, its back-pointer is right, and the count is
     /// `6·voxels − 2·(face-adjacent pairs)`. O(voxels · depth).
     pub fn assert_valid(&self) {
-        assert_eq!(self.nodes[EMPTY as usize].child, [EMPTY; 8], "empty sentinel node");
-        assert_eq!(self.nodes[FULL as usize].child, [FULL; 8], "full sentinel node");
-        assert_eq!(self.leaves[EMPTY as usize].0, ZERO_BLOCK, "empty sentinel block");
-        assert_eq!(self.leaves[FULL as usize].0, FULL_BLOCK, "full sentinel block");
-        let nfree: std::collections::HashSet<u32> = self.node_free.iter().copied().collect();
-        let lfree: std::collections::HashSet<u32> = self.leaf_free.iter().copied().collect();
-        let sfree: std::collections::HashSet<u32> = self.small_free.iter().copied().collect();
         assert_eq!(
-            sfree.len(),
-            self.small_free.len(),
-            "small block free list has duplicates"
-        );
-        for &i in &self.small_free {
-            assert_eq!(
-                self.small_parent[i as usize], FREED,
-                "free small block {i} not marked"
-            );
-        }
-        assert_eq!(
-            self.small.len(),
-            self.small_parent.len(),
-            "small block parent array length"
+            self.nodes[EMPTY as usize].child, [EMPTY; 8],
+            "empty sentinel node"
         );
         assert_eq!(
-            nfree.len(),
-            self.node_free.len(),
-            "node free list has duplicates"
+            self.nodes[FULL as usize].child, [FULL; 8],
+            "full sentinel node"
         );
         assert_eq!(
-            lfree.len(),
-            self.leaf_free.len(),
-            "block free list has duplicates"
-        );
-        for &i in &self.node_free {
-            assert!(i as usize >= SENTINELS, "sentinel node {i} on the free list");
-            assert_eq!(
-                self.node_parent[i as usize], FREED,
-                "free node {i} not marked"
-            );
-        }
-        for &i in &self.leaf_free {
-            assert!(i as usize >= SENTINELS, "sentinel block {i} on the free list");
-            assert_eq!(
-                self.leaf_parent[i as usize], FREED,
-                "free block {i} not marked"
-            );
-        }
-        assert_eq!(
-            self.leaves.len(),
-            self.leaf_parent.len(),
-            "block parent array length"
+            self.leaves[EMPTY as usize].0, ZERO_BLOCK,
+            "empty sentinel block"
         );
         assert_eq!(
+            self.leaves[FULL as usize].0, FULL_BLOCK,
+            "full sentinel block"
+        );
+        let nfree = check_pool(
+            "node",
+            &self.node_free,
+            &self.node_parent,
             self.nodes.len(),
-            self.node_parent.len(),
-            "node parent array length"
+            SENTINELS,
+        );
+        let lfree = check_pool(
+            "block",
+            &self.leaf_free,
+            &self.leaf_parent,
+            self.leaves.len(),
+            SENTINELS,
+        );
+        let sfree = check_pool(
+            "small block",
+            &self.small_free,
+            &self.small_parent,
+            self.small.len(),
+            0,
         );
         if self.root == EMPTY {
             assert_eq!(self.voxels, 0, "empty root with voxels");
@@ -2092,9 +2095,16 @@ impl DynamicOctree {
                         "small block {i} has a vacant lane before an occupied one"
                     );
                     assert!(!keys.is_empty(), "small block {i} is empty");
-                    assert!(keys.iter().all(|&e| e < 512), "small block {i} lane out of range");
+                    assert!(
+                        keys.iter().all(|&e| e < 512),
+                        "small block {i} lane out of range"
+                    );
                     let distinct: std::collections::HashSet<u16> = keys.iter().copied().collect();
-                    assert_eq!(distinct.len(), keys.len(), "small block {i} repeats a voxel");
+                    assert_eq!(
+                        distinct.len(),
+                        keys.len(),
+                        "small block {i} repeats a voxel"
+                    );
                     seen_small += 1;
                     count += keys.len() as u128;
                 }
