@@ -69,8 +69,6 @@ const EMPTY: u32 = 0;
 /// A full slot. Also the index of the full sentinel in each pool: node 1 has eight
 /// full children, block 1 is all ones.
 const FULL: u32 = 1;
-/// Pool entries 0 and 1 are the sentinels; stored nodes and blocks start at 2.
-const SENTINELS: usize = 2;
 /// Tag of a slot (at the block level only) that holds a small block.
 const SMALL: u32 = 1 << 31;
 /// Voxels a small block holds; one more turns it into a bitmap block.
@@ -108,7 +106,7 @@ pub const NEIGHBOUR_BIT: [u32; 6] = [12, 14, 10, 16, 4, 22];
 pub const CENTRE_BIT: u32 = 13;
 
 /// Eight child slots, 32 bytes aligned to 32, so a node never straddles two cache
-/// lines; its parent link lives in a separate array (`node_parent`), which searches
+/// lines; its parent link lives in a separate array (`Pool::parent`), which searches
 /// from the root never touch.
 #[derive(Clone, Copy)]
 #[repr(C, align(32))]
@@ -191,15 +189,9 @@ pub struct DynamicOctree {
     root_min: Voxel,
     /// log2 of the root's side, 0..=64. Below 3 the root is the low corner of a block.
     size_log2: u32,
-    nodes: Vec<Node>,
-    node_parent: Vec<u32>,
-    node_free: Vec<u32>,
-    leaves: Vec<Leaf>,
-    leaf_parent: Vec<u32>,
-    leaf_free: Vec<u32>,
-    small: Vec<Small>,
-    small_parent: Vec<u32>,
-    small_free: Vec<u32>,
+    nodes: Pool<Node>,
+    leaves: Pool<Leaf>,
+    small: Pool<Small>,
     /// Whether new blocks start small (see [`DynamicOctree::set_small_blocks`]).
     small_blocks: bool,
     voxels: u64,
@@ -281,6 +273,109 @@ impl fmt::Debug for DynamicOctree {
 fn grow<T>(v: &mut Vec<T>) {
     if v.len() == v.capacity() {
         v.reserve_exact((v.len() / 8).max(64));
+    }
+}
+
+/// A pool of entries addressed by `u32`: the entries, a parent link per entry (kept
+/// apart, so searches from the root never load it) and a free list. The first
+/// `reserved` entries are sentinels, never handed out or released.
+#[derive(Clone)]
+struct Pool<T> {
+    items: Vec<T>,
+    parent: Vec<u32>,
+    free: Vec<u32>,
+    reserved: usize,
+}
+
+impl<T: Copy> Pool<T> {
+    fn new(sentinels: &[T]) -> Self {
+        Pool {
+            items: sentinels.to_vec(),
+            parent: vec![FREED; sentinels.len()],
+            free: Vec::new(),
+            reserved: sentinels.len(),
+        }
+    }
+
+    /// Stores `value` under `parent`; returns its index, below 2^31 (bit 31 of a slot
+    /// tags a small block).
+    fn alloc(&mut self, value: T, parent: u32, what: &str) -> u32 {
+        if let Some(i) = self.free.pop() {
+            self.items[i as usize] = value;
+            self.parent[i as usize] = parent;
+            return i;
+        }
+        let i = u32::try_from(self.items.len())
+            .ok()
+            .filter(|&i| i < SMALL)
+            .unwrap_or_else(|| panic!("DynamicOctree: more than 2^31 {what}s"));
+        grow(&mut self.items);
+        self.items.push(value);
+        grow(&mut self.parent);
+        self.parent.push(parent);
+        i
+    }
+
+    fn release(&mut self, i: u32) {
+        debug_assert!(i as usize >= self.reserved, "releasing a sentinel");
+        self.parent[i as usize] = FREED;
+        self.free.push(i);
+    }
+
+    /// Entries in use, sentinels not counted.
+    fn live(&self) -> usize {
+        self.items.len() - self.reserved - self.free.len()
+    }
+
+    fn heap_bytes(&self) -> usize {
+        self.items.capacity() * std::mem::size_of::<T>()
+            + (self.parent.capacity() + self.free.capacity()) * 4
+    }
+
+    fn shrink_to_fit(&mut self) {
+        self.items.shrink_to_fit();
+        self.parent.shrink_to_fit();
+        self.free.shrink_to_fit();
+    }
+
+    /// Checks the bookkeeping for [`DynamicOctree::assert_valid`]: one parent link per
+    /// entry, a free list without repeats or sentinels whose entries are marked freed.
+    /// Returns the free entries.
+    fn check(&self, what: &str) -> std::collections::HashSet<u32> {
+        assert_eq!(
+            self.items.len(),
+            self.parent.len(),
+            "{what} parent array length"
+        );
+        let set: std::collections::HashSet<u32> = self.free.iter().copied().collect();
+        assert_eq!(
+            set.len(),
+            self.free.len(),
+            "{what} free list has duplicates"
+        );
+        for &i in &self.free {
+            assert!(
+                i as usize >= self.reserved,
+                "sentinel {what} {i} on the free list"
+            );
+            assert_eq!(self.parent[i as usize], FREED, "free {what} {i} not marked");
+        }
+        set
+    }
+}
+
+impl<T> std::ops::Index<usize> for Pool<T> {
+    type Output = T;
+    #[inline(always)]
+    fn index(&self, i: usize) -> &T {
+        &self.items[i]
+    }
+}
+
+impl<T> std::ops::IndexMut<usize> for Pool<T> {
+    #[inline(always)]
+    fn index_mut(&mut self, i: usize) -> &mut T {
+        &mut self.items[i]
     }
 }
 
@@ -418,29 +513,6 @@ fn rows27(u: [u64; 3], lo: [u64; 3], hi: [u64; 3], word: impl Fn(usize, usize) -
     r
 }
 
-/// Checks one pool for [`DynamicOctree::assert_valid`]: one parent link per entry, a
-/// free list without repeats or sentinels (the first `reserved` entries) whose entries
-/// are marked freed. Returns the free entries.
-fn check_pool(
-    what: &str,
-    free: &[u32],
-    parent: &[u32],
-    len: usize,
-    reserved: usize,
-) -> std::collections::HashSet<u32> {
-    assert_eq!(len, parent.len(), "{what} parent array length");
-    let set: std::collections::HashSet<u32> = free.iter().copied().collect();
-    assert_eq!(set.len(), free.len(), "{what} free list has duplicates");
-    for &i in free {
-        assert!(
-            i as usize >= reserved,
-            "sentinel {what} {i} on the free list"
-        );
-        assert_eq!(parent[i as usize], FREED, "free {what} {i} not marked");
-    }
-    set
-}
-
 /// The six face-neighbour bits (bit `dir`) of a 27-bit neighbourhood.
 #[inline]
 fn six(n: u32) -> u8 {
@@ -465,15 +537,9 @@ impl DynamicOctree {
             root: EMPTY,
             root_min: [0; 3],
             size_log2: 0,
-            nodes: vec![Node { child: [EMPTY; 8] }, Node { child: [FULL; 8] }],
-            node_parent: vec![FREED; SENTINELS],
-            node_free: Vec::new(),
-            leaves: vec![Leaf(ZERO_BLOCK), Leaf(FULL_BLOCK)],
-            leaf_parent: vec![FREED; SENTINELS],
-            leaf_free: Vec::new(),
-            small: Vec::new(),
-            small_parent: Vec::new(),
-            small_free: Vec::new(),
+            nodes: Pool::new(&[Node { child: [EMPTY; 8] }, Node { child: [FULL; 8] }]),
+            leaves: Pool::new(&[Leaf(ZERO_BLOCK), Leaf(FULL_BLOCK)]),
+            small: Pool::new(&[]),
             small_blocks: true,
             voxels: 0,
             expansions: 0,
@@ -545,80 +611,30 @@ impl DynamicOctree {
     // ----- pools -------------------------------------------------------------------
 
     fn alloc_node(&mut self, parent: u32, fill: u32) -> u32 {
-        let n = Node { child: [fill; 8] };
-        if let Some(i) = self.node_free.pop() {
-            self.nodes[i as usize] = n;
-            self.node_parent[i as usize] = parent;
-            i
-        } else {
-            let i = u32::try_from(self.nodes.len())
-                .ok()
-                .filter(|&i| i < SMALL)
-                .expect("DynamicOctree: more than 2^31 nodes");
-            grow(&mut self.nodes);
-            self.nodes.push(n);
-            grow(&mut self.node_parent);
-            self.node_parent.push(parent);
-            i
-        }
+        self.nodes.alloc(Node { child: [fill; 8] }, parent, "node")
     }
 
     fn free_node(&mut self, i: u32) {
-        debug_assert!(i as usize >= SENTINELS, "freeing a sentinel node");
-        self.node_parent[i as usize] = FREED;
-        self.node_free.push(i);
+        self.nodes.release(i);
     }
 
     fn alloc_leaf(&mut self, parent: u32, fill: u64) -> u32 {
-        if let Some(i) = self.leaf_free.pop() {
-            self.leaves[i as usize] = Leaf([fill; 8]);
-            self.leaf_parent[i as usize] = parent;
-            i
-        } else {
-            let i = u32::try_from(self.leaves.len())
-                .ok()
-                .filter(|&i| i < SMALL)
-                .expect("DynamicOctree: more than 2^31 blocks");
-            grow(&mut self.leaves);
-            self.leaves.push(Leaf([fill; 8]));
-            grow(&mut self.leaf_parent);
-            self.leaf_parent.push(parent);
-            i
-        }
+        self.leaves.alloc(Leaf([fill; 8]), parent, "block")
     }
 
     fn free_leaf(&mut self, i: u32) {
-        debug_assert!(i as usize >= SENTINELS, "freeing a sentinel block");
-        self.leaf_parent[i as usize] = FREED;
-        self.leaf_free.push(i);
+        self.leaves.release(i);
     }
 
     /// A small block holding the one voxel `key`; returns its tagged slot.
     fn alloc_small(&mut self, parent: u32, key: u16) -> u32 {
         let mut lanes = [VACANT; SMALL_CAP];
         lanes[0] = key;
-        let i = if let Some(i) = self.small_free.pop() {
-            self.small[i as usize] = Small(lanes);
-            self.small_parent[i as usize] = parent;
-            i
-        } else {
-            let i = u32::try_from(self.small.len())
-                .ok()
-                .filter(|&i| i < SMALL)
-                .expect("DynamicOctree: more than 2^31 small blocks");
-            grow(&mut self.small);
-            self.small.push(Small(lanes));
-            grow(&mut self.small_parent);
-            self.small_parent.push(parent);
-            i
-        };
-        i | SMALL
+        self.small.alloc(Small(lanes), parent, "small block") | SMALL
     }
 
     fn free_small(&mut self, slot: u32) {
-        let i = slot & !SMALL;
-        self.small_parent[i as usize] = FREED;
-        self.small_free.push(i);
+        self.small.release(slot & !SMALL);
     }
 
     /// Turns the small block in `slot` (child `ci` of `parent`, containing offsets
@@ -739,11 +755,11 @@ impl DynamicOctree {
     fn set_parent(&mut self, slot: u32, level: u32, parent: u32) {
         if is_index(slot) {
             if level > LEAF_LOG2 {
-                self.node_parent[slot as usize] = parent;
+                self.nodes.parent[slot as usize] = parent;
             } else if is_small(slot) {
-                self.small_parent[(slot & !SMALL) as usize] = parent;
+                self.small.parent[(slot & !SMALL) as usize] = parent;
             } else {
-                self.leaf_parent[slot as usize] = parent;
+                self.leaves.parent[slot as usize] = parent;
             }
         }
     }
@@ -1031,7 +1047,7 @@ impl DynamicOctree {
     /// children are all full becomes a full slot in its parent.
     fn collapse_up(&mut self, mut node: u32, mut level: u32, u: [u64; 3]) {
         while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == FULL) {
-            let p = self.node_parent[node as usize];
+            let p = self.nodes.parent[node as usize];
             self.free_node(node);
             level += 1;
             let ci = if p != NONE { child_index(u, level) } else { 0 };
@@ -1262,7 +1278,7 @@ impl DynamicOctree {
             self.set_slot(parent, child_index(u, level), EMPTY, LEAF_LOG2, u);
             let mut node = parent;
             while node != NONE && self.nodes[node as usize].child.iter().all(|&c| c == EMPTY) {
-                let p = self.node_parent[node as usize];
+                let p = self.nodes.parent[node as usize];
                 self.free_node(node);
                 level += 1;
                 let ci = if p != NONE { child_index(u, level) } else { 0 };
@@ -1347,7 +1363,7 @@ impl DynamicOctree {
         while level < 64
             && ((t[0] ^ probe[0]) | (t[1] ^ probe[1]) | (t[2] ^ probe[2])) >> level != 0
         {
-            node = self.node_parent[node as usize];
+            node = self.nodes.parent[node as usize];
             level += 1;
             debug_assert!(node != NONE, "climbed past the root");
         }
@@ -1694,9 +1710,7 @@ impl DynamicOctree {
     /// Stored nodes: interior nodes plus 8³ blocks (bitmap and small). O(1).
     #[must_use]
     pub fn node_count(&self) -> usize {
-        (self.nodes.len() - SENTINELS - self.node_free.len())
-            + (self.leaves.len() - SENTINELS - self.leaf_free.len())
-            + (self.small.len() - self.small_free.len())
+        self.nodes.live() + self.leaves.live() + self.small.live()
     }
 
     /// Bytes of memory held: the struct plus every heap allocation at its capacity
@@ -1705,15 +1719,9 @@ impl DynamicOctree {
     #[must_use]
     pub fn bytes(&self) -> usize {
         std::mem::size_of::<Self>()
-            + self.nodes.capacity() * std::mem::size_of::<Node>()
-            + self.node_parent.capacity() * 4
-            + self.node_free.capacity() * 4
-            + self.leaves.capacity() * std::mem::size_of::<Leaf>()
-            + self.leaf_parent.capacity() * 4
-            + self.leaf_free.capacity() * 4
-            + self.small.capacity() * std::mem::size_of::<Small>()
-            + self.small_parent.capacity() * 4
-            + self.small_free.capacity() * 4
+            + self.nodes.heap_bytes()
+            + self.leaves.heap_bytes()
+            + self.small.heap_bytes()
             + self.dir.capacity() * 4
             + self.faces.as_ref().map_or(0, FaceList::heap_bytes)
     }
@@ -1722,14 +1730,8 @@ impl DynamicOctree {
     /// pools may hold up to twice what they need). O(size).
     pub fn shrink_to_fit(&mut self) {
         self.nodes.shrink_to_fit();
-        self.node_parent.shrink_to_fit();
-        self.node_free.shrink_to_fit();
         self.leaves.shrink_to_fit();
-        self.leaf_parent.shrink_to_fit();
-        self.leaf_free.shrink_to_fit();
         self.small.shrink_to_fit();
-        self.small_parent.shrink_to_fit();
-        self.small_free.shrink_to_fit();
         self.dir.shrink_to_fit();
         if let Some(f) = &mut self.faces {
             f.list.shrink_to_fit();
@@ -2016,27 +2018,9 @@ impl DynamicOctree {
             self.leaves[FULL as usize].0, FULL_BLOCK,
             "full sentinel block"
         );
-        let nfree = check_pool(
-            "node",
-            &self.node_free,
-            &self.node_parent,
-            self.nodes.len(),
-            SENTINELS,
-        );
-        let lfree = check_pool(
-            "block",
-            &self.leaf_free,
-            &self.leaf_parent,
-            self.leaves.len(),
-            SENTINELS,
-        );
-        let sfree = check_pool(
-            "small block",
-            &self.small_free,
-            &self.small_parent,
-            self.small.len(),
-            0,
-        );
+        let nfree = self.nodes.check("node");
+        let lfree = self.leaves.check("block");
+        let sfree = self.small.check("small block");
         if self.root == EMPTY {
             assert_eq!(self.voxels, 0, "empty root with voxels");
             assert_eq!(self.size_log2, 0, "empty tree has root size 1");
@@ -2070,7 +2054,7 @@ impl DynamicOctree {
                     let n = &self.nodes[slot as usize];
                     assert!(!nfree.contains(&slot), "node {slot} is live and free");
                     assert_eq!(
-                        self.node_parent[slot as usize], parent,
+                        self.nodes.parent[slot as usize], parent,
                         "parent link of node {slot}"
                     );
                     assert!(n.child.iter().any(|&c| c != EMPTY), "node {slot} is empty");
@@ -2085,7 +2069,7 @@ impl DynamicOctree {
                     let lanes = &self.small[i as usize].0;
                     assert!(!sfree.contains(&i), "small block {i} is live and free");
                     assert_eq!(
-                        self.small_parent[i as usize], parent,
+                        self.small.parent[i as usize], parent,
                         "parent link of small block {i}"
                     );
                     assert_eq!(level, LEAF_LOG2, "small block {i} above the block level");
@@ -2112,7 +2096,7 @@ impl DynamicOctree {
                     let l = &self.leaves[slot as usize].0;
                     assert!(!lfree.contains(&slot), "block {slot} is live and free");
                     assert_eq!(
-                        self.leaf_parent[slot as usize], parent,
+                        self.leaves.parent[slot as usize], parent,
                         "parent link of block {slot}"
                     );
                     assert!(l.iter().any(|&w| w != 0), "block {slot} is empty");
@@ -2141,21 +2125,9 @@ impl DynamicOctree {
                 "directory larger than the tree"
             );
         }
-        assert_eq!(
-            seen_nodes,
-            self.nodes.len() - SENTINELS - self.node_free.len(),
-            "live node count"
-        );
-        assert_eq!(
-            seen_leaves,
-            self.leaves.len() - SENTINELS - self.leaf_free.len(),
-            "live block count"
-        );
-        assert_eq!(
-            seen_small,
-            self.small.len() - self.small_free.len(),
-            "live small block count"
-        );
+        assert_eq!(seen_nodes, self.nodes.live(), "live node count");
+        assert_eq!(seen_leaves, self.leaves.live(), "live block count");
+        assert_eq!(seen_small, self.small.live(), "live small block count");
         // The root cannot contract.
         if self.size_log2 > LEAF_LOG2 && self.root != FULL {
             let ch = &self.nodes[self.root as usize].child;
