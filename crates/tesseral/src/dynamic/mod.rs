@@ -1481,7 +1481,17 @@ impl DynamicOctree {
                 extract27(&self.leaves[slot as usize].0, u)
             };
         }
-        let (cur, level, parent) = self.descend(self.root, phys, NONE, u);
+        // Find `v`'s own node, starting at the directory when its entry is a node.
+        let start = if self.dir_levels > 0 && self.dir_level > LEAF_LOG2 {
+            let entry = self.dir[self.dir_index(u)];
+            is_index(entry).then_some((entry, self.dir_level))
+        } else {
+            None
+        };
+        let (cur, level, parent) = match start {
+            Some((node, level)) => self.descend(node, level, NONE, u),
+            None => self.descend(self.root, phys, NONE, u),
+        };
         let m = if level >= 64 {
             u64::MAX
         } else {
