@@ -1544,15 +1544,28 @@ impl DynamicOctree {
             u[1].wrapping_add(1) >> 3,
             u[2].wrapping_add(1) >> 3,
         ];
+        // Bit `a` of a block number selects the upper block along axis `a`; only the
+        // blocks the 3×3×3 cube touches are looked up.
+        let spans = usize::from(lo[0] != hi[0])
+            | usize::from(lo[1] != hi[1]) << 1
+            | usize::from(lo[2] != hi[2]) << 2;
+        // Blocks in the same 16³ cell as `v`'s are siblings: children of `v`'s node.
+        let siblings = start != NONE && start_level == LEAF_LOG2 + 1;
         let mut blocks = [EMPTY; 8];
         for i in 0..8usize {
-            let sel = [i & 1, i >> 1 & 1, i >> 2 & 1];
-            if (0..3).any(|a| sel[a] == 1 && hi[a] == lo[a]) {
+            if i & !spans != 0 {
                 continue;
             }
-            let b: [u64; 3] = std::array::from_fn(|a| if sel[a] == 0 { lo[a] } else { hi[a] });
+            let b = [
+                if i & 1 == 0 { lo[0] } else { hi[0] },
+                if i & 2 == 0 { lo[1] } else { hi[1] },
+                if i & 4 == 0 { lo[2] } else { hi[2] },
+            ];
             blocks[i] = if b == home {
                 own
+            } else if siblings && (b[0] ^ home[0]) | (b[1] ^ home[1]) | (b[2] ^ home[2]) < 2 {
+                let ci = (b[0] & 1) | (b[1] & 1) << 1 | (b[2] & 1) << 2;
+                self.nodes[start as usize].child[ci as usize]
             } else {
                 self.block_slot_from([b[0] << 3, b[1] << 3, b[2] << 3], u, start, start_level)
             };
