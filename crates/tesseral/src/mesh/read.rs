@@ -158,6 +158,9 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
     })?;
     let mut m = TriMesh::default();
     let mut saw_solid = false;
+    // Whether the last solid was closed: a file cut short loses its tail silently
+    // otherwise.
+    let mut ended = false;
     let mut last_line = 0;
     for (i, line) in text.lines().enumerate() {
         let mut ws = words(line);
@@ -166,7 +169,11 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         };
         last_line = i + 1;
         match key {
-            "solid" => saw_solid = true,
+            "solid" => {
+                saw_solid = true;
+                ended = false;
+            }
+            "endsolid" => ended = true,
             "vertex" => {
                 let p = parse_point(&mut ws, path, i + 1, line, "vertex")?;
                 if m.positions.len() >= 3 * MAX_MESH_ELEMENTS {
@@ -174,7 +181,7 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                 }
                 m.positions.push(p);
             }
-            "facet" | "outer" | "endloop" | "endfacet" | "endsolid" => {}
+            "facet" | "outer" | "endloop" | "endfacet" => {}
             other => {
                 return Err(syntax(
                     path,
@@ -187,6 +194,14 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
     }
     if !saw_solid {
         return Err(syntax(path, 1, 1, "not an STL file (no `solid`)"));
+    }
+    if !ended {
+        return Err(syntax(
+            path,
+            last_line,
+            1,
+            "ASCII STL ends without `endsolid` (the file is cut short)",
+        ));
     }
     if m.positions.len() % 3 != 0 {
         return Err(syntax(
@@ -652,6 +667,21 @@ mod tests {
         let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
         let m = parse_ply(ply.as_bytes(), Path::new("t.ply")).unwrap();
         assert_eq!((m.positions.len(), m.triangles.len()), (3, 1));
+    }
+
+    #[test]
+    fn a_cut_ascii_stl_is_an_error() {
+        // Only the header, or facets without the closing `endsolid`: the tail is lost.
+        for text in [
+            "solid x\n",
+            "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
+        ] {
+            let e = parse_stl(text.as_bytes(), Path::new("c.stl")).unwrap_err();
+            assert!(e.to_string().contains("without `endsolid`"), "{e}");
+        }
+        // An empty but closed solid is a valid, empty mesh.
+        let m = parse_stl(b"solid x\nendsolid x\n", Path::new("e.stl")).unwrap();
+        assert!(m.triangles.is_empty());
     }
 
     #[test]
