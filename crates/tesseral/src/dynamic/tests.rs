@@ -333,6 +333,44 @@ fn far_apart_voxels_near_two_to_the_62() {
 }
 
 #[test]
+fn clusters_at_the_ends_of_the_i64_range_with_the_directory() {
+    // A 2^64 root with thousands of blocks: the directory skips six levels, and the
+    // clusters sit where offsets wrap.
+    let mut rng = Pcg64::seed_from_u64(62);
+    let centres = [
+        [i64::MIN, i64::MIN, i64::MIN],
+        [i64::MAX, 0, i64::MAX],
+        [0, 0, 0],
+    ];
+    let mut t = DynamicOctree::new();
+    let mut m: HashSet<Voxel> = HashSet::new();
+    let mut cells = Vec::new();
+    for (k, c) in centres.iter().cycle().take(6000).enumerate() {
+        let v: Voxel = std::array::from_fn(|a| c[a].wrapping_add(rng.random_range(-200..200)));
+        cells.push(v);
+        assert_eq!(t.insert(v), m.insert(v));
+        if k % 1000 == 999 {
+            t.assert_valid();
+        }
+    }
+    assert_eq!(t.root_size_log2(), 64);
+    assert!(t.dir_levels >= 4, "directory skips {} levels", t.dir_levels);
+    for _ in 0..5000 {
+        let c = centres[rng.random_range(0..3)];
+        let q: Voxel = std::array::from_fn(|a| c[a].wrapping_add(rng.random_range(-210..210)));
+        assert_eq!(t.contains(q), m.contains(&q), "{q:?}");
+    }
+    for (k, v) in cells.iter().enumerate() {
+        assert_eq!(t.remove(*v), m.remove(v));
+        if k % 1000 == 999 {
+            t.assert_valid();
+        }
+    }
+    assert!(t.is_empty());
+    t.assert_valid();
+}
+
+#[test]
 fn string_to_two_to_the_60_costs_sixty_expansions() {
     // Libes §5: "a surface that grows from a single voxel to a long string of 2^60
     // voxels will only cause octree expansion to occur sixty times".
