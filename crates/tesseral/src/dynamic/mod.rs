@@ -75,7 +75,7 @@ const SMALL: u32 = 1 << 31;
 const SMALL_CAP: usize = 8;
 /// A vacant lane of a small block.
 const VACANT: u16 = u16::MAX;
-/// The most levels the directory skips (8^5 = 32,768 entries, 128 KiB).
+/// The most levels the directory skips (8^6 = 262,144 entries, 1 MiB).
 const DIR_MAX_LEVELS: u32 = 6;
 /// No parent: the node is the root.
 const NONE: u32 = 0;
@@ -201,8 +201,11 @@ pub struct DynamicOctree {
     version: u64,
     /// The directory: the slots at level `dir_level = phys − dir_levels`, densely, in
     /// tesseral order of the root's cells at that level, so a search starts there
-    /// instead of at the root. Empty when `dir_levels == 0`. Sized to the tree (at
-    /// most one entry per stored node and block, up to `8^DIR_MAX_LEVELS`).
+    /// instead of at the root. Empty when `dir_levels == 0`. Sized to the tree: built
+    /// with at most eight entries per stored node and block (4 bytes each, against
+    /// their 16–64), rebuilt larger when the tree has grown eightfold and smaller
+    /// when it holds less than one stored node per 64 entries, and never more than
+    /// `8^DIR_MAX_LEVELS` entries.
     dir: Vec<u32>,
     dir_levels: u32,
     dir_level: u32,
@@ -704,8 +707,9 @@ impl DynamicOctree {
 
     /// Rebuilds the directory after the root changed (expansion, contraction, a new
     /// or emptied tree) or the tree outgrew it or shrank well below it. It skips
-    /// `t ≤ 5` levels, the most for which `8^t ≤ 8 · stored nodes` and the directory
-    /// level stays at or above the blocks. O(8^t), at most 32,768 entries.
+    /// `t ≤ DIR_MAX_LEVELS` levels, the most for which `8^t ≤ 8 · stored nodes` and
+    /// the directory level stays at or above the blocks. O(8^t), at most 262,144
+    /// entries (about 0.1 ms).
     fn rebuild_dir(&mut self) {
         let live = self.node_count();
         let max_t = (self.phys_log2() - LEAF_LOG2).min(DIR_MAX_LEVELS);
