@@ -709,7 +709,7 @@ impl DynamicOctree {
     /// or emptied tree) or the tree outgrew it or shrank well below it. It skips
     /// `t ≤ DIR_MAX_LEVELS` levels, the most for which `8^t ≤ 8 · stored nodes` and
     /// the directory level stays at or above the blocks. O(8^t), at most 262,144
-    /// entries (about 0.1 ms).
+    /// entries (tens of microseconds).
     fn rebuild_dir(&mut self) {
         let live = self.node_count();
         let max_t = (self.phys_log2() - LEAF_LOG2).min(DIR_MAX_LEVELS);
