@@ -4,7 +4,7 @@
 //!   watertight, manifold triangle mesh. Coplanar faces are merged greedily, vertices
 //!   are split where voxels touch only along an edge or at a corner, and T-junctions
 //!   are closed, so every edge is shared by exactly two triangles. Written as STL,
-//!   OBJ, PLY or glTF binary ([`write`]).
+//!   OBJ, PLY or glTF binary ([`mod@write`]).
 //! - **In** ([`read`], [`voxelize`]): STL (ASCII and binary), OBJ and PLY (ASCII and
 //!   binary) become solid octrees at a chosen depth or voxel size, top-down through a
 //!   [`crate::linear::Classifier`], with exact integer triangle/box overlap tests and
