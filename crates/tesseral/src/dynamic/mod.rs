@@ -592,8 +592,9 @@ impl DynamicOctree {
     /// occupancy-map use) to about a third, and its lookups gain because more of the
     /// tree stays in the cache; dense surfaces fill their blocks anyway and read
     /// their neighbourhoods faster from bitmaps. On by default; off for
-    /// [`with_faces`](Self::with_faces) trees (random surfaces). Existing blocks keep
-    /// their form. O(1).
+    /// [`with_faces`](Self::with_faces) trees (random surfaces). While it is on, a
+    /// bitmap block that deletions leave with four or fewer voxels turns small again.
+    /// Existing blocks keep their form. O(1).
     ///
     /// ```
     /// let mut t = tesseral::dynamic::DynamicOctree::new();
@@ -1222,9 +1223,39 @@ impl DynamicOctree {
         }
         if is_index(slot) && word & !b != 0 {
             self.leaves[slot as usize].0[w] = word & !b;
+            self.maybe_demote(slot, u);
             return true;
         }
         self.clear_bit_slow(u)
+    }
+
+    /// A bitmap block (not the root block) left with at most half a small block's
+    /// voxels becomes a small block again, in a tree whose new blocks start small.
+    /// (The gap between four and nine voxels keeps a block from switching back and
+    /// forth.)
+    fn maybe_demote(&mut self, slot: u32, u: [u64; 3]) {
+        if !self.small_blocks {
+            return;
+        }
+        let words = self.leaves[slot as usize].0;
+        let count: u32 = words.iter().map(|w| w.count_ones()).sum();
+        let parent = self.leaves.parent[slot as usize];
+        if count as usize > SMALL_CAP / 2 || parent == NONE {
+            return;
+        }
+        let mut lanes = [VACANT; SMALL_CAP];
+        let mut k = 0;
+        for (z, &word) in words.iter().enumerate() {
+            let mut rest = word;
+            while rest != 0 {
+                lanes[k] = (z as u16) << 6 | rest.trailing_zeros() as u16;
+                k += 1;
+                rest &= rest - 1;
+            }
+        }
+        self.free_leaf(slot);
+        let small = self.small.alloc(Small(lanes), parent, "small block") | SMALL;
+        self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), small, LEAF_LOG2, u);
     }
 
     /// [`clear_bit`](Self::clear_bit) that instantiates a full octant on the way down
@@ -1274,6 +1305,8 @@ impl DynamicOctree {
             let emptied = l[w] == 0 && l.iter().all(|&x| x == 0);
             if emptied {
                 self.free_leaf(cur);
+            } else {
+                self.maybe_demote(cur, u);
             }
             emptied
         };

@@ -215,10 +215,22 @@ fn small_blocks_grow_into_bitmaps_and_go_away() {
             assert_eq!(t.contains(d), cells[..=n].contains(&d));
         }
     }
-    for &c in &cells {
+    for (n, &c) in cells.iter().enumerate() {
         assert!(t.remove(c));
         assert!(!t.remove(c));
         t.assert_valid();
+        // Down to four voxels the bitmap turns small again; the last one frees it.
+        let left = cells.len() - n - 1;
+        let forms = (t.small.live(), t.leaves.live());
+        let want = match left {
+            0 => (0, 1),
+            1..=4 => (1, 1),
+            _ => (0, 2),
+        };
+        assert_eq!(forms, want, "with {left} voxels left");
+        for &d in &cells {
+            assert_eq!(t.contains(d), cells[n + 1..].contains(&d));
+        }
     }
     assert_eq!(t.voxel_count(), 1);
     assert_eq!(t.node_count(), 1); // the far voxel's block, the root again
