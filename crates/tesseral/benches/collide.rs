@@ -18,6 +18,8 @@
 //! for the C++ harness. `benches/fcl/run.sh` runs both and prints the ratios. Then
 //! criterion runs (skip it with `TESSERAL_SUMMARY_ONLY=1`).
 
+mod common;
+
 use std::collections::HashSet;
 use std::fmt::Write as _;
 use std::hint::black_box;
@@ -31,6 +33,8 @@ use tesseral::motion::{
     Placement, PlanOptions,
 };
 use tesseral::Voxel;
+
+use common::SplitMix64;
 
 struct Pair {
     name: &'static str,
@@ -87,18 +91,6 @@ fn terrain() -> Vec<Voxel> {
         }
     }
     v
-}
-
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
 }
 
 fn porous(seed: u64) -> Vec<Voxel> {

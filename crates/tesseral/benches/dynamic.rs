@@ -12,6 +12,8 @@
 //! run; `benches/octomap/run.sh` puts them side by side with OctoMap's. Then criterion
 //! runs (skip them with `TESSERAL_SUMMARY_ONLY=1`).
 
+mod common;
+
 use std::collections::HashSet;
 use std::hint::black_box;
 use std::time::Instant;
@@ -20,27 +22,19 @@ use criterion::{BatchSize, Criterion};
 use tesseral::dynamic::DynamicOctree;
 use tesseral::Voxel;
 
-struct SplitMix64(u64);
+use common::SplitMix64;
 
-impl SplitMix64 {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
-    }
-    fn cell(&mut self) -> Voxel {
-        let x = (self.next() >> 55) as i64 - 256;
-        let y = (self.next() >> 55) as i64 - 256;
-        let z = (self.next() >> 55) as i64 - 256;
-        [x, y, z]
-    }
+/// A random cell of the box [−256, 256)³.
+fn cell(r: &mut SplitMix64) -> Voxel {
+    let x = (r.next() >> 55) as i64 - 256;
+    let y = (r.next() >> 55) as i64 - 256;
+    let z = (r.next() >> 55) as i64 - 256;
+    [x, y, z]
 }
 
 fn random_cells(seed: u64, n: usize) -> Vec<Voxel> {
     let mut r = SplitMix64(seed);
-    (0..n).map(|_| r.cell()).collect()
+    (0..n).map(|_| cell(&mut r)).collect()
 }
 
 fn shell_cells() -> Vec<Voxel> {

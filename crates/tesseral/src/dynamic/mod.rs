@@ -129,6 +129,26 @@ struct Leaf([u64; 8]);
 struct Small([u16; SMALL_CAP]);
 
 impl Small {
+    /// A block holding the one voxel `key`.
+    fn one(key: u16) -> Self {
+        let mut lanes = [VACANT; SMALL_CAP];
+        lanes[0] = key;
+        Small(lanes)
+    }
+    /// The voxels of `words` (at most [`SMALL_CAP`]) as a small block.
+    fn from_words(words: &[u64; 8]) -> Self {
+        let mut lanes = [VACANT; SMALL_CAP];
+        let mut k = 0;
+        for (z, &word) in words.iter().enumerate() {
+            let mut rest = word;
+            while rest != 0 {
+                lanes[k] = (z as u16) << 6 | rest.trailing_zeros() as u16;
+                k += 1;
+                rest &= rest - 1;
+            }
+        }
+        Small(lanes)
+    }
     /// Whether lane value `key` is present. Branch-free (all eight lanes are
     /// compared), so a hit does not mispredict a loop exit.
     #[inline(always)]
@@ -209,9 +229,6 @@ pub struct DynamicOctree {
     dir: Vec<u32>,
     dir_levels: u32,
     dir_level: u32,
-    /// Live node counts at which the directory is resized.
-    dir_grow_at: usize,
-    dir_shrink_below: usize,
     faces: Option<FaceList>,
 }
 
@@ -551,8 +568,6 @@ impl DynamicOctree {
             dir: Vec::new(),
             dir_levels: 0,
             dir_level: 0,
-            dir_grow_at: 1,
-            dir_shrink_below: 0,
             faces: None,
         }
     }
@@ -630,11 +645,9 @@ impl DynamicOctree {
         self.leaves.release(i);
     }
 
-    /// A small block holding the one voxel `key`; returns its tagged slot.
-    fn alloc_small(&mut self, parent: u32, key: u16) -> u32 {
-        let mut lanes = [VACANT; SMALL_CAP];
-        lanes[0] = key;
-        self.small.alloc(Small(lanes), parent, "small block") | SMALL
+    /// Stores a small block; returns its tagged slot.
+    fn alloc_small(&mut self, parent: u32, block: Small) -> u32 {
+        self.small.alloc(block, parent, "small block") | SMALL
     }
 
     fn free_small(&mut self, slot: u32) {
@@ -713,45 +726,49 @@ impl DynamicOctree {
     /// entries (tens of microseconds).
     fn rebuild_dir(&mut self) {
         let live = self.node_count();
-        let max_t = (self.phys_log2() - LEAF_LOG2).min(DIR_MAX_LEVELS);
         let mut t = 0;
-        while t < max_t && 1usize << (3 * (t + 1)) <= 8 * live {
+        while t < self.dir_max_levels() && 1usize << (3 * (t + 1)) <= 8 * live {
             t += 1;
         }
         self.dir_levels = t;
         self.dir_level = self.phys_log2() - t;
-        self.dir_grow_at = if t < max_t {
-            1usize << (3 * t)
-        } else {
-            usize::MAX
-        };
-        self.dir_shrink_below = (1usize << (3 * t)) / 64;
-        self.dir.clear();
+        let mut dir = Vec::new();
         if t > 0 {
-            self.dir.resize(1 << (3 * t), EMPTY);
-            self.fill_dir(self.root, self.phys_log2(), 0);
+            dir.resize(1 << (3 * t), EMPTY);
+            self.fill_dir(&mut dir, self.root, self.phys_log2(), 0);
         }
+        self.dir = dir;
     }
 
-    /// Writes the directory entries under `slot` at `level`, from entry `base`.
-    fn fill_dir(&mut self, slot: u32, level: u32, base: usize) {
+    /// The most levels the directory may skip in a root of this size: it stays at or
+    /// above the blocks.
+    fn dir_max_levels(&self) -> u32 {
+        (self.phys_log2() - LEAF_LOG2).min(DIR_MAX_LEVELS)
+    }
+
+    /// Writes into `dir` (entries of `self.dir_level`) the entries under `slot` at
+    /// `level`, from entry `base`.
+    fn fill_dir(&self, dir: &mut [u32], slot: u32, level: u32, base: usize) {
         if level == self.dir_level || !is_index(slot) {
             let span = 1usize << (3 * (level - self.dir_level));
-            self.dir[base..base + span].fill(slot);
+            dir[base..base + span].fill(slot);
         } else {
-            let child = self.nodes[slot as usize].child;
             let step = 1usize << (3 * (level - 1 - self.dir_level));
-            for (ci, c) in child.into_iter().enumerate() {
-                self.fill_dir(c, level - 1, base + ci * step);
+            for (ci, &c) in self.nodes[slot as usize].child.iter().enumerate() {
+                self.fill_dir(dir, c, level - 1, base + ci * step);
             }
         }
     }
 
-    /// Resizes the directory when the tree has outgrown it or shrunk well below it.
+    /// Rebuilds the directory when the tree has grown eightfold since it was built
+    /// (and a deeper one is allowed), or holds less than one stored node per 64
+    /// entries.
     #[inline]
     fn check_dir_size(&mut self) {
         let live = self.node_count();
-        if live >= self.dir_grow_at || live < self.dir_shrink_below {
+        let entries = 1usize << (3 * self.dir_levels);
+        let grown = self.dir_levels < self.dir_max_levels() && live >= entries;
+        if grown || live < entries / 64 {
             self.rebuild_dir();
         }
     }
@@ -1012,7 +1029,7 @@ impl DynamicOctree {
         }
         if cur == EMPTY && parent != NONE && self.small_blocks {
             // A new block starts small.
-            let s = self.alloc_small(parent, local_index(u));
+            let s = self.alloc_small(parent, Small::one(local_index(u)));
             self.set_slot(parent, ci, s, LEAF_LOG2, u);
             self.check_dir_size();
             return true;
@@ -1243,18 +1260,8 @@ impl DynamicOctree {
         if count as usize > SMALL_CAP / 2 || parent == NONE {
             return;
         }
-        let mut lanes = [VACANT; SMALL_CAP];
-        let mut k = 0;
-        for (z, &word) in words.iter().enumerate() {
-            let mut rest = word;
-            while rest != 0 {
-                lanes[k] = (z as u16) << 6 | rest.trailing_zeros() as u16;
-                k += 1;
-                rest &= rest - 1;
-            }
-        }
         self.free_leaf(slot);
-        let small = self.small.alloc(Small(lanes), parent, "small block") | SMALL;
+        let small = self.alloc_small(parent, Small::from_words(&words));
         self.set_slot(parent, child_index(u, LEAF_LOG2 + 1), small, LEAF_LOG2, u);
     }
 
@@ -2175,9 +2182,9 @@ impl DynamicOctree {
             assert_eq!(self.dir_level + self.dir_levels, phys, "directory level");
             assert_eq!(self.dir.len(), 1 << (3 * self.dir_levels), "directory size");
             assert!(self.dir_level >= LEAF_LOG2, "directory below the blocks");
-            let mut fresh = self.clone();
-            fresh.fill_dir(self.root, phys, 0);
-            for (i, (&a, &b)) in self.dir.iter().zip(&fresh.dir).enumerate() {
+            let mut fresh = vec![EMPTY; self.dir.len()];
+            self.fill_dir(&mut fresh, self.root, phys, 0);
+            for (i, (&a, &b)) in self.dir.iter().zip(&fresh).enumerate() {
                 assert_eq!(a, b, "directory entry {i}");
             }
             assert!(

@@ -473,56 +473,14 @@ fn face_list_order_follows_the_contract() {
     t.insert([1, 0, 0]);
     // a's +x face (index 1) is swap-removed: a's +z face (index 5) moves there, then
     // b pushes −y, +y, −z, +z after the +x face (b's −x is covered).
-    let want = [
-        Face {
-            voxel: [0, 0, 0],
-            dir: 0,
-        },
-        Face {
-            voxel: [0, 0, 0],
-            dir: 5,
-        },
-        Face {
-            voxel: [0, 0, 0],
-            dir: 2,
-        },
-        Face {
-            voxel: [0, 0, 0],
-            dir: 3,
-        },
-        Face {
-            voxel: [0, 0, 0],
-            dir: 4,
-        },
-        Face {
-            voxel: [1, 0, 0],
-            dir: 1,
-        },
-        Face {
-            voxel: [1, 0, 0],
-            dir: 2,
-        },
-        Face {
-            voxel: [1, 0, 0],
-            dir: 3,
-        },
-        Face {
-            voxel: [1, 0, 0],
-            dir: 4,
-        },
-        Face {
-            voxel: [1, 0, 0],
-            dir: 5,
-        },
-    ];
+    let face = |voxel, dir| Face { voxel, dir };
+    let a = |dir| face([0, 0, 0], dir);
+    let b = |dir| face([1, 0, 0], dir);
+    let want = [a(0), a(5), a(2), a(3), a(4), b(1), b(2), b(3), b(4), b(5)];
     assert_eq!(t.faces(), want);
     t.remove([0, 0, 0]);
     t.assert_valid();
     // Worked by hand through the six swap_removes and one push.
-    let b = |dir| Face {
-        voxel: [1, 0, 0],
-        dir,
-    };
     assert_eq!(t.faces(), [b(5), b(2), b(0), b(4), b(3), b(1)]);
 }
 
