@@ -147,27 +147,7 @@ impl FormatError {
     }
 }
 
-/// Where the voxel lattice sits in the world of a file: the corner of voxel
-/// `(i, j, k)` is `translate + voxel_size * (i, j, k)`.
-///
-/// OctoMap's resolution and binvox's translate and scale become a `Frame`, so a
-/// round trip through tesseral keeps them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Frame {
-    /// The side of one voxel, in world units (metres for OctoMap).
-    pub voxel_size: f64,
-    /// The world position of the corner of voxel `(0, 0, 0)`.
-    pub translate: [f64; 3],
-}
-
-impl Default for Frame {
-    fn default() -> Self {
-        Self {
-            voxel_size: 1.0,
-            translate: [0.0; 3],
-        }
-    }
-}
+pub use crate::model::Frame;
 
 /// Per-voxel colours `[r, g, b, a]`, kept beside the octree for formats that carry
 /// colour (MagicaVoxel palettes, OctoMap `ColorOcTree`). Voxels that are not black
