@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
-use crate::linear::{LinearOctree, OctreeError};
+use crate::linear::{Leaf, LinearOctree, OctreeError};
 use crate::Voxel;
 
 /// A value a [`Layer`] can hold: copied, and grouped into regions by a key (so
@@ -109,6 +109,42 @@ impl<T: LayerValue> Layer<T> {
             regions.push((x, LinearOctree::from_voxels(depth, origin, voxels)?));
         }
         Ok(Self::from_regions_unchecked(depth, origin, regions))
+    }
+
+    /// A layer from `(leaf, value)` pairs of disjoint leaves in tesseral order (as a
+    /// preorder file walk yields them).
+    ///
+    /// # Runtime
+    /// O(n) expected for n leaves.
+    ///
+    /// # Errors
+    /// As [`LinearOctree::from_sorted_leaves`].
+    pub fn from_sorted_leaves(
+        depth: u8,
+        origin: Voxel,
+        leaves: impl IntoIterator<Item = (Leaf, T)>,
+    ) -> Result<Self, OctreeError> {
+        let mut groups: HashMap<u64, (T, Vec<Leaf>)> = HashMap::new();
+        for (l, x) in leaves {
+            groups.entry(x.key()).or_insert_with(|| (x, Vec::new())).1.push(l);
+        }
+        let mut regions = Vec::with_capacity(groups.len());
+        for (_, (x, leaves)) in groups {
+            regions.push((x, LinearOctree::from_sorted_leaves(depth, origin, leaves)?));
+        }
+        Ok(Self::from_regions_unchecked(depth, origin, regions))
+    }
+
+    /// Every leaf of every region with its value, in tesseral order.
+    #[must_use]
+    pub fn leaves(&self) -> Vec<(Leaf, T)> {
+        let mut out: Vec<(Leaf, T)> = self
+            .regions
+            .iter()
+            .flat_map(|(x, t)| t.leaves().iter().map(move |l| (*l, *x)))
+            .collect();
+        out.sort_unstable_by_key(|(l, _)| l.code());
+        out
     }
 
     /// A layer from regions already in the space and disjoint; regions with the same
@@ -225,12 +261,12 @@ impl<T: LayerValue> Layer<T> {
         let probe = LinearOctree::empty(self.depth, self.origin).ok()?;
         let c = probe.code_of(v)?;
         let idx = self.index();
-        let i = idx.partition_point(|&(p, _)| crate::linear::Leaf::from_packed(p).code() <= c);
+        let i = idx.partition_point(|&(p, _)| Leaf::from_packed(p).code() <= c);
         if i == 0 {
             return None;
         }
         let (p, r) = idx[i - 1];
-        crate::linear::Leaf::from_packed(p)
+        Leaf::from_packed(p)
             .contains_code(c)
             .then(|| self.regions[r as usize].0)
     }
