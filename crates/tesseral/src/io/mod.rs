@@ -20,6 +20,7 @@
 
 mod atomic;
 pub mod binvox;
+mod estimate;
 pub mod native;
 pub mod octomap;
 mod reframe;
@@ -27,6 +28,7 @@ pub mod vox;
 pub mod xyz;
 
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
+pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
 
 use std::collections::BTreeMap;
