@@ -6,6 +6,9 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tesseral::csg::Scene;
 
+use super::octree;
+use super::output::{self, Limits};
+
 /// Arguments of `tesseral build`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,13 +20,20 @@ pub struct Args {
     /// Print the size and timing as JSON on stdout.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.scene])?;
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
     let tree = scene.build()?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    let ext = tesseral::io::extension(&args.output);
+    if let Some(bytes) = tesseral::io::estimate_output_bytes(&tree, &ext) {
+        output::check_size(&args.output, bytes, args.limits.max_output)?;
+    }
     tesseral::io::write_octree(&args.output, &tree)
         .with_context(|| format!("writing {}", args.output.display()))?;
     if args.json {
@@ -39,7 +49,7 @@ pub fn run(args: Args) -> Result<()> {
             "leaves_by_depth": tree.leaves_by_depth(),
             "build_ms": build_ms,
         });
-        println!("{out}");
+        crate::outln!("{out}")?;
     }
     Ok(())
 }

@@ -183,7 +183,7 @@ pub fn run(args: Args) -> Result<()> {
                     explain_add(&mode, ca, cb, &mut out);
                 }
                 writeln!(out, "{}", mode.show(r.code))?;
-                print!("{}", tidy(&out));
+                crate::out!("{}", tidy(&out))?;
                 if r.carry != 0 {
                     eprintln!(
                         "note: carry {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
@@ -215,7 +215,7 @@ pub fn run(args: Args) -> Result<()> {
                 explain_sub(&mode, ca, cb, &mut out)?;
             }
             writeln!(out, "{}", mode.show(code))?;
-            print!("{}", tidy(&out));
+            crate::out!("{}", tidy(&out))?;
             if mode.bounded && r.carry != 0 {
                 eprintln!(
                     "note: borrow {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
@@ -276,7 +276,7 @@ pub fn run(args: Args) -> Result<()> {
             }
         }
     }
-    print!("{}", tidy(&out));
+    crate::out!("{}", tidy(&out))?;
     Ok(())
 }
 

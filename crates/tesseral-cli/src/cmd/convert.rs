@@ -12,6 +12,9 @@ use anyhow::{bail, Result};
 use tesseral::io::{self, ReadOptions, WriteOptions};
 use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
+use super::octree;
+use super::output::{self, Limits};
+
 /// Arguments of `tesseral convert`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -36,10 +39,13 @@ pub struct Args {
     /// Print a summary as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub limits: Limits,
 }
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let resolution = match (args.depth, args.voxel_size) {
         (Some(d), _) => {
             if d > MAX_VOXELIZE_DEPTH {
@@ -67,6 +73,9 @@ pub fn run(args: Args) -> Result<()> {
         },
     };
     let model = io::read_model_with(&args.input, &read).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if let Some(bytes) = io::estimate_output_bytes(&model.tree, &io::extension(&args.output)) {
+        output::check_size(&args.output, bytes, args.limits.max_output)?;
+    }
     io::write_model_with(&args.output, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
     if args.json {
         let bbox = model.tree.bbox();
@@ -83,7 +92,7 @@ pub fn run(args: Args) -> Result<()> {
             "translate": model.frame.map(|f| f.translate),
             "colors": model.colors.as_ref().map(|c| c.len()),
         });
-        println!("{summary}");
+        crate::outln!("{summary}")?;
     }
     Ok(())
 }

@@ -53,25 +53,25 @@ pub fn run(args: Args) -> Result<()> {
         bytes: 8 * tree.leaf_count() as u64,
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&info)?)?;
         return Ok(());
     }
-    println!("file     {}", args.file.display());
-    println!("voxels   {}", info.voxels);
-    println!("leaves   {}", info.leaves);
-    println!(
+    crate::outln!("file     {}", args.file.display())?;
+    crate::outln!("voxels   {}", info.voxels)?;
+    crate::outln!("leaves   {}", info.leaves)?;
+    crate::outln!(
         "space    depth {} ({} per axis) from {}",
         info.depth,
         1u64 << info.depth,
         octree::fmt_voxel(info.origin)
-    );
+    )?;
     match bbox {
-        Some((lo, hi)) => println!(
+        Some((lo, hi)) => crate::outln!(
             "bbox     {} to {}",
             octree::fmt_voxel(lo),
             octree::fmt_voxel(hi)
-        ),
-        None => println!("bbox     (empty)"),
+        )?,
+        None => crate::outln!("bbox     (empty)")?,
     }
     let by_depth: Vec<String> = info
         .leaves_by_depth
@@ -80,12 +80,12 @@ pub fn run(args: Args) -> Result<()> {
         .filter(|(_, &n)| n > 0)
         .map(|(d, n)| format!("{d}:{n}"))
         .collect();
-    println!("by depth {}", by_depth.join(" "));
+    crate::outln!("by depth {}", by_depth.join(" "))?;
     let per_voxel = if info.voxels == 0 {
         0.0
     } else {
         info.bytes as f64 / info.voxels as f64
     };
-    println!("bytes    {} ({per_voxel:.3} per voxel)", info.bytes);
+    crate::outln!("bytes    {} ({per_voxel:.3} per voxel)", info.bytes)?;
     Ok(())
 }

@@ -7,6 +7,7 @@ pub mod convert;
 pub mod info;
 pub mod octree;
 pub mod op;
+pub mod output;
 pub mod plan;
 pub mod render;
 pub mod replay;

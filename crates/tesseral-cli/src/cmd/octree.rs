@@ -6,6 +6,8 @@ use std::path::Path;
 use anyhow::Result;
 use tesseral::linear::{Axis, LinearOctree};
 
+use super::output::{self, Limits};
+
 /// Reads an octree, in any format `tesseral::io` knows by the extension.
 pub fn read(path: &Path) -> Result<LinearOctree> {
     // The library's message already names the file and its cause; keep it as one
@@ -13,30 +15,28 @@ pub fn read(path: &Path) -> Result<LinearOctree> {
     tesseral::io::read_octree(path).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// The most voxels a command writes as a voxel list (`.xyz` holds one line per
-/// voxel, so a scaled-up or complemented solid could otherwise fill the disk).
-pub const MAX_LISTED_VOXELS: u64 = 1 << 27;
+/// Checks an octree output before any work: a format we write, and not an input.
+pub fn guard(output: &Path, inputs: &[&Path]) -> Result<()> {
+    output::guard("--output", output, &output::octree_formats(), inputs)
+}
 
 /// Writes an octree atomically, in the format named by the extension, and prints a
-/// one-line summary.
-pub fn write(path: &Path, tree: &LinearOctree) -> Result<()> {
-    if tesseral::io::extension(path) == "xyz" && tree.voxel_count() > MAX_LISTED_VOXELS {
-        anyhow::bail!(
-            "{}: {} voxels is too many for a voxel list (at most {MAX_LISTED_VOXELS}); \
-             write a block-based format instead",
-            path.display(),
-            tree.voxel_count()
-        );
+/// one-line summary. Refuses, before writing, an output estimated above
+/// `--max-output`.
+pub fn write(path: &Path, tree: &LinearOctree, limits: &Limits) -> Result<()> {
+    let ext = tesseral::io::extension(path);
+    if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
+        output::check_size(path, bytes, limits.max_output)?;
     }
     tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
-    println!(
+    crate::outln!(
         "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
         path.display(),
         tree.voxel_count(),
         tree.leaf_count(),
         tree.depth(),
         fmt_voxel(tree.origin())
-    );
+    )?;
     Ok(())
 }
 

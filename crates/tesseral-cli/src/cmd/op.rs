@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use tesseral::linear::SetOp;
 
 use super::octree;
+use super::output::Limits;
 
 /// A set operation on the command line.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -33,9 +34,12 @@ pub struct Args {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.a, &args.b])?;
     let a = octree::read(&args.a)?;
     let b = octree::read(&args.b)?;
     let op = match args.op {
@@ -47,5 +51,5 @@ pub fn run(args: Args) -> Result<()> {
     let r = a
         .set_op(&b, op)
         .with_context(|| format!("combining {} and {}", args.a.display(), args.b.display()))?;
-    octree::write(&args.output, &r)
+    octree::write(&args.output, &r, &args.limits)
 }

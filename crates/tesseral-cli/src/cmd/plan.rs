@@ -10,6 +10,7 @@ use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
 use super::collide::parse_voxel;
+use super::output;
 
 /// Arguments of `tesseral plan`.
 #[derive(clap::Args)]
@@ -96,6 +97,9 @@ struct NotFound {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(path) = &args.output {
+        output::guard("--output", path, &["png"], &[&args.env, &args.obj])?;
+    }
     let env = read_solid(&args.env).context("reading the environment")?;
     let obj = read_solid(&args.obj).context("reading the object")?;
     let options = PlanOptions {

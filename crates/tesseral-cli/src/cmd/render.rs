@@ -9,6 +9,8 @@ use tesseral::io;
 use tesseral::linear::LinearOctree;
 use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
 
+use super::output;
+
 /// Arguments of `tesseral render`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -137,6 +139,7 @@ fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    output::guard("--output", &args.output, &["png"], &[&args.input])?;
     let (width, height) = parse_size(&args.size)?;
     let view = View::parse(&args.view)
         .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
@@ -265,7 +268,7 @@ pub fn run(args: Args) -> Result<()> {
             "load_ms": load_ms,
             "render_ms": render_ms,
         });
-        println!("{out}");
+        crate::outln!("{out}")?;
     }
     Ok(())
 }

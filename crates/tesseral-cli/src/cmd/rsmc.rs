@@ -417,9 +417,9 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             "backend": args.backend,
             "out": args.out.display().to_string(),
         });
-        println!("{summary}");
+        crate::outln!("{summary}")?;
     } else {
-        println!(
+        crate::outln!(
             "{} steps ({} this run, {:.2} M steps/s): area {}, volume {}, Euler characteristic {}, {} accepted; wrote {}",
             k.steps,
             ran,
@@ -429,7 +429,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             report.euler(),
             k.accepted,
             args.out.display()
-        );
+        )?;
     }
     Ok(())
 }

@@ -8,6 +8,8 @@ use serde::Serialize;
 use tesseral::motion::{read_world, render_frame, Aabb, Body, Frame};
 use tesseral::render::{Camera, RenderOptions, View};
 
+use super::output::{self, Limits};
+
 /// Arguments of `tesseral simulate`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -31,6 +33,8 @@ pub struct Args {
     /// The frames' height in pixels.
     #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(16..=4096))]
     height: u32,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 #[derive(Serialize)]
@@ -66,8 +70,22 @@ fn parse_view(s: &str) -> Result<View, String> {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(dir) = &args.frames {
+        if output::same_file(dir, &args.world) {
+            anyhow::bail!(
+                "--frames {}: this is the world file; give a folder for the pictures",
+                dir.display()
+            );
+        }
+    }
     let wf = read_world(&args.world).context("reading the world file")?;
     let world = &wf.world;
+    if let Some(dir) = &args.frames {
+        // One picture per step and one of the start, each estimated before any work.
+        let each = tesseral::io::estimate_image_bytes(args.width.into(), args.height.into());
+        let total = each.saturating_mul(wf.steps.saturating_add(1));
+        output::check_size(dir, total, args.limits.max_output)?;
+    }
     let sim = world
         .simulate(wf.time_step, wf.steps)
         .context("keeping the objects' octrees current")?;

@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use tesseral::pointer::PointerOctree;
 
 use super::octree::{self, AxisArg};
+use super::output::Limits;
 
 /// How `translate` moves the tree.
 #[derive(Clone, Copy, Default, clap::ValueEnum)]
@@ -30,6 +31,8 @@ pub struct TranslateArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
     /// The algorithm.
     #[arg(long, value_enum, default_value_t)]
     method: Method,
@@ -40,6 +43,7 @@ pub struct TranslateArgs {
 }
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
     let by = args.by;
     let moved = match (args.method, args.clip) {
@@ -54,7 +58,7 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             let (moved, dropped) = tree
                 .translate_clipped(by)
                 .with_context(|| format!("translating {}", args.input.display()))?;
-            println!("clipped: {dropped} voxels left the space and were dropped");
+            crate::outln!("clipped: {dropped} voxels left the space and were dropped")?;
             moved
         }
         (Method::Labels, true) => {
@@ -67,21 +71,21 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
                 .with_context(|| format!("translating {}", args.input.display()))?;
             for (name, s) in ["x", "y", "z"].iter().zip(stats.axes.iter()) {
                 if s.displacement != 0 {
-                    println!(
+                    crate::outln!(
                         "axis {name}: by {}, nodes of side 2^{} moved: {}, traversed {}, path steps {}, compaction {}, split {}",
                         s.displacement, s.moved_size_log2, s.moved, s.traversed, s.path_steps, s.compacted, s.split_created
-                    );
+                    )?;
                 }
             }
-            println!(
+            crate::outln!(
                 "nodes visited: {} (root expansions: {})",
                 stats.nodes_visited(),
                 stats.root_expansions
-            );
+            )?;
             p.to_linear()
         }
     };
-    octree::write(&args.output, &moved)
+    octree::write(&args.output, &moved, &args.limits)
 }
 
 /// Arguments of `tesseral rotate`.
@@ -98,11 +102,18 @@ pub struct RotateArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.rotate(args.axis.into(), args.turns))
+    octree::write(
+        &args.output,
+        &tree.rotate(args.axis.into(), args.turns),
+        &args.limits,
+    )
 }
 
 /// Arguments of `tesseral mirror`.
@@ -116,11 +127,14 @@ pub struct MirrorArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn mirror(args: MirrorArgs) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.mirror(args.axis.into()))
+    octree::write(&args.output, &tree.mirror(args.axis.into()), &args.limits)
 }
 
 /// Arguments of `tesseral scale`.
@@ -135,9 +149,12 @@ pub struct ScaleArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn scale(args: ScaleArgs) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
     let k = args.by;
     let scaled = if k >= 0 {
@@ -146,7 +163,7 @@ pub fn scale(args: ScaleArgs) -> Result<()> {
         tree.scale_down(k.unsigned_abs() as u8)
     }
     .with_context(|| format!("scaling {} by 2^{k}", args.input.display()))?;
-    octree::write(&args.output, &scaled)
+    octree::write(&args.output, &scaled, &args.limits)
 }
 
 /// Arguments of `tesseral complement`.
@@ -157,9 +174,12 @@ pub struct ComplementArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 pub fn complement(args: ComplementArgs) -> Result<()> {
+    octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.complement())
+    octree::write(&args.output, &tree.complement(), &args.limits)
 }

@@ -33,7 +33,9 @@ static PENDING: Mutex<Vec<PathBuf>> = Mutex::new(Vec::new());
 fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
     // A panic while the lock was held cannot leave the list inconsistent (pushes and
     // removals are single operations), so a poisoned lock is still usable.
-    PENDING.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    PENDING
+        .lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 /// Removes every temporary file that a [`write_atomic`] in progress has created and
@@ -204,7 +206,10 @@ mod tests {
         std::os::unix::fs::symlink(&victim, &planted).unwrap();
         write_atomic(&path, |w| w.write_all(b"new")).unwrap();
         assert_eq!(fs::read(&victim).unwrap(), b"precious");
-        assert!(!fs::symlink_metadata(&path).unwrap().file_type().is_symlink());
+        assert!(!fs::symlink_metadata(&path)
+            .unwrap()
+            .file_type()
+            .is_symlink());
         assert_eq!(fs::read(&path).unwrap(), b"new");
     }
 

@@ -71,7 +71,9 @@ pub fn estimate_output_bytes(tree: &LinearOctree, ext: &str) -> Option<u64> {
             100u64.saturating_add(runs.saturating_mul(2))
         }
         "vox" => 2000u64.saturating_add(tree.voxel_count().saturating_mul(4)),
-        "stl" | "obj" | "ply" | "glb" => 200u64.saturating_add(leaves.saturating_mul(MESH_BYTES_PER_LEAF)),
+        "stl" | "obj" | "ply" | "glb" => {
+            200u64.saturating_add(leaves.saturating_mul(MESH_BYTES_PER_LEAF))
+        }
         _ => return None,
     };
     Some(bytes)
@@ -156,7 +158,9 @@ mod tests {
                 continue;
             }
             let tree = LinearOctree::from_voxels(5, origin, voxels).unwrap();
-            for ext in ["xyz", "tess", "bt", "ot", "binvox", "vox", "stl", "obj", "ply", "glb"] {
+            for ext in [
+                "xyz", "tess", "bt", "ot", "binvox", "vox", "stl", "obj", "ply", "glb",
+            ] {
                 if spread > 5 && ["binvox", "vox", "bt", "ot"].contains(&ext) {
                     // These formats hold a bounded grid: far origins are refused.
                     continue;
@@ -203,7 +207,8 @@ mod tests {
 
     #[test]
     fn huge_counts_saturate() {
-        let tree = LinearOctree::from_voxels(21, [0, 0, 0], std::iter::empty::<crate::Voxel>()).unwrap();
+        let tree =
+            LinearOctree::from_voxels(21, [0, 0, 0], std::iter::empty::<crate::Voxel>()).unwrap();
         let full = tree.complement();
         assert_eq!(full.voxel_count(), 1 << 63);
         let xyz = estimate_output_bytes(&full, "xyz").unwrap();
