@@ -311,7 +311,10 @@ fn bad_input_gives_one_line_errors_and_exit_2() {
         (vec!["convert", "cut.tess", "x.xyz"], "cut.tess"),
         (vec!["convert", "bad.obj", "x.xyz"], "bad.obj:2:7"),
         (vec!["convert", "bad.bt", "x.xyz"], "bad.bt"),
-        (vec!["convert", "a.xyz", "x.unknown"], "does not write .unknown"),
+        (
+            vec!["convert", "a.xyz", "x.unknown"],
+            "does not write .unknown",
+        ),
         (vec!["convert", "missing.binvox", "x.xyz"], "missing.binvox"),
         (
             vec!["convert", "a.xyz", "x.stl", "--depth", "40"],

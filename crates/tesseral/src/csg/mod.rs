@@ -22,6 +22,7 @@
 //! predicate. The build therefore equals a dense per-voxel evaluation, voxel for voxel,
 //! and its cost follows the surface: only cells the surface may cross are split.
 
+mod budget;
 mod compile;
 pub mod scene;
 mod shape;
