@@ -6,6 +6,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tesseral::csg::Scene;
 
+use super::budget::Budget;
 use super::octree;
 use super::output::{self, Limits};
 
@@ -22,13 +23,15 @@ pub struct Args {
     json: bool,
     #[command(flatten)]
     limits: Limits,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 pub fn run(args: Args) -> Result<()> {
     octree::guard(&args.output, &[&args.scene])?;
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
-    let tree = scene.build()?;
+    let tree = args.budget.build_scene(&args.scene, &scene)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
     let ext = tesseral::io::extension(&args.output);
     if let Some(bytes) = tesseral::io::estimate_output_bytes(&tree, &ext) {

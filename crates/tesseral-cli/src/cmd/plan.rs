@@ -5,10 +5,11 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::motion::{estimate_plan, plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
 use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
+use super::budget::Budget;
 use super::collide::parse_voxel;
 use super::output;
 
@@ -49,6 +50,8 @@ pub struct Args {
     /// The view of the picture: top, iso, front or side.
     #[arg(long, default_value = "top", value_parser = parse_view)]
     view: View,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 fn parse_view(s: &str) -> Result<View, String> {
@@ -109,6 +112,20 @@ pub fn run(args: Args) -> Result<()> {
         region: args.region,
         ..PlanOptions::default()
     };
+    // Refuse a region too large for memory before the search grows into it; a
+    // region the object cannot use at all is left to `plan` to explain.
+    if let Ok(e) = estimate_plan(&env, &obj, args.from, args.to, &options) {
+        let hint = if args.region.is_some() {
+            ", or give a smaller --region"
+        } else {
+            ", or lower --margin (or give --region)"
+        };
+        args.budget.check_memory(
+            &format!("the planning region ({} free cells)", e.free_cells),
+            e.bytes,
+            hint,
+        )?;
+    }
     let result = plan(&env, &obj, args.from, args.to, &options);
     if let Some(path) = &args.output {
         picture(

@@ -9,6 +9,7 @@ use tesseral::io;
 use tesseral::linear::LinearOctree;
 use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
 
+use super::budget::Budget;
 use super::output;
 
 /// Arguments of `tesseral render`.
@@ -78,6 +79,8 @@ pub struct Args {
     /// Print sizes and timings as JSON on stdout.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 /// The largest image side we draw.
@@ -179,7 +182,7 @@ pub fn run(args: Args) -> Result<()> {
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
         let scene = Scene::read(&args.input)?;
         let csg = scene.csg()?;
-        let tree = scene.build()?;
+        let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
         let tree = io::read_octree(&args.input)

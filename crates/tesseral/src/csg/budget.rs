@@ -18,8 +18,8 @@ impl Scene {
     /// of depth below 6 are built outright (at most 32³ voxels), so the estimate is
     /// exact there.
     ///
-    /// The estimating build stops once it passes `max_leaves / 64`; the estimate is
-    /// then above `max_leaves`, which is all a caller deciding to refuse needs. Thin
+    /// The estimating build stops once it passes `max_leaves / 64`, and the estimate
+    /// is then `u64::MAX`: more than `max_leaves`, by an amount not measured. Thin
     /// features (narrower than eight voxels) may vanish at the coarse level, so the
     /// estimate can be low by a small factor on such scenes; the real build still
     /// enforces `max_leaves` as it goes.
@@ -50,7 +50,7 @@ impl Scene {
                 Err(SceneError::Build {
                     source: CsgError::TooManyLeaves { .. },
                     ..
-                }) => Ok(max_leaves as u64 + 1),
+                }) => Ok(u64::MAX),
                 Err(e) => Err(e),
             };
         }
@@ -70,9 +70,7 @@ impl Scene {
             .map_err(wrap)?;
         match csg.build_limited(self.depth - COARSER, [0, 0, 0], coarse_cap) {
             Ok(tree) => Ok((tree.leaf_count() as u64).saturating_mul(factor)),
-            Err(CsgError::TooManyLeaves { .. }) => {
-                Ok((coarse_cap as u64 + 1).saturating_mul(factor))
-            }
+            Err(CsgError::TooManyLeaves { .. }) => Ok(u64::MAX),
             Err(e) => Err(wrap(e)),
         }
     }
@@ -144,7 +142,7 @@ mod tests {
         .unwrap();
         let real = scene.build().unwrap().leaf_count();
         let cap = real / 100;
-        assert!(scene.estimate_leaves(cap).unwrap() > cap as u64);
+        assert_eq!(scene.estimate_leaves(cap).unwrap(), u64::MAX);
         assert!(scene.build_limited(cap).is_err());
         assert_eq!(scene.build_limited(real).unwrap().leaf_count(), real);
         // A small scene is built outright: the estimate is exact.
