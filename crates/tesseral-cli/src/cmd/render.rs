@@ -190,6 +190,22 @@ pub fn run(args: Args) -> Result<()> {
         (tree, None, (1.0, [0.0; 3]))
     };
     let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
+    if let Some((axis, op, c)) = cut {
+        // A plane outside the solid keeps all of it or none of it; say which, since
+        // an empty picture alone looks like a failure.
+        let clip = Clip {
+            axis,
+            at: to_voxel(axis, c),
+            keep_above: op == '>',
+        };
+        let kept = render::crop_to_clip(&tree, clip).voxel_count();
+        let spec = args.cut.as_deref().unwrap_or_default();
+        if kept == 0 && !tree.is_empty() {
+            eprintln!("note: --cut '{spec}' keeps nothing of the solid; the picture is empty");
+        } else if kept == tree.voxel_count() && !tree.is_empty() {
+            eprintln!("note: --cut '{spec}' keeps all of the solid (the plane does not cross it)");
+        }
+    }
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let shader = csg
         .as_ref()
