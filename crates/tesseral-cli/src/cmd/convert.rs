@@ -15,6 +15,10 @@ use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPT
 use super::octree;
 use super::output::{self, Limits};
 
+/// The mesh formats read (voxelized) and written (meshed).
+const MESH_IN: [&str; 3] = ["stl", "obj", "ply"];
+const MESH_OUT: [&str; 4] = ["stl", "obj", "ply", "glb"];
+
 /// Arguments of `tesseral convert`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -46,6 +50,29 @@ pub struct Args {
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
     octree::guard(&args.output, &[&args.input])?;
+    // Flags that do not apply are errors, not silently ignored.
+    let mesh_in = MESH_IN.contains(&io::extension(&args.input).as_str());
+    let mesh_out = MESH_OUT.contains(&io::extension(&args.output).as_str());
+    if !mesh_in {
+        for (flag, given) in [
+            ("--depth", args.depth.is_some()),
+            ("--voxel-size", args.voxel_size.is_some()),
+            ("--surface-only", args.surface_only),
+        ] {
+            if given {
+                bail!(
+                    "{flag} voxelizes a mesh input (.stl, .obj, .ply); {} is not a mesh",
+                    args.input.display()
+                );
+            }
+        }
+    }
+    if args.smooth && !mesh_out {
+        bail!(
+            "--smooth shapes a mesh output (.stl, .obj, .ply, .glb); {} is not a mesh",
+            args.output.display()
+        );
+    }
     let resolution = match (args.depth, args.voxel_size) {
         (Some(d), _) => {
             if d > MAX_VOXELIZE_DEPTH {

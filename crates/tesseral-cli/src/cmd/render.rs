@@ -39,9 +39,9 @@ pub struct Args {
     /// Perspective projection instead of orthographic.
     #[arg(long)]
     perspective: bool,
-    /// Vertical field of view of the perspective camera, degrees.
-    #[arg(long, default_value_t = 40.0)]
-    fov: f64,
+    /// Vertical field of view of the perspective camera, degrees (with --perspective).
+    #[arg(long, requires = "perspective")]
+    fov: Option<f64>,
     /// Draw the outlines of the octree blocks (the decomposition).
     #[arg(long)]
     outline: bool,
@@ -59,17 +59,18 @@ pub struct Args {
     /// (scene units for a scene, voxels for an octree file) with its block outlines.
     #[arg(long)]
     slice: Option<String>,
-    /// Pixels per voxel of a slice.
-    #[arg(long, default_value_t = 4)]
-    slice_scale: usize,
+    /// Pixels per voxel of a slice (with --slice). [default: 4]
+    #[arg(long, requires = "slice", value_parser = clap::value_parser!(u16).range(1..=4096))]
+    slice_scale: Option<u16>,
     /// A contact sheet of the four named views (iso, front, top, side), 2 x 2.
     #[arg(long)]
     sheet: bool,
     /// Background colour, a name or #rrggbb.
     #[arg(long, default_value = "#fafafc")]
     background: String,
-    /// Colour of an octree file's solid (a scene's objects carry their own).
-    #[arg(long, default_value = "#96a5b9")]
+    /// Colour of an octree file's solid (a scene's objects carry their own); also
+    /// spelled --color.
+    #[arg(long, visible_alias = "color", default_value = "#96a5b9")]
     colour: String,
     /// Shading: `faces` shows the blocks' faces, `smooth` the surface's normals (a
     /// scene's own, else estimated from the octree), `auto` picks smooth where voxels
@@ -149,8 +150,26 @@ pub fn run(args: Args) -> Result<()> {
     if !(args.zoom.is_finite() && args.zoom > 0.0) {
         bail!("--zoom {}: must be a positive number", args.zoom);
     }
-    if !(args.fov > 0.0 && args.fov < 180.0) {
-        bail!("--fov {}: must lie between 0 and 180 degrees", args.fov);
+    let fov = args.fov.unwrap_or(40.0);
+    if !(fov > 0.0 && fov < 180.0) {
+        bail!("--fov {fov}: must lie between 0 and 180 degrees");
+    }
+    for (flag, value) in [("azimuth", args.azimuth), ("elevation", args.elevation)] {
+        if value.is_some_and(|v| !v.is_finite()) {
+            bail!(
+                "--{flag} {}: must be a finite number of degrees",
+                value.unwrap_or_default()
+            );
+        }
+    }
+    if args.elevation.is_some_and(|e| e.abs() > 90.0) {
+        bail!(
+            "--elevation {}: must lie between -90 and 90 degrees",
+            args.elevation.unwrap_or_default()
+        );
+    }
+    if args.sheet && (args.slice.is_some() || args.azimuth.is_some() || args.elevation.is_some()) {
+        bail!("--sheet draws the four named views: it takes no --slice, --azimuth or --elevation");
     }
     if args.ao > 256 {
         bail!("--ao {}: at most 256 rays per pixel", args.ao);
@@ -237,7 +256,7 @@ pub fn run(args: Args) -> Result<()> {
             elevation_deg: args.elevation.unwrap_or(el),
             zoom: args.zoom,
             projection: if args.perspective {
-                Projection::Perspective { fov_deg: args.fov }
+                Projection::Perspective { fov_deg: fov }
             } else {
                 Projection::Orthographic
             },
@@ -257,13 +276,12 @@ pub fn run(args: Args) -> Result<()> {
     let image = if let Some((axis, _, c)) = slice {
         let layer = to_voxel(axis, c).floor() as i64;
         let side = tree.side() as usize;
-        if side.saturating_mul(args.slice_scale.max(1)) > MAX_SIDE {
+        let scale = usize::from(args.slice_scale.unwrap_or(4));
+        if side.saturating_mul(scale) > MAX_SIDE {
             bail!(
-                "--slice: the tree is {side} voxels across; at {} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)",
-                args.slice_scale.max(1)
+                "--slice: the tree is {side} voxels across; at {scale} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)"
             );
         }
-        let scale = args.slice_scale.max(1);
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)

@@ -190,6 +190,25 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// A step rate for people: three significant figures, with k or M.
+fn rate_text(per_second: f64) -> String {
+    let (value, unit) = if per_second >= 1e6 {
+        (per_second / 1e6, "M ")
+    } else if per_second >= 1e3 {
+        (per_second / 1e3, "k ")
+    } else {
+        (per_second, "")
+    };
+    let decimals = if value >= 100.0 {
+        0
+    } else if value >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{value:.decimals$} {unit}steps/s")
+}
+
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
@@ -312,9 +331,15 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     }
     bar.set_style(
         ProgressStyle::with_template(
-            "{bar:40} {percent:>3}% {human_pos}/{human_len} steps, {per_sec}, eta {eta} {msg}",
+            "{bar:40} {percent:>3}% {human_pos}/{human_len} steps, {rate}, eta {eta} {msg}",
         )
-        .expect("valid template"),
+        .expect("valid template")
+        .with_key(
+            "rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = w.write_str(&rate_text(state.per_sec()));
+            },
+        ),
     );
     let save = |chain: &mut Chain<L>, rows: &[Row], base: (u64, u64)| -> Result<()> {
         let cp = CliCheckpoint {
@@ -432,4 +457,18 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate_text;
+
+    #[test]
+    fn rates_read_well() {
+        assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
+        assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
+        assert_eq!(rate_text(999.4), "999 steps/s");
+        assert_eq!(rate_text(3.14159), "3.14 steps/s");
+        assert_eq!(rate_text(0.0), "0.00 steps/s");
+    }
 }

@@ -65,6 +65,15 @@ fn name(b: &Body) -> String {
     }
 }
 
+/// `1 object`, `2 objects`.
+fn plural(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 fn parse_view(s: &str) -> Result<View, String> {
     View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
 }
@@ -138,11 +147,11 @@ pub fn run(args: Args) -> Result<()> {
         }
         writeln!(
             out,
-            "{} contacts in {} steps of {} ({} objects)",
-            contacts.len(),
-            wf.steps,
+            "{} in {} of {} ({})",
+            plural(contacts.len() as u64, "contact"),
+            plural(wf.steps, "step"),
             wf.time_step,
-            world.objects.len()
+            plural(world.objects.len() as u64, "object")
         )?;
     }
     Ok(())
