@@ -24,8 +24,13 @@ const MESH_OUT: [&str; 4] = ["stl", "obj", "ply", "glb"];
 pub struct Args {
     /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply.
     pub input: PathBuf,
-    /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply, .glb.
-    pub output: PathBuf,
+    /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj,
+    /// .ply, .glb (or give it with -o).
+    #[arg(value_name = "OUTPUT", required_unless_present = "output")]
+    pub output_positional: Option<PathBuf>,
+    /// The output file, as the second argument.
+    #[arg(short, long, conflicts_with = "output_positional")]
+    pub output: Option<PathBuf>,
     /// Voxelize an input mesh with 2^DEPTH voxels along its longest side (default 8).
     #[arg(long, conflicts_with = "voxel_size")]
     pub depth: Option<u8>,
@@ -48,11 +53,14 @@ pub struct Args {
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+pub fn run(mut args: Args) -> Result<()> {
+    let Some(out) = args.output.take().or(args.output_positional.take()) else {
+        bail!("convert: give the output file, as `convert IN OUT` or `convert IN -o OUT`");
+    };
+    octree::guard(&out, &[&args.input])?;
     // Flags that do not apply are errors, not silently ignored.
     let mesh_in = MESH_IN.contains(&io::extension(&args.input).as_str());
-    let mesh_out = MESH_OUT.contains(&io::extension(&args.output).as_str());
+    let mesh_out = MESH_OUT.contains(&io::extension(&out).as_str());
     if !mesh_in {
         for (flag, given) in [
             ("--depth", args.depth.is_some()),
@@ -70,7 +78,7 @@ pub fn run(args: Args) -> Result<()> {
     if args.smooth && !mesh_out {
         bail!(
             "--smooth shapes a mesh output (.stl, .obj, .ply, .glb); {} is not a mesh",
-            args.output.display()
+            out.display()
         );
     }
     let resolution = match (args.depth, args.voxel_size) {
@@ -100,15 +108,15 @@ pub fn run(args: Args) -> Result<()> {
         },
     };
     let model = io::read_model_with(&args.input, &read).map_err(|e| anyhow::anyhow!("{e}"))?;
-    if let Some(bytes) = io::estimate_output_bytes(&model.tree, &io::extension(&args.output)) {
-        output::check_size(&args.output, bytes, args.limits.max_output)?;
+    if let Some(bytes) = io::estimate_output_bytes(&model.tree, &io::extension(&out)) {
+        output::check_size(&out, bytes, args.limits.max_output)?;
     }
-    io::write_model_with(&args.output, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
+    io::write_model_with(&out, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
     if args.json {
         let bbox = model.tree.bbox();
         let summary = serde_json::json!({
             "input": args.input,
-            "output": args.output,
+            "output": out,
             "voxels": model.tree.voxel_count(),
             "leaves": model.tree.leaf_count(),
             "depth": model.tree.depth(),

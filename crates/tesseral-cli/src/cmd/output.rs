@@ -104,6 +104,40 @@ pub fn octree_formats() -> Vec<&'static str> {
     tesseral::io::KNOWN_WRITE_EXTENSIONS.split(", ").collect()
 }
 
+/// The largest image side any command draws.
+pub const MAX_SIDE: usize = 8192;
+/// The most pixels in one picture (a contact sheet has four).
+pub const MAX_PIXELS: usize = 16 << 20;
+
+/// An image size on the command line, `WIDTHxHEIGHT` (`--size` everywhere).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Size {
+    /// Pixels across.
+    pub width: usize,
+    /// Pixels down.
+    pub height: usize,
+}
+
+/// Parses `WIDTHxHEIGHT` (each side 1 to [`MAX_SIDE`], at most [`MAX_PIXELS`]).
+pub fn parse_size(s: &str) -> Result<Size, String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("`{s}`: expected WIDTHxHEIGHT, e.g. 800x600"))?;
+    let side = |t: &str, what: &str| -> Result<usize, String> {
+        t.trim()
+            .parse()
+            .map_err(|_| format!("`{s}`: the {what} `{t}` is not a whole number"))
+    };
+    let (width, height) = (side(w, "width")?, side(h, "height")?);
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(format!("`{s}`: each side must be from 1 to {MAX_SIDE}"));
+    }
+    if width * height > MAX_PIXELS {
+        return Err(format!("`{s}`: more than {MAX_PIXELS} pixels"));
+    }
+    Ok(Size { width, height })
+}
+
 /// Where an output goes, for the checks: `-` is standard output.
 pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
@@ -235,6 +269,36 @@ mod tests {
         assert!(parse_bytes("nanG").is_err());
         assert!(parse_bytes("4X").is_err());
         assert!(parse_bytes("99999999999T").is_err());
+    }
+
+    #[test]
+    fn image_sizes() {
+        assert_eq!(
+            parse_size("800x600"),
+            Ok(Size {
+                width: 800,
+                height: 600
+            })
+        );
+        assert_eq!(
+            parse_size("16X9"),
+            Ok(Size {
+                width: 16,
+                height: 9
+            })
+        );
+        for bad in [
+            "800",
+            "0x10",
+            "10x0",
+            "x",
+            "8193x10",
+            "-1x5",
+            "4096x4097",
+            "axb",
+        ] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
     }
 
     #[test]

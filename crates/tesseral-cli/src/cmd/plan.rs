@@ -11,7 +11,7 @@ use tesseral::Voxel;
 
 use super::budget::Budget;
 use super::collide::parse_voxel;
-use super::output;
+use super::output::{self, Size};
 
 /// Arguments of `tesseral plan`.
 #[derive(clap::Args)]
@@ -50,6 +50,9 @@ pub struct Args {
     /// The view of the picture: top, iso, front or side.
     #[arg(long, default_value = "top", value_parser = parse_view)]
     view: View,
+    /// The picture's size, WIDTHxHEIGHT (with --output). [default: 800x600]
+    #[arg(long, requires = "output", value_parser = output::parse_size)]
+    size: Option<Size>,
     #[command(flatten)]
     budget: Budget,
 }
@@ -197,7 +200,13 @@ fn picture(
     args: &Args,
     waypoints: Option<&[Voxel]>,
 ) -> Result<()> {
+    let size = args.size.unwrap_or(Size {
+        width: 800,
+        height: 600,
+    });
     let opts = RenderOptions {
+        width: size.width,
+        height: size.height,
         camera: Camera::view(args.view),
         ..RenderOptions::default()
     };

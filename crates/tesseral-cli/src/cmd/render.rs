@@ -10,7 +10,7 @@ use tesseral::linear::LinearOctree;
 use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
 
 use super::budget::Budget;
-use super::output;
+use super::output::{self, Size, MAX_SIDE};
 
 /// Arguments of `tesseral render`.
 #[derive(clap::Args)]
@@ -22,8 +22,8 @@ pub struct Args {
     #[arg(short, long)]
     output: PathBuf,
     /// Image size, WIDTHxHEIGHT (for a contact sheet: of each view).
-    #[arg(long, default_value = "800x600")]
-    size: String,
+    #[arg(long, default_value = "800x600", value_parser = output::parse_size)]
+    size: Size,
     /// A named view: iso, front, top or side.
     #[arg(long, default_value = "iso")]
     view: String,
@@ -84,32 +84,6 @@ pub struct Args {
     budget: Budget,
 }
 
-/// The largest image side we draw.
-const MAX_SIDE: usize = 8192;
-/// The most pixels in one view (a contact sheet has four).
-const MAX_PIXELS: usize = 16 << 20;
-
-fn parse_size(s: &str) -> Result<(usize, usize)> {
-    let (w, h) = s
-        .split_once('x')
-        .with_context(|| format!("--size {s:?}: expected WIDTHxHEIGHT, e.g. 800x600"))?;
-    let w: usize = w
-        .trim()
-        .parse()
-        .with_context(|| format!("--size {s:?}: bad width"))?;
-    let h: usize = h
-        .trim()
-        .parse()
-        .with_context(|| format!("--size {s:?}: bad height"))?;
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        bail!("--size {s:?}: each side must be from 1 to {MAX_SIDE}");
-    }
-    if w * h > MAX_PIXELS {
-        bail!("--size {s:?}: more than {MAX_PIXELS} pixels");
-    }
-    Ok((w, h))
-}
-
 /// Parses `x<C`, `x>C` or `x=C`: the axis, the comparison and the value.
 fn parse_plane(flag: &str, s: &str) -> Result<(usize, char, f64)> {
     let mut chars = s.trim().chars();
@@ -144,7 +118,7 @@ fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
 
 pub fn run(args: Args) -> Result<()> {
     output::guard("--output", &args.output, &["png"], &[&args.input])?;
-    let (width, height) = parse_size(&args.size)?;
+    let Size { width, height } = args.size;
     let view = View::parse(&args.view)
         .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
     if !(args.zoom.is_finite() && args.zoom > 0.0) {

@@ -42,8 +42,9 @@ pub struct Args {
     /// Lattice implementation.
     #[arg(long, value_enum, default_value_t = Backend::Octree)]
     backend: Backend,
-    /// Folder for series.csv, area.png, the mesh and checkpoint.json.
-    #[arg(long, default_value = "rsmc-out")]
+    /// Folder for series.csv, area.png, the mesh and checkpoint.json (also spelled
+    /// --out).
+    #[arg(short = 'o', long = "output", alias = "out", default_value = "rsmc-out")]
     out: PathBuf,
     /// Steps between rows of series.csv.
     #[arg(long, default_value_t = 1000)]
@@ -61,8 +62,15 @@ pub struct Args {
     mesh: MeshFormat,
     /// Width in pixels of surface.png, the rendered final surface (height 3/4 of it);
     /// 0: no picture.
-    #[arg(long, default_value_t = 800)]
-    render_width: usize,
+    #[arg(long, hide = true, conflicts_with_all = ["size", "no_picture"])]
+    render_width: Option<usize>,
+    /// The size of surface.png, the rendered final surface, WIDTHxHEIGHT.
+    /// [default: 800x600]
+    #[arg(long, value_parser = super::output::parse_size, conflicts_with = "no_picture")]
+    size: Option<super::output::Size>,
+    /// Draw no surface.png.
+    #[arg(long)]
+    no_picture: bool,
     /// Continue the run saved in OUT/checkpoint.json.
     #[arg(long)]
     resume: bool,
@@ -209,14 +217,32 @@ fn rate_text(per_second: f64) -> String {
     format!("{value:.decimals$} {unit}steps/s")
 }
 
+/// The size of surface.png: --size, or the older --render-width W (W × 3W/4; 0:
+/// none); `None` draws no picture.
+fn picture_size(args: &Args) -> Option<super::output::Size> {
+    match (args.no_picture, args.size, args.render_width) {
+        (true, _, _) | (_, _, Some(0)) => None,
+        (_, Some(size), _) => Some(size),
+        (_, None, Some(w)) => Some(super::output::Size {
+            width: w,
+            height: w * 3 / 4,
+        }),
+        (_, None, None) => Some(super::output::Size {
+            width: 800,
+            height: 600,
+        }),
+    }
+}
+
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
-    ensure!(
-        args.render_width == 0 || (16..=8192).contains(&args.render_width),
-        "--render-width {} is outside 16..=8192 (or 0 for no picture)",
-        args.render_width
-    );
+    if let Some(w) = args.render_width {
+        ensure!(
+            w == 0 || (16..=8192).contains(&w),
+            "--render-width {w} is outside 16..=8192 (or 0 for no picture)"
+        );
+    }
     ensure!(
         args.steps / args.sample_every <= MAX_ROWS,
         "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
@@ -405,12 +431,12 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         MeshFormat::Obj => mesh::write_obj(&faces, w),
         MeshFormat::Ply => mesh::write_ply(&faces, w),
     })?;
-    if args.render_width > 0 {
+    if let Some(size) = picture_size(&args) {
         let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
             .context("building the octree to render")?;
         let opts = RenderOptions {
-            width: args.render_width,
-            height: args.render_width * 3 / 4,
+            width: size.width,
+            height: size.height,
             ao_samples: 4,
             ..RenderOptions::default()
         };
