@@ -12,6 +12,7 @@ use anyhow::{bail, Result};
 use tesseral::io::{self, ReadOptions, WriteOptions};
 use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
+use super::budget::Budget;
 use super::octree;
 use super::output::{self, Limits};
 
@@ -22,7 +23,8 @@ const MESH_OUT: [&str; 4] = ["stl", "obj", "ply", "glb"];
 /// Arguments of `tesseral convert`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply.
+    /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, a mesh .stl, .obj, .ply,
+    /// or a .tss scene (built as `build` does).
     pub input: PathBuf,
     /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj,
     /// .ply, .glb (or give it with -o).
@@ -50,6 +52,8 @@ pub struct Args {
     pub json: bool,
     #[command(flatten)]
     pub limits: Limits,
+    #[command(flatten)]
+    pub budget: Budget,
 }
 
 /// Runs the command.
@@ -107,7 +111,7 @@ pub fn run(mut args: Args) -> Result<()> {
             smooth: args.smooth,
         },
     };
-    let model = io::read_model_with(&args.input, &read).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let model = octree::read_model(&args.input, &args.budget, &read)?;
     if let Some(bytes) = io::estimate_output_bytes(&model.tree, &io::extension(&out)) {
         output::check_size(&out, bytes, args.limits.max_output)?;
     }

@@ -5,17 +5,21 @@ use std::path::PathBuf;
 use anyhow::Result;
 use serde::Serialize;
 
+use super::budget::Budget;
 use super::octree;
 
 /// Arguments of `tesseral info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The octree file; its format is chosen by the extension.
+    /// The octree file (its format is chosen by the extension), or a .tss scene,
+    /// which is built.
     file: PathBuf,
     /// Print JSON (keys: voxels, leaves, depth, origin, bbox_min, bbox_max,
     /// leaves_by_depth, bytes).
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 /// The `--json` output. Its keys are a public interface: only ever add to them.
@@ -40,7 +44,7 @@ struct Info {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let tree = octree::read(&args.file)?;
+    let tree = octree::read_model(&args.file, &args.budget, &Default::default())?.tree;
     let bbox = tree.bbox();
     let info = Info {
         voxels: tree.voxel_count(),

@@ -6,7 +6,29 @@ use std::path::Path;
 use anyhow::Result;
 use tesseral::linear::{Axis, LinearOctree};
 
+use super::budget::Budget;
 use super::output::{self, Limits};
+
+/// Reads a model: a `.tss` scene is built within `budget` (its frame is the scene's
+/// voxel size and lower corner), any other file is read in the format its extension
+/// names.
+pub fn read_model(
+    path: &Path,
+    budget: &Budget,
+    options: &tesseral::io::ReadOptions,
+) -> Result<tesseral::io::VoxelModel> {
+    if tesseral::io::extension(path) == "tss" {
+        let scene = tesseral::csg::Scene::read(path)?;
+        let tree = budget.build_scene(path, &scene)?;
+        let mut model = tesseral::io::VoxelModel::new(tree);
+        model.frame = Some(tesseral::io::Frame {
+            voxel_size: scene.voxel,
+            translate: scene.bounds_min,
+        });
+        return Ok(model);
+    }
+    tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))
+}
 
 /// Reads an octree, in any format `tesseral::io` knows by the extension.
 pub fn read(path: &Path) -> Result<LinearOctree> {
