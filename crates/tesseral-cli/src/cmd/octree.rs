@@ -42,15 +42,42 @@ pub fn guard(output: &Path, inputs: &[&Path]) -> Result<()> {
     output::guard("--output", output, &output::octree_formats(), inputs)
 }
 
-/// Writes an octree atomically, in the format named by the extension, and prints a
-/// one-line summary. Refuses, before writing, an output estimated above
+/// How a command that writes an octree reports: a line of text, or with `--json` an
+/// object with the keys `output`, `voxels`, `leaves`, `depth`, `origin`, `bbox_min`,
+/// `bbox_max` (null when empty), plus the command's own keys in `extra`.
+pub struct Report {
+    /// Print JSON instead of text.
+    pub json: bool,
+    /// The command's own keys (a JSON object), added to the JSON output.
+    pub extra: serde_json::Value,
+}
+
+/// Writes an octree atomically, in the format named by the extension, and reports it
+/// (see [`Report`]). Refuses, before writing, an output estimated above
 /// `--max-output`.
-pub fn write(path: &Path, tree: &LinearOctree, limits: &Limits) -> Result<()> {
+pub fn write(path: &Path, tree: &LinearOctree, limits: &Limits, report: Report) -> Result<()> {
     let ext = tesseral::io::extension(path);
     if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
         output::check_size(path, bytes, limits.max_output)?;
     }
     tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if report.json {
+        let bbox = tree.bbox();
+        let mut v = serde_json::json!({
+            "output": path,
+            "voxels": tree.voxel_count(),
+            "leaves": tree.leaf_count(),
+            "depth": tree.depth(),
+            "origin": tree.origin(),
+            "bbox_min": bbox.map(|b| b.0),
+            "bbox_max": bbox.map(|b| b.1),
+        });
+        if let (Some(map), serde_json::Value::Object(extra)) = (v.as_object_mut(), report.extra) {
+            map.extend(extra);
+        }
+        crate::outln!("{v}")?;
+        return Ok(());
+    }
     crate::outln!(
         "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
         path.display(),

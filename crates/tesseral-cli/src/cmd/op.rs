@@ -34,6 +34,9 @@ pub struct Args {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, op.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
 }
@@ -51,5 +54,15 @@ pub fn run(args: Args) -> Result<()> {
     let r = a
         .set_op(&b, op)
         .with_context(|| format!("combining {} and {}", args.a.display(), args.b.display()))?;
-    octree::write(&args.output, &r, &args.limits)
+    let name = match args.op {
+        OpArg::Union => "union",
+        OpArg::Intersection => "intersection",
+        OpArg::Difference => "difference",
+        OpArg::Xor => "xor",
+    };
+    let report = octree::Report {
+        json: args.json,
+        extra: serde_json::json!({ "op": name }),
+    };
+    octree::write(&args.output, &r, &args.limits, report)
 }

@@ -44,7 +44,12 @@ pub struct Args {
     backend: Backend,
     /// Folder for series.csv, area.png, the mesh and checkpoint.json (also spelled
     /// --out).
-    #[arg(short = 'o', long = "output", alias = "out", default_value = "rsmc-out")]
+    #[arg(
+        short = 'o',
+        long = "output",
+        alias = "out",
+        default_value = "rsmc-out"
+    )]
     out: PathBuf,
     /// Steps between rows of series.csv.
     #[arg(long, default_value_t = 1000)]

@@ -31,6 +31,9 @@ pub struct TranslateArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, by, method, dropped (with --clip), nodes_visited and root_expansions (with --method labels).
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
     /// The algorithm.
@@ -46,6 +49,13 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
     let by = args.by;
+    let mut extra = serde_json::json!({
+        "by": by,
+        "method": match args.method {
+            Method::Linear => "linear",
+            Method::Labels => "labels",
+        },
+    });
     let moved = match (args.method, args.clip) {
         (Method::Linear, false) => tree.translate(by).with_context(|| {
             format!(
@@ -58,7 +68,11 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             let (moved, dropped) = tree
                 .translate_clipped(by)
                 .with_context(|| format!("translating {}", args.input.display()))?;
-            crate::outln!("clipped: {dropped} voxels left the space and were dropped")?;
+            if args.json {
+                extra["dropped"] = dropped.into();
+            } else {
+                crate::outln!("clipped: {dropped} voxels left the space and were dropped")?;
+            }
             moved
         }
         (Method::Labels, true) => {
@@ -69,23 +83,31 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             let stats = p
                 .translate(by)
                 .with_context(|| format!("translating {}", args.input.display()))?;
+            extra["nodes_visited"] = stats.nodes_visited().into();
+            extra["root_expansions"] = stats.root_expansions.into();
             for (name, s) in ["x", "y", "z"].iter().zip(stats.axes.iter()) {
-                if s.displacement != 0 {
+                if s.displacement != 0 && !args.json {
                     crate::outln!(
                         "axis {name}: by {}, nodes of side 2^{} moved: {}, traversed {}, path steps {}, compaction {}, split {}",
                         s.displacement, s.moved_size_log2, s.moved, s.traversed, s.path_steps, s.compacted, s.split_created
                     )?;
                 }
             }
-            crate::outln!(
-                "nodes visited: {} (root expansions: {})",
-                stats.nodes_visited(),
-                stats.root_expansions
-            )?;
+            if !args.json {
+                crate::outln!(
+                    "nodes visited: {} (root expansions: {})",
+                    stats.nodes_visited(),
+                    stats.root_expansions
+                )?;
+            }
             p.to_linear()
         }
     };
-    octree::write(&args.output, &moved, &args.limits)
+    let report = octree::Report {
+        json: args.json,
+        extra,
+    };
+    octree::write(&args.output, &moved, &args.limits, report)
 }
 
 /// Arguments of `tesseral rotate`.
@@ -102,6 +124,9 @@ pub struct RotateArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis, turns.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
 }
@@ -113,6 +138,10 @@ pub fn rotate(args: RotateArgs) -> Result<()> {
         &args.output,
         &tree.rotate(args.axis.into(), args.turns),
         &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "axis": axis_name(args.axis), "turns": args.turns }),
+        },
     )
 }
 
@@ -127,6 +156,9 @@ pub struct MirrorArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
 }
@@ -134,7 +166,15 @@ pub struct MirrorArgs {
 pub fn mirror(args: MirrorArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.mirror(args.axis.into()), &args.limits)
+    octree::write(
+        &args.output,
+        &tree.mirror(args.axis.into()),
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "axis": axis_name(args.axis) }),
+        },
+    )
 }
 
 /// Arguments of `tesseral scale`.
@@ -149,6 +189,9 @@ pub struct ScaleArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, scale_log2.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
 }
@@ -163,7 +206,15 @@ pub fn scale(args: ScaleArgs) -> Result<()> {
         tree.scale_down(k.unsigned_abs() as u8)
     }
     .with_context(|| format!("scaling {} by 2^{k}", args.input.display()))?;
-    octree::write(&args.output, &scaled, &args.limits)
+    octree::write(
+        &args.output,
+        &scaled,
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "scale_log2": k }),
+        },
+    )
 }
 
 /// Arguments of `tesseral complement`.
@@ -174,6 +225,9 @@ pub struct ComplementArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max.
+    #[arg(long)]
+    json: bool,
     #[command(flatten)]
     limits: Limits,
 }
@@ -181,5 +235,22 @@ pub struct ComplementArgs {
 pub fn complement(args: ComplementArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input])?;
     let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.complement(), &args.limits)
+    octree::write(
+        &args.output,
+        &tree.complement(),
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({}),
+        },
+    )
+}
+
+/// The axis's name in JSON output.
+fn axis_name(a: AxisArg) -> &'static str {
+    match a {
+        AxisArg::X => "x",
+        AxisArg::Y => "y",
+        AxisArg::Z => "z",
+    }
 }
