@@ -55,6 +55,7 @@ enum Command {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    cmd::output::install_signal_handler();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Replay(args) => cmd::replay::run(args),
@@ -105,8 +106,12 @@ fn one_line(err: &anyhow::Error) -> String {
 
 /// A reader that closed our stdout early (`tesseral ... | head`) is not an error.
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    use std::io::ErrorKind::BrokenPipe;
     err.chain().any(|e| {
         e.downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            .is_some_and(|io| io.kind() == BrokenPipe)
+            // serde_json wraps the writer's error in its own type.
+            || e.downcast_ref::<serde_json::Error>()
+                .is_some_and(|j| j.io_error_kind() == Some(BrokenPipe))
     })
 }

@@ -6,6 +6,10 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tesseral::csg::Scene;
 
+use super::budget::Budget;
+use super::octree;
+use super::output::{self, Limits};
+
 /// Arguments of `tesseral build`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,14 +21,24 @@ pub struct Args {
     /// Print the size and timing as JSON on stdout.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    limits: Limits,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.scene])?;
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
-    let tree = scene.build()?;
+    let model = args.budget.build_scene_model(&args.scene)?;
+    let tree = &model.tree;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    tesseral::io::write_octree(&args.output, &tree)
+    let ext = tesseral::io::extension(&args.output);
+    if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
+        output::check_size(&args.output, bytes, args.limits.max_output)?;
+    }
+    tesseral::io::write_model(&args.output, &model)
         .with_context(|| format!("writing {}", args.output.display()))?;
     if args.json {
         let out = serde_json::json!({
@@ -38,8 +52,9 @@ pub fn run(args: Args) -> Result<()> {
             "voxels": tree.voxel_count(),
             "leaves_by_depth": tree.leaves_by_depth(),
             "build_ms": build_ms,
+            "colors": model.colors.as_ref().map(|c| c.region_count()),
         });
-        println!("{out}");
+        crate::outln!("{out}")?;
     }
     Ok(())
 }

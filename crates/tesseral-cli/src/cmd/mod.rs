@@ -1,5 +1,6 @@
 //! One module per subcommand. Each has an `Args` (clap derive) and a `run`.
 
+pub mod budget;
 pub mod build;
 pub mod calc;
 pub mod collide;
@@ -7,6 +8,7 @@ pub mod convert;
 pub mod info;
 pub mod octree;
 pub mod op;
+pub mod output;
 pub mod plan;
 pub mod render;
 pub mod replay;

@@ -4,39 +4,91 @@
 use std::path::Path;
 
 use anyhow::Result;
-use tesseral::linear::{Axis, LinearOctree};
+use tesseral::linear::Axis;
+use tesseral::model::Model;
 
-/// Reads an octree, in any format `tesseral::io` knows by the extension.
-pub fn read(path: &Path) -> Result<LinearOctree> {
+use super::budget::Budget;
+use super::output::{self, Limits};
+
+/// Reads a model: a `.tss` scene is built within `budget` with its frame (the
+/// scene's voxel size and lower corner) and its objects' colours; any other file is
+/// read in the format its extension names, with what the format carries.
+pub fn read_model(
+    path: &Path,
+    budget: &Budget,
+    options: &tesseral::io::ReadOptions,
+) -> Result<Model> {
+    if tesseral::io::extension(path) == "tss" {
+        return budget.build_scene_model(path);
+    }
     // The library's message already names the file and its cause; keep it as one
     // line rather than repeating the cause from the error chain.
-    tesseral::io::read_octree(path).map_err(|e| anyhow::anyhow!("{e}"))
+    tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// The most voxels a command writes as a voxel list (`.xyz` holds one line per
-/// voxel, so a scaled-up or complemented solid could otherwise fill the disk).
-pub const MAX_LISTED_VOXELS: u64 = 1 << 27;
+/// Reads a model from an octree file (any format `tesseral::io` knows by the
+/// extension) or a `.tss` scene, with the default budget.
+pub fn read(path: &Path) -> Result<Model> {
+    read_model(path, &Budget::default(), &Default::default())
+}
 
-/// Writes an octree atomically, in the format named by the extension, and prints a
-/// one-line summary.
-pub fn write(path: &Path, tree: &LinearOctree) -> Result<()> {
-    if tesseral::io::extension(path) == "xyz" && tree.voxel_count() > MAX_LISTED_VOXELS {
-        anyhow::bail!(
-            "{}: {} voxels is too many for a voxel list (at most {MAX_LISTED_VOXELS}); \
-             write a block-based format instead",
-            path.display(),
-            tree.voxel_count()
-        );
+/// Checks an octree output before any work: a format we write, and not an input.
+pub fn guard(output: &Path, inputs: &[&Path]) -> Result<()> {
+    output::guard("--output", output, &output::octree_formats(), inputs)
+}
+
+/// How a command that writes an octree reports: a line of text, or with `--json` an
+/// object with the keys `output`, `voxels`, `leaves`, `depth`, `origin`, `bbox_min`,
+/// `bbox_max` (null when empty), plus the command's own keys in `extra`.
+pub struct Report {
+    /// Print JSON instead of text.
+    pub json: bool,
+    /// The command's own keys (a JSON object), added to the JSON output.
+    pub extra: serde_json::Value,
+}
+
+/// Writes a model atomically, in the format named by the extension, and reports it
+/// (see [`Report`]; JSON also has `voxel_size` and `translate`, the frame). Refuses,
+/// before writing, an output estimated above `--max-output`.
+pub fn write(path: &Path, model: &Model, limits: &Limits, report: Report) -> Result<()> {
+    let tree = &model.tree;
+    let ext = tesseral::io::extension(path);
+    if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
+        output::check_size(path, bytes, limits.max_output)?;
     }
-    tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
-    println!(
-        "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
+    tesseral::io::write_model(path, model).map_err(|e| anyhow::anyhow!("{e}"))?;
+    if report.json {
+        let bbox = tree.bbox();
+        let mut v = serde_json::json!({
+            "output": path,
+            "voxels": tree.voxel_count(),
+            "leaves": tree.leaf_count(),
+            "depth": tree.depth(),
+            "origin": tree.origin(),
+            "bbox_min": bbox.map(|b| b.0),
+            "bbox_max": bbox.map(|b| b.1),
+            "voxel_size": model.frame.voxel_size,
+            "translate": model.frame.translate,
+        });
+        if let (Some(map), serde_json::Value::Object(extra)) = (v.as_object_mut(), report.extra) {
+            map.extend(extra);
+        }
+        crate::outln!("{v}")?;
+        return Ok(());
+    }
+    let frame = if model.frame.is_unit() {
+        String::new()
+    } else {
+        format!(", {}", model.frame)
+    };
+    crate::outln!(
+        "wrote {}: {} voxels, {} leaves, depth {}, origin {}{frame}",
         path.display(),
         tree.voxel_count(),
         tree.leaf_count(),
         tree.depth(),
         fmt_voxel(tree.origin())
-    );
+    )?;
     Ok(())
 }
 

@@ -69,7 +69,6 @@ impl<'a> Reader<'a> {
     }
 }
 
-
 /// Appends the leaves as varints: the first packed leaf, then each one's difference
 /// from the one before.
 pub(crate) fn put_leaves(out: &mut Vec<u8>, leaves: &[Leaf]) {
@@ -92,7 +91,9 @@ pub(crate) fn read_leaves(
     let remaining = (r.bytes.len() - r.pos) as u64;
     // Every leaf takes at least one byte, so the bytes left bound the count.
     if count > remaining {
-        return Err(format!("{what} count {count} cannot fit in {remaining} bytes"));
+        return Err(format!(
+            "{what} count {count} cannot fit in {remaining} bytes"
+        ));
     }
     let space_end = 1u64 << (3 * u32::from(depth));
     let mut leaves = Vec::with_capacity(count as usize);
@@ -112,11 +113,15 @@ pub(crate) fn read_leaves(
             return Err(format!("{what} {index}: invalid packed leaf {packed:#x}"));
         }
         if leaf.end() > space_end {
-            return Err(format!("{what} {index}: lies outside the depth-{depth} space"));
+            return Err(format!(
+                "{what} {index}: lies outside the depth-{depth} space"
+            ));
         }
         if let Some(p) = prev {
             if p.end() > leaf.code() {
-                return Err(format!("{what} {index}: overlaps or precedes the leaf before it"));
+                return Err(format!(
+                    "{what} {index}: overlaps or precedes the leaf before it"
+                ));
             }
         }
         prev = Some(leaf);

@@ -18,7 +18,9 @@
 //! | `.stl`, `.obj`, `.ply` | meshes, voxelized on read, meshed on write | [`crate::mesh`] |
 //! | `.glb` | glTF binary mesh (write only) | [`crate::mesh`] |
 
+mod atomic;
 pub mod binvox;
+mod estimate;
 mod leafstream;
 pub mod native;
 pub mod octomap;
@@ -26,10 +28,12 @@ mod reframe;
 pub mod vox;
 pub mod xyz;
 
+pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
+pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
 
 use std::fs;
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 use crate::linear::{LinearOctree, OctreeError};
@@ -254,36 +258,6 @@ pub fn extension(path: &Path) -> String {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase()
-}
-
-/// Writes a file through `body` to a temporary name beside `path`, then renames it
-/// into place. On any error the temporary file is removed and `path` is untouched.
-///
-/// # Errors
-/// [`FormatError::Io`] naming `path`.
-pub fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
-) -> Result<(), FormatError> {
-    let wrap = |source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    };
-    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = (|| {
-        let mut w = BufWriter::new(fs::File::create(&tmp)?);
-        body(&mut w)?;
-        w.into_inner()
-            .map_err(io::IntoInnerError::into_error)?
-            .sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result.map_err(wrap)
 }
 
 /// Reads a whole file, refusing files larger than `limit` bytes.

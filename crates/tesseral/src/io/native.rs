@@ -284,12 +284,16 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
             let rgba = tail.take(4).map_err(&bad)?;
             pairs.push((tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]));
         }
-        colors = Some(Layer::from_voxels(depth, origin, pairs).map_err(|e| FormatError::octree(path, e))?);
+        colors = Some(
+            Layer::from_voxels(depth, origin, pairs).map_err(|e| FormatError::octree(path, e))?,
+        );
     }
     if flags & FLAG_COLOR_LAYER != 0 {
         colors = Some(
-            read_layer(&mut tail, depth, origin, "colour", |b| [b[0], b[1], b[2], b[3]])
-                .map_err(&bad)?,
+            read_layer(&mut tail, depth, origin, "colour", |b| {
+                [b[0], b[1], b[2], b[3]]
+            })
+            .map_err(&bad)?,
         );
     }
     let free = if flags & FLAG_FREE != 0 {
@@ -329,7 +333,11 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
 fn check_parts(m: &Model) -> Result<(), String> {
     use crate::linear::SetOp;
     if let Some(c) = &m.colors {
-        if !c.domain().set_op_same_space(&m.tree, SetOp::Difference).is_empty() {
+        if !c
+            .domain()
+            .set_op_same_space(&m.tree, SetOp::Difference)
+            .is_empty()
+        {
             return Err("colour section: colours on voxels that are not black".into());
         }
     }
@@ -339,7 +347,11 @@ fn check_parts(m: &Model) -> Result<(), String> {
         }
     }
     if let Some(l) = &m.log_odds {
-        if !l.domain().set_op_same_space(&m.known(), SetOp::Difference).is_empty() {
+        if !l
+            .domain()
+            .set_op_same_space(&m.known(), SetOp::Difference)
+            .is_empty()
+        {
             return Err("log-odds section: values on unknown voxels".into());
         }
     }
@@ -359,7 +371,12 @@ fn put_layer<T: LayerValue>(out: &mut Vec<u8>, layer: &Layer<T>, bytes: impl Fn(
     }
 }
 
-fn read_stream(r: &mut Reader<'_>, depth: u8, origin: crate::Voxel, what: &str) -> Result<LinearOctree, String> {
+fn read_stream(
+    r: &mut Reader<'_>,
+    depth: u8,
+    origin: crate::Voxel,
+    what: &str,
+) -> Result<LinearOctree, String> {
     let count = r.u64()?;
     let leaves = read_leaves(r, count, depth, what)?;
     LinearOctree::from_sorted_leaves(depth, origin, leaves).map_err(|e| format!("{what}: {e}"))
@@ -376,7 +393,9 @@ fn read_layer<T: LayerValue>(
     let remaining = (r.bytes.len() - r.pos) as u64;
     // A region takes at least 4 + 8 bytes.
     if count > remaining / 12 {
-        return Err(format!("{what} region count {count} cannot fit in {remaining} bytes"));
+        return Err(format!(
+            "{what} region count {count} cannot fit in {remaining} bytes"
+        ));
     }
     let mut regions = Vec::with_capacity(count as usize);
     let mut keys = std::collections::HashSet::new();
@@ -385,7 +404,10 @@ fn read_layer<T: LayerValue>(
         if !keys.insert(x.key()) {
             return Err(format!("{what} region {i}: repeats a value"));
         }
-        regions.push((x, read_stream(r, depth, origin, &format!("{what} region {i} leaf"))?));
+        regions.push((
+            x,
+            read_stream(r, depth, origin, &format!("{what} region {i} leaf"))?,
+        ));
     }
     let layer = Layer::from_regions(depth, origin, regions).map_err(|e| e.to_string())?;
     let total: u64 = layer.regions().iter().map(|(_, t)| t.voxel_count()).sum();
@@ -425,7 +447,10 @@ mod tests {
     fn round_trips_random_trees_with_frame_and_colours() {
         for seed in 0..200 {
             let tree = random_tree(seed);
-            let pairs = tree.voxels().step_by(3).map(|v| (v, [v[0] as u8, v[1] as u8, 9, 255]));
+            let pairs = tree
+                .voxels()
+                .step_by(3)
+                .map(|v| (v, [v[0] as u8, v[1] as u8, 9, 255]));
             let colors = Layer::from_voxels(tree.depth(), tree.origin(), pairs).unwrap();
             // Free space: the voxels of the space's first octant that are not black.
             let octant = LinearOctree::full(tree.depth().saturating_sub(1), tree.origin()).unwrap();
@@ -434,7 +459,9 @@ mod tests {
             let odds = Layer::from_voxels(
                 tree.depth(),
                 tree.origin(),
-                known.voxels().map(|v| (v, if v[0] % 2 == 0 { 0.85f32 } else { -0.4 })),
+                known
+                    .voxels()
+                    .map(|v| (v, if v[0] % 2 == 0 { 0.85f32 } else { -0.4 })),
             )
             .unwrap();
             let frame = if seed % 2 == 0 {

@@ -16,8 +16,8 @@ use std::path::Path;
 
 use super::leafstream::Reader;
 use super::{FormatError, Model, MAX_DENSE_VOXELS};
-use crate::model::Layer;
 use crate::linear::LinearOctree;
+use crate::model::Layer;
 use crate::Voxel;
 
 /// The colour given to voxels that have none when written.
@@ -475,7 +475,8 @@ mod tests {
                 })
                 .collect();
             let tree = LinearOctree::from_voxels(6, [0; 3], colours.keys().copied()).unwrap();
-            let layer = Layer::from_voxels(6, [0; 3], colours.iter().map(|(v, c)| (*v, *c))).unwrap();
+            let layer =
+                Layer::from_voxels(6, [0; 3], colours.iter().map(|(v, c)| (*v, *c))).unwrap();
             let model = Model::new(tree).with_colors(layer).unwrap();
             let back = decode(&encode(&model).unwrap(), Path::new("t.vox"))
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
@@ -485,8 +486,13 @@ mod tests {
                 colours.keys().copied().collect(),
                 "seed {seed}"
             );
-            let back_colours: std::collections::BTreeMap<Voxel, [u8; 4]> =
-                back.colors.unwrap().to_voxels().into_iter().map(|(v, _, c)| (v, c)).collect();
+            let back_colours: std::collections::BTreeMap<Voxel, [u8; 4]> = back
+                .colors
+                .unwrap()
+                .to_voxels()
+                .into_iter()
+                .map(|(v, _, c)| (v, c))
+                .collect();
             assert_eq!(back_colours, colours, "seed {seed}");
         }
     }

@@ -104,11 +104,7 @@ pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<Model, F
 ///
 /// # Errors
 /// [`FormatError::Io`]; [`FormatError::UnknownFormat`] for another extension.
-pub fn write_meshed(
-    path: &Path,
-    model: &Model,
-    options: &MeshOptions,
-) -> Result<(), FormatError> {
+pub fn write_meshed(path: &Path, model: &Model, options: &MeshOptions) -> Result<(), FormatError> {
     let mut mesh = if options.smooth {
         smooth_mesh(&model.tree)
     } else {

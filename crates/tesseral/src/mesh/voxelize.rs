@@ -28,8 +28,8 @@ use rayon::prelude::*;
 
 use super::TriMesh;
 use crate::io::FormatError;
-use crate::model::{Frame, Model};
 use crate::linear::{CellClass, Classifier, LinearOctree};
+use crate::model::{Frame, Model};
 use crate::Voxel;
 
 /// The deepest voxelization we attempt (16384 voxels per axis).

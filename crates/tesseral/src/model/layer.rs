@@ -126,7 +126,11 @@ impl<T: LayerValue> Layer<T> {
     ) -> Result<Self, OctreeError> {
         let mut groups: HashMap<u64, (T, Vec<Leaf>)> = HashMap::new();
         for (l, x) in leaves {
-            groups.entry(x.key()).or_insert_with(|| (x, Vec::new())).1.push(l);
+            groups
+                .entry(x.key())
+                .or_insert_with(|| (x, Vec::new()))
+                .1
+                .push(l);
         }
         let mut regions = Vec::with_capacity(groups.len());
         for (_, (x, leaves)) in groups {

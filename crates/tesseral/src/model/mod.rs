@@ -270,6 +270,25 @@ impl Model {
         })?)
     }
 
+    /// The model turned within its space about the space's centre, as
+    /// [`LinearOctree::rotate`]: every part turns with the tree and the frame is kept,
+    /// so in world terms the model turns about the centre of its space.
+    ///
+    /// # Errors
+    /// As [`LinearOctree::resample`] (never, as every part shares the space).
+    pub fn rotate_in_space(&self, axis: Axis, turns: i32) -> Result<Self, ModelError> {
+        Ok(self.map(self.frame, |t| Ok(t.rotate(axis, turns)))?)
+    }
+
+    /// The model mirrored within its space, as [`LinearOctree::mirror`]; the frame is
+    /// kept, so in world terms the mirror plane passes through the space's centre.
+    ///
+    /// # Errors
+    /// As [`Model::rotate_in_space`].
+    pub fn mirror_in_space(&self, axis: Axis) -> Result<Self, ModelError> {
+        Ok(self.map(self.frame, |t| Ok(t.mirror(axis)))?)
+    }
+
     /// The model mirrored in the plane `axis = 0` of the world; the frame's
     /// placement is mirrored too.
     ///

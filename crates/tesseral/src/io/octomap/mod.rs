@@ -293,7 +293,10 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
                 )));
             }
             if !value.is_finite() {
-                return Err(bad(format!("byte {}: log-odds {value} is not finite", *pos - node_len - 1)));
+                return Err(bad(format!(
+                    "byte {}: log-odds {value} is not finite",
+                    *pos - node_len - 1
+                )));
             }
             if children == 0 {
                 values.push((Leaf::new(code, OCTOMAP_DEPTH - depth), value));
@@ -350,8 +353,10 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     } else {
         None
     };
-    let free = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free).map_err(oct)?;
-    let log_odds = Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], values).map_err(oct)?;
+    let free =
+        LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free).map_err(oct)?;
+    let log_odds =
+        Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], values).map_err(oct)?;
     let _ = space;
     Ok(Model {
         tree,
@@ -400,16 +405,26 @@ mod tests {
             })
             .filter(|&v| !tree.contains(v))
             .collect();
-        let free = LinearOctree::from_voxels(6, [origin[0] - 8, origin[1] - 8, origin[2]], free_voxels).unwrap();
-        let model = Model::from_parts(tree, Frame::new(0.05, [0.0; 3]), None, Some(free), None).unwrap();
+        let free =
+            LinearOctree::from_voxels(6, [origin[0] - 8, origin[1] - 8, origin[2]], free_voxels)
+                .unwrap();
+        let model =
+            Model::from_parts(tree, Frame::new(0.05, [0.0; 3]), None, Some(free), None).unwrap();
         let known: Vec<_> = model.known().voxels().collect();
         let odds = [0.85f32, 3.5, -0.405, -2.0];
         let pairs = known.iter().map(|&v| {
-            let x = if model.tree.contains(v) { odds[(v[0] & 1) as usize] } else { odds[2 + (v[1] & 1) as usize] };
+            let x = if model.tree.contains(v) {
+                odds[(v[0] & 1) as usize]
+            } else {
+                odds[2 + (v[1] & 1) as usize]
+            };
             (v, x)
         });
         let layer = Layer::from_voxels(model.tree.depth(), model.tree.origin(), pairs).unwrap();
-        let m = Model { log_odds: Some(layer), ..model };
+        let m = Model {
+            log_odds: Some(layer),
+            ..model
+        };
         m.assert_valid();
         m
     }
@@ -440,23 +455,38 @@ mod tests {
             bt.tree.assert_valid();
             assert_eq!(set(&bt.tree), set(&m.tree), "seed {seed}");
             assert_eq!(bt.frame.voxel_size, 0.05);
-            assert_eq!(set(bt.free.as_ref().unwrap()), set(m.free.as_ref().unwrap()), "seed {seed}");
+            assert_eq!(
+                set(bt.free.as_ref().unwrap()),
+                set(m.free.as_ref().unwrap()),
+                "seed {seed}"
+            );
             bt.assert_valid();
             let ot = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot"))
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             ot.assert_valid();
             assert_eq!(set(&ot.tree), set(&m.tree), "seed {seed}");
-            assert_eq!(set(ot.free.as_ref().unwrap()), set(m.free.as_ref().unwrap()), "seed {seed}");
+            assert_eq!(
+                set(ot.free.as_ref().unwrap()),
+                set(m.free.as_ref().unwrap()),
+                "seed {seed}"
+            );
             assert_eq!(odds(&ot), odds(&m), "seed {seed}: log-odds bit for bit");
             // Written again, the file is the same bytes.
-            assert_eq!(encode_ot(&ot).unwrap(), encode_ot(&m).unwrap(), "seed {seed}");
+            assert_eq!(
+                encode_ot(&ot).unwrap(),
+                encode_ot(&m).unwrap(),
+                "seed {seed}"
+            );
         }
     }
 
     #[test]
     fn colour_ot_round_trip() {
         let m = random_model(3);
-        let pairs = m.tree.voxels().map(|v| (v, [v[0] as u8, v[1] as u8, 7, 255]));
+        let pairs = m
+            .tree
+            .voxels()
+            .map(|v| (v, [v[0] as u8, v[1] as u8, 7, 255]));
         let colors = Layer::from_voxels(m.tree.depth(), m.tree.origin(), pairs).unwrap();
         let m = Model {
             colors: Some(colors.clone()),
@@ -464,8 +494,18 @@ mod tests {
         };
         let back = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot")).unwrap();
         back.assert_valid();
-        let got: Vec<_> = back.colors.unwrap().to_voxels().into_iter().map(|(v, k, _)| (v, k)).collect();
-        let want: Vec<_> = colors.to_voxels().into_iter().map(|(v, k, _)| (v, k)).collect();
+        let got: Vec<_> = back
+            .colors
+            .unwrap()
+            .to_voxels()
+            .into_iter()
+            .map(|(v, k, _)| (v, k))
+            .collect();
+        let want: Vec<_> = colors
+            .to_voxels()
+            .into_iter()
+            .map(|(v, k, _)| (v, k))
+            .collect();
         assert_eq!(got, want);
     }
 

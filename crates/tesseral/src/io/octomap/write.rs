@@ -44,8 +44,9 @@ fn to_key_space(model: &Model) -> Result<KeyModel, String> {
                 .checked_add(shift[a])
                 .ok_or("the frame's translate moves the octree out of range")?;
         }
-        let shifted = LinearOctree::from_sorted_leaves(t.depth(), origin, t.leaves().iter().copied())
-            .map_err(|e| e.to_string())?;
+        let shifted =
+            LinearOctree::from_sorted_leaves(t.depth(), origin, t.leaves().iter().copied())
+                .map_err(|e| e.to_string())?;
         reframe(&shifted, OCTOMAP_DEPTH, [KEY_ORIGIN; 3])
             .map_err(|e| format!("{e}: OctoMap keys reach only voxels −32768..32767 on each axis"))
     };
@@ -105,7 +106,11 @@ fn pieces(km: &KeyModel) -> Vec<Piece> {
             split(leaf, &colors, &mut |l, c: Option<Rgba>| {
                 let rgb = c.unwrap_or(default_rgb);
                 split(l, &odds, &mut |l, v| {
-                    let fallback = if occupied { OCCUPIED_LOG_ODDS } else { FREE_LOG_ODDS };
+                    let fallback = if occupied {
+                        OCCUPIED_LOG_ODDS
+                    } else {
+                        FREE_LOG_ODDS
+                    };
                     out.push(Piece {
                         leaf: l,
                         occupied,
