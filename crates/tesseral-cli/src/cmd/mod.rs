@@ -16,5 +16,6 @@ pub mod replay;
 pub mod rsmc;
 pub mod shell;
 pub mod simulate;
+pub mod stdio;
 pub mod tables;
 pub mod transform;

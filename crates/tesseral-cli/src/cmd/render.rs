@@ -18,7 +18,7 @@ pub struct Args {
     /// A scene (`.tss`) or an octree file in any format `tesseral` reads. An octree
     /// file is drawn as it is, never rebuilt.
     input: PathBuf,
-    /// The PNG file to write.
+    /// The PNG file to write (`-`: standard output).
     #[arg(short, long)]
     output: PathBuf,
     /// Image size, WIDTHxHEIGHT (for a contact sheet: of each view).
@@ -118,6 +118,9 @@ fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
 
 pub fn run(args: Args) -> Result<()> {
     output::guard("--output", &args.output, &["png"], &[&args.input])?;
+    if output::is_stdio(&args.output) && args.json {
+        bail!("--json: standard output already holds the picture (-o -)");
+    }
     let Size { width, height } = args.size;
     let view = View::parse(&args.view)
         .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
@@ -178,8 +181,7 @@ pub fn run(args: Args) -> Result<()> {
         let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
-        let tree = io::read_octree(&args.input)
-            .with_context(|| format!("reading {}", args.input.display()))?;
+        let tree = super::octree::read(&args.input)?;
         (tree, None, (1.0, [0.0; 3]))
     };
     let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
@@ -263,9 +265,15 @@ pub fn run(args: Args) -> Result<()> {
         render::render(&tree, surface, &opts)
     };
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    image
-        .write_png(&args.output)
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    if output::is_stdio(&args.output) {
+        super::stdio::to_stdout("png", |p| {
+            image.write_png(p).map_err(|e| anyhow::anyhow!("{e}"))
+        })?;
+    } else {
+        image
+            .write_png(&args.output)
+            .with_context(|| format!("writing {}", args.output.display()))?;
+    }
     if args.json {
         let out = serde_json::json!({
             "input": args.input,

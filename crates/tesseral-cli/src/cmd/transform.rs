@@ -6,7 +6,6 @@ use anyhow::{Context, Result};
 use tesseral::pointer::PointerOctree;
 
 use super::octree::{self, AxisArg};
-use super::output::Limits;
 
 /// How `translate` moves the tree.
 #[derive(Clone, Copy, Default, clap::ValueEnum)]
@@ -35,7 +34,7 @@ pub struct TranslateArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
     /// The algorithm.
     #[arg(long, value_enum, default_value_t)]
     method: Method,
@@ -46,7 +45,7 @@ pub struct TranslateArgs {
 }
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let tree = octree::read(&args.input)?;
     let by = args.by;
     let mut extra = serde_json::json!({
@@ -128,11 +127,11 @@ pub struct RotateArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let tree = octree::read(&args.input)?;
     octree::write(
         &args.output,
@@ -160,11 +159,11 @@ pub struct MirrorArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn mirror(args: MirrorArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let tree = octree::read(&args.input)?;
     octree::write(
         &args.output,
@@ -193,11 +192,11 @@ pub struct ScaleArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn scale(args: ScaleArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let tree = octree::read(&args.input)?;
     let k = args.by;
     let scaled = if k >= 0 {
@@ -229,11 +228,11 @@ pub struct ComplementArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn complement(args: ComplementArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let tree = octree::read(&args.input)?;
     octree::write(
         &args.output,

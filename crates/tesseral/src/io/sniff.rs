@@ -86,7 +86,9 @@ mod tests {
         let tree =
             LinearOctree::from_voxels(3, [0, 0, 0], [[0, 0, 0], [1, 0, 0], [1, 2, 3]]).unwrap();
         let dir = tempfile::tempdir().unwrap();
-        for ext in ["tess", "xyz", "binvox", "vox", "bt", "ot", "stl", "obj", "ply"] {
+        for ext in [
+            "tess", "xyz", "binvox", "vox", "bt", "ot", "stl", "obj", "ply",
+        ] {
             let path = dir.path().join(format!("a.{ext}"));
             write_model(&path, &VoxelModel::new(tree.clone())).unwrap();
             let bytes = std::fs::read(&path).unwrap();
@@ -96,8 +98,14 @@ mod tests {
 
     #[test]
     fn text_and_garbage() {
-        assert_eq!(sniff_format(b"solid cube\n facet normal 0 0 1\n"), Some("stl"));
-        assert_eq!(sniff_format(b"# made by hand\n\nv 0 0 0\nv 1 0 0\n"), Some("obj"));
+        assert_eq!(
+            sniff_format(b"solid cube\n facet normal 0 0 1\n"),
+            Some("stl")
+        );
+        assert_eq!(
+            sniff_format(b"# made by hand\n\nv 0 0 0\nv 1 0 0\n"),
+            Some("obj")
+        );
         assert_eq!(sniff_format(b"mtllib a.mtl\n"), Some("obj"));
         assert_eq!(sniff_format(b"1 2 3\n4 5 6\n"), Some("xyz"));
         assert_eq!(sniff_format(b"1 2\n"), None);
