@@ -97,7 +97,8 @@ pub fn save(
     options: &tesseral::io::WriteOptions,
 ) -> Result<()> {
     let ext = out.format_of(path);
-    if let Some(bytes) = tesseral::io::estimate_output_bytes(&model.tree, &ext) {
+    let estimate = tesseral::io::estimate_output_bytes(&model.tree, &ext);
+    if let Some(bytes) = estimate {
         output::check_size(path, bytes, out.limits.max_output)?;
     }
     let write = |p: &Path| {
@@ -106,7 +107,7 @@ pub fn save(
     if output::is_stdio(path) {
         stdio::to_stdout(&ext, write)
     } else {
-        write(path)
+        output::with_progress(estimate.unwrap_or(0), || write(path))
     }
 }
 
