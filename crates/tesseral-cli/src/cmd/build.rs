@@ -8,7 +8,6 @@ use tesseral::csg::Scene;
 
 use super::budget::Budget;
 use super::octree;
-use super::output::{self, Limits};
 
 /// Arguments of `tesseral build`.
 #[derive(clap::Args)]
@@ -22,24 +21,20 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
     #[command(flatten)]
     budget: Budget,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    octree::guard(&args.output, &[&args.scene])?;
+    octree::guard(&args.output, &[&args.scene], &args.limits)?;
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
     let model = args.budget.build_scene_model(&args.scene)?;
-    let tree = &model.tree;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    let ext = tesseral::io::extension(&args.output);
-    if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
-        output::check_size(&args.output, bytes, args.limits.max_output)?;
-    }
-    tesseral::io::write_model(&args.output, &model)
+    octree::save(&args.output, &model, &args.limits, &Default::default())
         .with_context(|| format!("writing {}", args.output.display()))?;
+    let tree = &model.tree;
     if args.json {
         let out = serde_json::json!({
             "scene": args.scene,

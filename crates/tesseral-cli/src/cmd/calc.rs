@@ -498,7 +498,7 @@ fn explain_sub(mode: &Mode, a: u128, b: u128, out: &mut String) -> Result<()> {
     Ok(())
 }
 
-/// The bit interleave of Harakal & Chmúrny §3 (x in bit 0 of a digit, DESIGN.md).
+/// The bit interleave of Harakal & Chmúrny §3 (x in bit 0 of a digit, docs/conventions.md).
 fn explain_bits(mode: &Mode, code: u128, out: &mut String, encoding: bool) {
     let n = if mode.bounded {
         mode.depth()

@@ -14,7 +14,10 @@ use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPT
 
 use super::budget::Budget;
 use super::octree;
-use super::output::{self, Limits};
+
+fn output_is_stdout(path: &std::path::Path) -> bool {
+    super::output::is_stdio(path)
+}
 
 /// The mesh formats read (voxelized) and written (meshed).
 const MESH_IN: [&str; 3] = ["stl", "obj", "ply"];
@@ -51,7 +54,7 @@ pub struct Args {
     #[arg(long)]
     pub json: bool,
     #[command(flatten)]
-    pub limits: Limits,
+    pub limits: octree::OutArgs,
     #[command(flatten)]
     pub budget: Budget,
 }
@@ -61,10 +64,13 @@ pub fn run(mut args: Args) -> Result<()> {
     let Some(out) = args.output.take().or(args.output_positional.take()) else {
         bail!("convert: give the output file, as `convert IN OUT` or `convert IN -o OUT`");
     };
-    octree::guard(&out, &[&args.input])?;
+    octree::guard(&out, &[&args.input], &args.limits)?;
+    if output_is_stdout(&out) && args.json {
+        bail!("--json: standard output already holds the octree (-o -)");
+    }
     // Flags that do not apply are errors, not silently ignored.
     let mesh_in = MESH_IN.contains(&io::extension(&args.input).as_str());
-    let mesh_out = MESH_OUT.contains(&io::extension(&out).as_str());
+    let mesh_out = MESH_OUT.contains(&args.limits.format_of(&out).as_str());
     if !mesh_in {
         for (flag, given) in [
             ("--depth", args.depth.is_some()),
@@ -112,10 +118,7 @@ pub fn run(mut args: Args) -> Result<()> {
         },
     };
     let model = octree::read_model(&args.input, &args.budget, &read)?;
-    if let Some(bytes) = io::estimate_output_bytes(&model.tree, &io::extension(&out)) {
-        output::check_size(&out, bytes, args.limits.max_output)?;
-    }
-    io::write_model_with(&out, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
+    octree::save(&out, &model, &args.limits, &write)?;
     if args.json {
         let bbox = model.tree.bbox();
         let summary = serde_json::json!({

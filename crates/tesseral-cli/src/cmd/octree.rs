@@ -9,6 +9,7 @@ use tesseral::model::Model;
 
 use super::budget::Budget;
 use super::output::{self, Limits};
+use super::stdio::{self, Stdin};
 
 /// Reads a model: a `.tss` scene is built within `budget` with its frame (the
 /// scene's voxel size and lower corner) and its objects' colours; any other file is
@@ -18,6 +19,10 @@ pub fn read_model(
     budget: &Budget,
     options: &tesseral::io::ReadOptions,
 ) -> Result<Model> {
+    if output::is_stdio(path) {
+        let stdin = Stdin::read()?;
+        return read_model(&stdin.path, budget, options).map_err(|e| stdin.rename(&e));
+    }
     if tesseral::io::extension(path) == "tss" {
         return budget.build_scene_model(path);
     }
@@ -27,14 +32,80 @@ pub fn read_model(
 }
 
 /// Reads a model from an octree file (any format `tesseral::io` knows by the
-/// extension) or a `.tss` scene, with the default budget.
+/// extension), a `.tss` scene (built within the default budget), or `-` for
+/// standard input.
 pub fn read(path: &Path) -> Result<Model> {
     read_model(path, &Budget::default(), &Default::default())
 }
 
-/// Checks an octree output before any work: a format we write, and not an input.
-pub fn guard(output: &Path, inputs: &[&Path]) -> Result<()> {
-    output::guard("--output", output, &output::octree_formats(), inputs)
+/// The output flags of commands that write an octree.
+#[derive(clap::Args, Clone, Debug)]
+pub struct OutArgs {
+    #[command(flatten)]
+    pub limits: Limits,
+    /// The format written to standard output by `-o -`: an extension such as tess,
+    /// xyz or stl.
+    #[arg(long, value_name = "EXT")]
+    pub format: Option<String>,
+}
+
+impl OutArgs {
+    /// The format of `path`: its extension, or `--format` for `-`.
+    pub fn format_of(&self, path: &Path) -> String {
+        match (&self.format, output::is_stdio(path)) {
+            (Some(f), true) => f.trim_start_matches('.').to_ascii_lowercase(),
+            _ => tesseral::io::extension(path),
+        }
+    }
+}
+
+/// Checks an octree output before any work: a format we write (`--format` for `-`,
+/// and only then), and not an input.
+pub fn guard(path: &Path, inputs: &[&Path], out: &OutArgs) -> Result<()> {
+    let formats = output::octree_formats();
+    match (output::is_stdio(path), &out.format) {
+        (true, None) => anyhow::bail!(
+            "--output -: give the format of standard output with --format (one of {})",
+            formats.join(", ")
+        ),
+        (false, Some(f)) => {
+            anyhow::bail!("--format {f}: only for --output - (a file's extension names its format)")
+        }
+        (true, Some(_)) => {
+            let f = out.format_of(path);
+            if !formats.contains(&f.as_str()) {
+                anyhow::bail!(
+                    "--format {f}: not a format we write (one of {})",
+                    formats.join(", ")
+                );
+            }
+            Ok(())
+        }
+        (false, None) => output::guard("--output", path, &formats, inputs),
+    }
+}
+
+/// Writes a model to `path` (or standard output for `-`), after checking its
+/// estimated size against `--max-output`.
+pub fn save(
+    path: &Path,
+    model: &Model,
+    out: &OutArgs,
+    options: &tesseral::io::WriteOptions,
+) -> Result<()> {
+    let ext = out.format_of(path);
+    let estimate = tesseral::io::estimate_output_bytes(&model.tree, &ext);
+    if let Some(bytes) = estimate {
+        output::check_size(path, bytes, out.limits.max_output)?;
+    }
+    let write = |p: &Path| {
+        tesseral::io::write_model_with(p, model, options).map_err(|e| anyhow::anyhow!("{e}"))
+    };
+    if output::is_stdio(path) {
+        stdio::to_stdout(&ext, write)
+    } else {
+        output::with_progress(estimate.unwrap_or(0), || write(path))
+    }
 }
 
 /// How a command that writes an octree reports: a line of text, or with `--json` an
@@ -50,13 +121,23 @@ pub struct Report {
 /// Writes a model atomically, in the format named by the extension, and reports it
 /// (see [`Report`]; JSON also has `voxel_size` and `translate`, the frame). Refuses,
 /// before writing, an output estimated above `--max-output`.
-pub fn write(path: &Path, model: &Model, limits: &Limits, report: Report) -> Result<()> {
+pub fn write(path: &Path, model: &Model, out: &OutArgs, report: Report) -> Result<()> {
     let tree = &model.tree;
-    let ext = tesseral::io::extension(path);
-    if let Some(bytes) = tesseral::io::estimate_output_bytes(tree, &ext) {
-        output::check_size(path, bytes, limits.max_output)?;
+    if output::is_stdio(path) && report.json {
+        anyhow::bail!("--json: standard output already holds the octree (-o -)");
     }
-    tesseral::io::write_model(path, model).map_err(|e| anyhow::anyhow!("{e}"))?;
+    save(path, model, out, &Default::default())?;
+    if output::is_stdio(path) {
+        // Standard output holds the octree; the report goes to standard error.
+        eprintln!(
+            "wrote <stdout>: {} voxels, {} leaves, depth {}, origin {}",
+            tree.voxel_count(),
+            tree.leaf_count(),
+            tree.depth(),
+            fmt_voxel(tree.origin())
+        );
+        return Ok(());
+    }
     if report.json {
         let bbox = tree.bbox();
         let mut v = serde_json::json!({

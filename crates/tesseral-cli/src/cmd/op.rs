@@ -6,7 +6,6 @@ use anyhow::{Context, Result};
 use tesseral::linear::SetOp;
 
 use super::octree;
-use super::output::Limits;
 
 /// A set operation on the command line.
 #[derive(Clone, Copy, clap::ValueEnum)]
@@ -38,11 +37,11 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    octree::guard(&args.output, &[&args.a, &args.b])?;
+    octree::guard(&args.output, &[&args.a, &args.b], &args.limits)?;
     let a = octree::read(&args.a)?;
     let b = octree::read(&args.b)?;
     let op = match args.op {

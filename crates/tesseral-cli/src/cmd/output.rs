@@ -232,6 +232,45 @@ fn suggest(bytes: u64) -> String {
     }
 }
 
+/// Outputs smaller than this are written without a progress bar.
+const PROGRESS_MIN_BYTES: u64 = 64 << 20;
+
+/// Runs `write`, and while it runs shows on standard error (on a terminal only) how
+/// far the temporary file of the write in progress has grown towards `estimate`. The
+/// library prints nothing, so the bar watches the file from a second thread.
+pub fn with_progress<T>(estimate: u64, write: impl FnOnce() -> T) -> T {
+    use std::io::IsTerminal;
+    if estimate < PROGRESS_MIN_BYTES || !std::io::stderr().is_terminal() {
+        return write();
+    }
+    let bar = indicatif::ProgressBar::new(estimate);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "writing {bar:40} {bytes}/~{total_bytes} {bytes_per_sec}, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                let written: u64 = tesseral::io::pending_temporaries()
+                    .iter()
+                    .filter_map(|p| std::fs::metadata(p).ok())
+                    .map(|m| m.len())
+                    .sum();
+                bar.set_position(written.min(estimate));
+                std::thread::sleep(std::time::Duration::from_millis(200));
+            }
+        });
+        let result = write();
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        result
+    });
+    bar.finish_and_clear();
+    result
+}
+
 /// Installs the SIGINT/SIGTERM handler: remove the temporaries of writes in progress
 /// and exit with 128 + the signal (130 for Ctrl-C, 143 for SIGTERM), as a shell
 /// reports a process killed by it. SIGKILL cannot be caught: a `kill -9` may leave a

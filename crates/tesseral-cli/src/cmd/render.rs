@@ -19,7 +19,7 @@ pub struct Args {
     /// A scene (`.tss`) or an octree file in any format `tesseral` reads. An octree
     /// file is drawn as it is, never rebuilt.
     input: PathBuf,
-    /// The PNG file to write.
+    /// The PNG file to write (`-`: standard output).
     #[arg(short, long)]
     output: PathBuf,
     /// Image size, WIDTHxHEIGHT (for a contact sheet: of each view).
@@ -119,6 +119,9 @@ fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
 
 pub fn run(args: Args) -> Result<()> {
     output::guard("--output", &args.output, &["png"], &[&args.input])?;
+    if output::is_stdio(&args.output) && args.json {
+        bail!("--json: standard output already holds the picture (-o -)");
+    }
     let Size { width, height } = args.size;
     let view = View::parse(&args.view)
         .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
@@ -274,9 +277,15 @@ pub fn run(args: Args) -> Result<()> {
         render::render(&tree, surface, &opts)
     };
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    image
-        .write_png(&args.output)
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    if output::is_stdio(&args.output) {
+        super::stdio::to_stdout("png", |p| {
+            image.write_png(p).map_err(|e| anyhow::anyhow!("{e}"))
+        })?;
+    } else {
+        image
+            .write_png(&args.output)
+            .with_context(|| format!("writing {}", args.output.display()))?;
+    }
     if args.json {
         let out = serde_json::json!({
             "input": args.input,

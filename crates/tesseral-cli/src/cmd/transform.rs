@@ -7,7 +7,6 @@ use tesseral::model::Model;
 use tesseral::pointer::PointerOctree;
 
 use super::octree::{self, AxisArg};
-use super::output::Limits;
 
 /// How `translate` moves the tree.
 #[derive(Clone, Copy, Default, clap::ValueEnum)]
@@ -41,7 +40,7 @@ pub struct TranslateArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
     /// The algorithm.
     #[arg(long, value_enum, default_value_t)]
     method: Method,
@@ -52,7 +51,7 @@ pub struct TranslateArgs {
 }
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     let by = match (args.by, args.by_world) {
         (Some(by), _) => by,
@@ -153,11 +152,11 @@ pub struct RotateArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     octree::write(
         &args.output,
@@ -185,11 +184,11 @@ pub struct MirrorArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn mirror(args: MirrorArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     octree::write(
         &args.output,
@@ -218,11 +217,11 @@ pub struct ScaleArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn scale(args: ScaleArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     let k = args.by;
     let scaled = if k >= 0 {
@@ -254,11 +253,11 @@ pub struct ComplementArgs {
     #[arg(long)]
     json: bool,
     #[command(flatten)]
-    limits: Limits,
+    limits: octree::OutArgs,
 }
 
 pub fn complement(args: ComplementArgs) -> Result<()> {
-    octree::guard(&args.output, &[&args.input])?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     octree::write(
         &args.output,

@@ -25,12 +25,14 @@ mod leafstream;
 pub mod native;
 pub mod octomap;
 mod reframe;
+mod sniff;
 pub mod vox;
 pub mod xyz;
 
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
 pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
+pub use sniff::sniff_format;
 
 use std::fs;
 use std::io;

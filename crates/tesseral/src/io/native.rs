@@ -26,7 +26,7 @@
 //! stream of the voxels that hold it; regions are disjoint. Each section is
 //! self-delimiting, so a reader can skip what it does not need.
 //!
-//! A packed leaf ([`Leaf::packed`]) holds the code and the block size, and packed
+//! A packed leaf ([`crate::linear::Leaf::packed`]) holds the code and the block size, and packed
 //! leaves increase strictly, so the deltas are positive and small: one byte for most
 //! leaves of a solid. The layout has no pointers, so the file can be memory-mapped
 //! and decoded in one pass ([`read`] maps it with `memmap2`).
