@@ -5,7 +5,7 @@ use std::path::Path;
 use tesseral::mesh::{self, Resolution, VoxelizeOptions};
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(m) = mesh::read::parse(data, "ply", Path::new("fuzz.ply")) {
+    if let Ok(m) = mesh::read::parse(data, "ply") {
         if m.triangles.len() <= 1000 {
             for surface_only in [false, true] {
                 let opts = VoxelizeOptions { resolution: Resolution::Depth(5), surface_only };

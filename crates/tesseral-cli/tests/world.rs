@@ -128,10 +128,7 @@ fn obj_bounds(path: &Path) -> ([f64; 3], [f64; 3]) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lo = [f64::MAX; 3];
     let mut hi = [f64::MIN; 3];
-    for line in text
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("v "))
-    {
+    for line in text.lines().filter_map(|l| l.trim().strip_prefix("v ")) {
         let p: Vec<f64> = line
             .split_whitespace()
             .map(|w| w.parse().unwrap())
@@ -279,4 +276,37 @@ fn item_3_free_space_survives_convert_translate_and_op() {
     let carved = read_model(&d.join("carved.bt")).unwrap();
     assert_eq!(carved.tree.voxel_count(), 0);
     assert_eq!(carved.free.as_ref().unwrap().voxel_count(), free + 120);
+}
+
+#[test]
+fn item_8_garbage_is_not_read_as_an_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut x = 12345u64;
+    let garbage: Vec<u8> = (0..4096)
+        .map(|_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 33) as u8
+        })
+        .collect();
+    std::fs::write(d.join("noise.obj"), &garbage).unwrap();
+    fails(d, &["convert", "noise.obj", "n.tess"], "noise.obj:");
+    // A binary STL renamed .obj.
+    std::fs::write(d.join("cube.stl"), octahedron([0.0; 3], 1.0)).unwrap();
+    ok(d, &["convert", "cube.stl", "c.tess", "--depth", "4"]);
+    ok(d, &["convert", "c.tess", "bin.stl"]);
+    std::fs::copy(d.join("bin.stl"), d.join("bin.obj")).unwrap();
+    fails(d, &["convert", "bin.obj", "b.tess"], "bin.obj:1:");
+    // A text file that is not OBJ, and an OBJ with no faces.
+    std::fs::write(d.join("notes.obj"), "hello world\n").unwrap();
+    fails(
+        d,
+        &["convert", "notes.obj", "x.tess"],
+        "notes.obj:1:1: `hello` is not an OBJ statement",
+    );
+    std::fs::write(d.join("empty.obj"), "# nothing\no thing\n").unwrap();
+    fails(d, &["convert", "empty.obj", "x.tess"], "no triangles");
+    assert!(!d.join("x.tess").exists() && !d.join("n.tess").exists());
 }

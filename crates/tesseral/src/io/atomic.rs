@@ -114,10 +114,7 @@ pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> Result<(), FormatError> {
-    write_atomic_inner(path, body).map_err(|source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    })
+    write_atomic_inner(path, body).map_err(|source| FormatError::Io(source).with_path(path))
 }
 
 fn write_atomic_inner(

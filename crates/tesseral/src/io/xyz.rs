@@ -14,30 +14,21 @@ use crate::Voxel;
 /// # Errors
 /// [`FormatError::Syntax`] with `file:line:column` for a malformed line.
 pub fn read(path: &Path) -> Result<LinearOctree, FormatError> {
-    let file = std::fs::File::open(path).map_err(|source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    let voxels = parse(io::BufReader::new(file), path)?;
-    LinearOctree::from_voxels_fitted(&voxels).map_err(|source| FormatError::Octree {
-        path: path.to_owned(),
-        source,
-    })
+    let attach = |e: FormatError| e.with_path(path);
+    let file = std::fs::File::open(path).map_err(|e| attach(FormatError::Io(e)))?;
+    let voxels = parse(io::BufReader::new(file)).map_err(attach)?;
+    LinearOctree::from_voxels_fitted(&voxels).map_err(|e| attach(FormatError::Octree(e)))
 }
 
-/// Parses `.xyz` text; `path` names the source in errors.
+/// Parses `.xyz` text.
 ///
 /// # Errors
 /// [`FormatError::Syntax`] for a malformed line, [`FormatError::Io`] if reading fails.
-pub fn parse(reader: impl BufRead, path: &Path) -> Result<Vec<Voxel>, FormatError> {
+pub fn parse(reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
     let mut voxels = Vec::new();
     for (index, line) in reader.lines().enumerate() {
-        let line = line.map_err(|source| FormatError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
+        let line = line.map_err(FormatError::Io)?;
         let syntax = |column: usize, message: String| FormatError::Syntax {
-            path: path.to_owned(),
             line: index + 1,
             column,
             message,
@@ -99,23 +90,27 @@ mod tests {
     #[test]
     fn parses_comments_blanks_and_negatives() {
         let text = "# header\n\n1 2 3\n  -4\t5 -6   # trailing\n";
-        let v = parse(text.as_bytes(), Path::new("a.xyz")).unwrap();
+        let v = parse(text.as_bytes()).unwrap();
         assert_eq!(v, vec![[1, 2, 3], [-4, 5, -6]]);
     }
 
     #[test]
     fn names_line_and_column_of_the_fault() {
-        let err = parse("1 2 3\n1 2 x\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2 3\n1 2 x\n".as_bytes())
+            .unwrap_err()
+            .with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:2:5: `x` is not an integer coordinate"
         );
-        let err = parse("1 2\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2\n".as_bytes()).unwrap_err().with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:1:4: expected three integers `x y z`, found 2 field(s)"
         );
-        let err = parse("1 2 3 4\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2 3 4\n".as_bytes())
+            .unwrap_err()
+            .with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:1:7: expected three integers `x y z`, found 4 field(s)"
