@@ -32,7 +32,7 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let tree = args.budget.build_scene(&args.scene, &scene)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    let model = tesseral::io::VoxelModel::new(tree);
+    let model = octree::Model::new(tree);
     octree::save(&args.output, &model, &args.limits, &Default::default())
         .with_context(|| format!("writing {}", args.output.display()))?;
     let tree = model.tree;

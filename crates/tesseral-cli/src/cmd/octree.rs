@@ -7,6 +7,10 @@ use anyhow::Result;
 use tesseral::linear::{Axis, LinearOctree};
 
 use super::budget::Budget;
+
+/// The library's model of an octree with its frame and colours (one name here, so
+/// that a change of the library's type touches one line).
+pub type Model = tesseral::io::VoxelModel;
 use super::output::{self, Limits};
 use super::stdio::{self, Stdin};
 
@@ -17,7 +21,7 @@ pub fn read_model(
     path: &Path,
     budget: &Budget,
     options: &tesseral::io::ReadOptions,
-) -> Result<tesseral::io::VoxelModel> {
+) -> Result<Model> {
     if output::is_stdio(path) {
         let stdin = Stdin::read()?;
         return read_model(&stdin.path, budget, options).map_err(|e| stdin.rename(&e));
@@ -25,7 +29,7 @@ pub fn read_model(
     if tesseral::io::extension(path) == "tss" {
         let scene = tesseral::csg::Scene::read(path)?;
         let tree = budget.build_scene(path, &scene)?;
-        let mut model = tesseral::io::VoxelModel::new(tree);
+        let mut model = Model::new(tree);
         model.frame = Some(tesseral::io::Frame {
             voxel_size: scene.voxel,
             translate: scene.bounds_min,
@@ -92,7 +96,7 @@ pub fn guard(path: &Path, inputs: &[&Path], out: &OutArgs) -> Result<()> {
 /// estimated size against `--max-output`.
 pub fn save(
     path: &Path,
-    model: &tesseral::io::VoxelModel,
+    model: &Model,
     out: &OutArgs,
     options: &tesseral::io::WriteOptions,
 ) -> Result<()> {
@@ -128,7 +132,7 @@ pub fn write(path: &Path, tree: &LinearOctree, out: &OutArgs, report: Report) ->
     if output::is_stdio(path) && report.json {
         anyhow::bail!("--json: standard output already holds the octree (-o -)");
     }
-    let model = tesseral::io::VoxelModel::new(tree.clone());
+    let model = Model::new(tree.clone());
     save(path, &model, out, &Default::default())?;
     if output::is_stdio(path) {
         // Standard output holds the octree; the report goes to standard error.

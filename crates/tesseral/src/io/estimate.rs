@@ -119,7 +119,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     use super::*;
-    use crate::io::{random_voxels, VoxelModel};
+    use crate::io::random_voxels;
 
     #[test]
     fn decimal_widths() {
@@ -166,8 +166,7 @@ mod tests {
                     continue;
                 }
                 let path = dir.path().join(format!("c.{ext}"));
-                let model = VoxelModel::new(tree.clone());
-                if crate::io::write_model(&path, &model).is_err() {
+                if crate::io::write_octree(&path, &tree).is_err() {
                     continue;
                 }
                 let real = std::fs::metadata(&path).unwrap().len();
