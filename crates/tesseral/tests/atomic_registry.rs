@@ -3,7 +3,6 @@
 //! beside it in one test binary.
 
 use std::fs;
-use std::io::Write;
 
 use tesseral::io::{pending_temporaries, remove_pending_temporaries, write_atomic};
 

@@ -499,7 +499,7 @@ mod tests {
         assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
         assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
         assert_eq!(rate_text(999.4), "999 steps/s");
-        assert_eq!(rate_text(3.14159), "3.14 steps/s");
+        assert_eq!(rate_text(2.71), "2.71 steps/s");
         assert_eq!(rate_text(0.0), "0.00 steps/s");
     }
 }
