@@ -138,6 +138,25 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
     Ok(Size { width, height })
 }
 
+/// A step rate for people: three significant figures, with k or M.
+pub fn rate_text(per_second: f64) -> String {
+    let (value, unit) = if per_second >= 1e6 {
+        (per_second / 1e6, "M ")
+    } else if per_second >= 1e3 {
+        (per_second / 1e3, "k ")
+    } else {
+        (per_second, "")
+    };
+    let decimals = if value >= 100.0 {
+        0
+    } else if value >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{value:.decimals$} {unit}steps/s")
+}
+
 /// Where an output goes, for the checks: `-` is standard output.
 pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
@@ -348,5 +367,14 @@ mod tests {
         assert_eq!(suggest(44 << 30), "44G");
         assert_eq!(suggest((44 << 30) + 1), "45G");
         assert_eq!(suggest(3 << 40), "3T");
+    }
+
+    #[test]
+    fn rates_read_well() {
+        assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
+        assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
+        assert_eq!(rate_text(999.4), "999 steps/s");
+        assert_eq!(rate_text(2.71), "2.71 steps/s");
+        assert_eq!(rate_text(0.0), "0.00 steps/s");
     }
 }
