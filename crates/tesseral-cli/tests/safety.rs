@@ -401,6 +401,10 @@ fn a_closed_pipe_ends_quietly() {
         &["build", "good.tss", "-o", "g.tess", "--json"],
         &["translate", "a.xyz", "--by", "1,0,0", "-o", "t.xyz"],
         &["plan", "a.xyz", "a.xyz", "--from", "5,0,0", "--to", "9,0,0"],
+        &["convert", "a.xyz", "-o", "-", "--format", "xyz"],
+        &["render", "a.xyz", "-o", "-", "--size", "64x48"],
+        &["completions", "bash"],
+        &["man"],
     ];
     for args in commands {
         quiet_on_broken_pipe(d, args);
