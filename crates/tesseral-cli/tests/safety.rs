@@ -124,6 +124,23 @@ fn plan_never_overwrites_its_environment() {
         "does not write .xyz",
     );
     assert_eq!(fs::read(d.join("wall.xyz")).unwrap(), wall);
+    // Nor does simulate write its frames over the world file.
+    fs::write(
+        d.join("w.json"),
+        r#"{"environment": "wall.xyz", "time_step": 1, "steps": 1, "objects": []}"#,
+    )
+    .unwrap();
+    refused(
+        d,
+        &["simulate", "w.json", "--frames", "w.json"],
+        "world file",
+    );
+    refused(
+        d,
+        &["simulate", "w.json", "--frames", "f", "--max-output", "1K"],
+        "--max-output",
+    );
+    assert!(d.join("w.json").is_file() && !d.join("f").exists());
 }
 
 /// Issue 12, item 4: `render -o x.jpg` and `-o out.tess` wrote PNG bytes.
