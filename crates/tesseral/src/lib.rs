@@ -16,6 +16,7 @@ pub mod dynamic;
 pub mod io;
 pub mod linear;
 pub mod mesh;
+pub mod model;
 pub mod motion;
 pub mod pointer;
 pub mod render;

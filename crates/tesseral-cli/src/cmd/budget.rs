@@ -86,6 +86,21 @@ impl Budget {
         }
     }
 
+    /// Reads a scene and builds it as a model (octree, frame, colours) within the
+    /// budget; each colour's part is built under the same leaf cap.
+    ///
+    /// # Errors
+    /// As [`Budget::build_scene`].
+    pub fn build_scene_model(&self, path: &Path) -> Result<tesseral::model::Model> {
+        let scene = Scene::read(path)?;
+        let tree = self.build_scene(path, &scene)?;
+        let colors = scene.colour_layer(&tree, self.leaf_cap())?;
+        Ok(tesseral::model::Model {
+            colors,
+            ..tesseral::model::Model::new(tree).with_frame(scene.frame())
+        })
+    }
+
     /// Refuses work estimated at `bytes` of memory above `--memory`.
     ///
     /// # Errors

@@ -33,12 +33,11 @@ pub fn run(args: Args) -> Result<()> {
     }
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
-    let tree = args.budget.build_scene(&args.scene, &scene)?;
+    let model = args.budget.build_scene_model(&args.scene)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    let model = octree::Model::new(tree);
     octree::save(&args.output, &model, &args.limits, &Default::default())
         .with_context(|| format!("writing {}", args.output.display()))?;
-    let tree = model.tree;
+    let tree = &model.tree;
     if args.json {
         let out = serde_json::json!({
             "scene": args.scene,
@@ -51,6 +50,7 @@ pub fn run(args: Args) -> Result<()> {
             "voxels": tree.voxel_count(),
             "leaves_by_depth": tree.leaves_by_depth(),
             "build_ms": build_ms,
+            "colors": model.colors.as_ref().map(|c| c.region_count()),
         });
         crate::outln!("{out}")?;
     }

@@ -130,9 +130,10 @@ pub fn run(mut args: Args) -> Result<()> {
             "origin": model.tree.origin(),
             "bbox_min": bbox.map(|b| b.0),
             "bbox_max": bbox.map(|b| b.1),
-            "voxel_size": model.frame.map(|f| f.voxel_size),
-            "translate": model.frame.map(|f| f.translate),
-            "colors": model.colors.as_ref().map(|c| c.len()),
+            "voxel_size": model.frame.voxel_size,
+            "translate": model.frame.translate,
+            "colors": model.colors.as_ref().map(|c| c.voxel_count()),
+            "free_voxels": model.free.as_ref().map(|f| f.voxel_count()),
         });
         crate::outln!("{summary}")?;
     }

@@ -4,19 +4,16 @@
 use std::path::Path;
 
 use anyhow::Result;
-use tesseral::linear::{Axis, LinearOctree};
+use tesseral::linear::Axis;
+use tesseral::model::Model;
 
 use super::budget::Budget;
-
-/// The library's model of an octree with its frame and colours (one name here, so
-/// that a change of the library's type touches one line).
-pub type Model = tesseral::io::VoxelModel;
 use super::output::{self, Limits};
 use super::stdio::{self, Stdin};
 
-/// Reads a model: a `.tss` scene is built within `budget` (its frame is the scene's
-/// voxel size and lower corner), any other file is read in the format its extension
-/// names.
+/// Reads a model: a `.tss` scene is built within `budget` with its frame (the
+/// scene's voxel size and lower corner) and its objects' colours; any other file is
+/// read in the format its extension names, with what the format carries.
 pub fn read_model(
     path: &Path,
     budget: &Budget,
@@ -27,22 +24,18 @@ pub fn read_model(
         return read_model(&stdin.path, budget, options).map_err(|e| stdin.rename(&e));
     }
     if tesseral::io::extension(path) == "tss" {
-        let scene = tesseral::csg::Scene::read(path)?;
-        let tree = budget.build_scene(path, &scene)?;
-        let mut model = Model::new(tree);
-        model.frame = Some(tesseral::io::Frame {
-            voxel_size: scene.voxel,
-            translate: scene.bounds_min,
-        });
-        return Ok(model);
+        return budget.build_scene_model(path);
     }
+    // The library's message already names the file and its cause; keep it as one
+    // line rather than repeating the cause from the error chain.
     tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// Reads an octree, in any format `tesseral::io` knows by the extension, a `.tss`
-/// scene (built within the default budget), or `-` for standard input.
-pub fn read(path: &Path) -> Result<LinearOctree> {
-    Ok(read_model(path, &Budget::default(), &Default::default())?.tree)
+/// Reads a model from an octree file (any format `tesseral::io` knows by the
+/// extension), a `.tss` scene (built within the default budget), or `-` for
+/// standard input.
+pub fn read(path: &Path) -> Result<Model> {
+    read_model(path, &Budget::default(), &Default::default())
 }
 
 /// The output flags of commands that write an octree.
@@ -125,15 +118,15 @@ pub struct Report {
     pub extra: serde_json::Value,
 }
 
-/// Writes an octree atomically, in the format named by the extension, and reports it
-/// (see [`Report`]). Refuses, before writing, an output estimated above
-/// `--max-output`.
-pub fn write(path: &Path, tree: &LinearOctree, out: &OutArgs, report: Report) -> Result<()> {
+/// Writes a model atomically, in the format named by the extension, and reports it
+/// (see [`Report`]; JSON also has `voxel_size` and `translate`, the frame). Refuses,
+/// before writing, an output estimated above `--max-output`.
+pub fn write(path: &Path, model: &Model, out: &OutArgs, report: Report) -> Result<()> {
+    let tree = &model.tree;
     if output::is_stdio(path) && report.json {
         anyhow::bail!("--json: standard output already holds the octree (-o -)");
     }
-    let model = Model::new(tree.clone());
-    save(path, &model, out, &Default::default())?;
+    save(path, model, out, &Default::default())?;
     if output::is_stdio(path) {
         // Standard output holds the octree; the report goes to standard error.
         eprintln!(
@@ -155,6 +148,8 @@ pub fn write(path: &Path, tree: &LinearOctree, out: &OutArgs, report: Report) ->
             "origin": tree.origin(),
             "bbox_min": bbox.map(|b| b.0),
             "bbox_max": bbox.map(|b| b.1),
+            "voxel_size": model.frame.voxel_size,
+            "translate": model.frame.translate,
         });
         if let (Some(map), serde_json::Value::Object(extra)) = (v.as_object_mut(), report.extra) {
             map.extend(extra);
@@ -162,8 +157,13 @@ pub fn write(path: &Path, tree: &LinearOctree, out: &OutArgs, report: Report) ->
         crate::outln!("{v}")?;
         return Ok(());
     }
+    let frame = if model.frame.is_unit() {
+        String::new()
+    } else {
+        format!(", {}", model.frame)
+    };
     crate::outln!(
-        "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
+        "wrote {}: {} voxels, {} leaves, depth {}, origin {}{frame}",
         path.display(),
         tree.voxel_count(),
         tree.leaf_count(),

@@ -50,9 +50,15 @@ pub fn run(args: Args) -> Result<()> {
         OpArg::Difference => SetOp::Difference,
         OpArg::Xor => SetOp::SymmetricDifference,
     };
-    let r = a
-        .set_op(&b, op)
-        .with_context(|| format!("combining {} and {}", args.a.display(), args.b.display()))?;
+    let r = a.set_op(&b, op).with_context(|| {
+        format!(
+            "combining {} ({}) and {} ({})",
+            args.a.display(),
+            a.frame,
+            args.b.display(),
+            b.frame
+        )
+    })?;
     let name = match args.op {
         OpArg::Union => "union",
         OpArg::Intersection => "intersection",

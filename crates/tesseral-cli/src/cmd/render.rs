@@ -10,6 +10,7 @@ use tesseral::linear::LinearOctree;
 use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
 
 use super::budget::Budget;
+use super::octree;
 use super::output::{self, Size, MAX_SIDE};
 
 /// Arguments of `tesseral render`.
@@ -174,6 +175,7 @@ pub fn run(args: Args) -> Result<()> {
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
+    let mut colors = None;
     // A scene's cut and slice positions are in scene units: (scale, lower corner).
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
         let scene = Scene::read(&args.input)?;
@@ -181,8 +183,10 @@ pub fn run(args: Args) -> Result<()> {
         let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
-        let tree = super::octree::read(&args.input)?;
-        (tree, None, (1.0, [0.0; 3]))
+        let model = octree::read(&args.input)?;
+        let frame = model.frame;
+        colors = model.colors;
+        (model.tree, None, (frame.voxel_size, frame.translate))
     };
     let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
     if let Some((axis, op, c)) = cut {
@@ -205,10 +209,18 @@ pub fn run(args: Args) -> Result<()> {
     let shader = csg
         .as_ref()
         .map(|c| move |p: [f64; 3]| c.colour_at(p).map_or(solid_colour, |k| k.0));
+    // An octree file's stored colours: the voxel holding the sample point.
+    let stored = colors.as_ref().map(|l| {
+        move |p: [f64; 3]| {
+            l.get(p.map(|c| c.floor() as i64))
+                .map_or(solid_colour, |c| [c[0], c[1], c[2]])
+        }
+    });
     let fixed = move |_: [f64; 3]| solid_colour;
-    let shader_ref: &(dyn Fn([f64; 3]) -> [u8; 3] + Sync) = match &shader {
-        Some(s) => s,
-        None => &fixed,
+    let shader_ref: &(dyn Fn([f64; 3]) -> [u8; 3] + Sync) = match (&shader, &stored) {
+        (Some(s), _) => s,
+        (None, Some(s)) => s,
+        (None, None) => &fixed,
     };
     let normal_fn = csg.as_ref().map(|c| move |p: [f64; 3]| c.normal_at(p));
     let surface = render::Surface {

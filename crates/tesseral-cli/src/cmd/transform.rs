@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use tesseral::model::Model;
 use tesseral::pointer::PointerOctree;
 
 use super::octree::{self, AxisArg};
@@ -24,9 +25,14 @@ pub struct TranslateArgs {
     /// The input octree file.
     input: PathBuf,
     /// The displacement `DX,DY,DZ` in voxels (negative allowed: `--by=-4,-50,0` or
-    /// `--by -4,-50,0`).
-    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true)]
-    by: [i64; 3],
+    /// `--by -4,-50,0`). The frame is kept, so the world moves by DX·voxel size.
+    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true,
+          required_unless_present = "by_world", conflicts_with = "by_world")]
+    by: Option<[i64; 3]>,
+    /// The displacement `X,Y,Z` in world units (metres for an OctoMap map); it must be
+    /// a whole number of voxels.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_world_vector, allow_hyphen_values = true)]
+    by_world: Option<[f64; 3]>,
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
@@ -46,8 +52,16 @@ pub struct TranslateArgs {
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
-    let tree = octree::read(&args.input)?;
-    let by = args.by;
+    let model = octree::read(&args.input)?;
+    let by = match (args.by, args.by_world) {
+        (Some(by), _) => by,
+        (None, Some(w)) => model
+            .frame
+            .world_to_voxels(w)
+            .map_err(|e| anyhow::anyhow!("--by-world: {e}"))?,
+        (None, None) => anyhow::bail!("give --by or --by-world"),
+    };
+    let tree = &model.tree;
     let mut extra = serde_json::json!({
         "by": by,
         "method": match args.method {
@@ -56,7 +70,7 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
         },
     });
     let moved = match (args.method, args.clip) {
-        (Method::Linear, false) => tree.translate(by).with_context(|| {
+        (Method::Linear, false) => model.translate(by).with_context(|| {
             format!(
                 "translating {} by {}",
                 args.input.display(),
@@ -64,9 +78,12 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             )
         })?,
         (Method::Linear, true) => {
-            let (moved, dropped) = tree
-                .translate_clipped(by)
+            // Moved, then put back in the input's space: what leaves it is dropped.
+            let moved = model
+                .translate(by)
+                .and_then(|m| Ok(m.in_space(tree.depth(), tree.origin())?))
                 .with_context(|| format!("translating {}", args.input.display()))?;
+            let dropped = tree.voxel_count() - moved.tree.voxel_count();
             if args.json {
                 extra["dropped"] = dropped.into();
             } else {
@@ -78,7 +95,7 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             anyhow::bail!("--clip works only with --method linear")
         }
         (Method::Labels, false) => {
-            let mut p = PointerOctree::from_linear(&tree);
+            let mut p = PointerOctree::from_linear(tree);
             let stats = p
                 .translate(by)
                 .with_context(|| format!("translating {}", args.input.display()))?;
@@ -99,7 +116,15 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
                     stats.root_expansions
                 )?;
             }
-            p.to_linear()
+            // The labels move the voxels; the colours and free space follow them.
+            let rest = model.translate(by)?;
+            Model::from_parts(
+                p.to_linear(),
+                model.frame,
+                rest.colors,
+                rest.free,
+                rest.log_odds,
+            )?
         }
     };
     let report = octree::Report {
@@ -132,10 +157,10 @@ pub struct RotateArgs {
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
-    let tree = octree::read(&args.input)?;
+    let model = octree::read(&args.input)?;
     octree::write(
         &args.output,
-        &tree.rotate(args.axis.into(), args.turns),
+        &model.rotate_in_space(args.axis.into(), args.turns)?,
         &args.limits,
         octree::Report {
             json: args.json,
@@ -164,10 +189,10 @@ pub struct MirrorArgs {
 
 pub fn mirror(args: MirrorArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
-    let tree = octree::read(&args.input)?;
+    let model = octree::read(&args.input)?;
     octree::write(
         &args.output,
-        &tree.mirror(args.axis.into()),
+        &model.mirror_in_space(args.axis.into())?,
         &args.limits,
         octree::Report {
             json: args.json,
@@ -197,12 +222,12 @@ pub struct ScaleArgs {
 
 pub fn scale(args: ScaleArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
-    let tree = octree::read(&args.input)?;
+    let model = octree::read(&args.input)?;
     let k = args.by;
     let scaled = if k >= 0 {
-        tree.scale_up(k as u8)
+        model.scale_up(k as u8)
     } else {
-        tree.scale_down(k.unsigned_abs() as u8)
+        model.scale_down(k.unsigned_abs() as u8)
     }
     .with_context(|| format!("scaling {} by 2^{k}", args.input.display()))?;
     octree::write(
@@ -233,16 +258,33 @@ pub struct ComplementArgs {
 
 pub fn complement(args: ComplementArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
-    let tree = octree::read(&args.input)?;
+    let model = octree::read(&args.input)?;
     octree::write(
         &args.output,
-        &tree.complement(),
+        &model.complement(),
         &args.limits,
         octree::Report {
             json: args.json,
             extra: serde_json::json!({}),
         },
     )
+}
+
+/// Parses `X,Y,Z` in world units.
+fn parse_world_vector(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three numbers `X,Y,Z`, got `{text}`"));
+    }
+    let mut v = [0.0; 3];
+    for (a, p) in parts.iter().enumerate() {
+        v[a] = p
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("`{p}` is not a finite number (in `{text}`)"))?;
+    }
+    Ok(v)
 }
 
 /// The axis's name in JSON output.

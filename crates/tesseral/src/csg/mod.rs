@@ -23,6 +23,7 @@
 //! and its cost follows the surface: only cells the surface may cross are split.
 
 mod budget;
+mod colours;
 mod compile;
 pub mod scene;
 mod shape;
@@ -30,6 +31,7 @@ mod shape;
 #[cfg(test)]
 pub(crate) mod tests;
 
+pub use colours::colour_parts;
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};
 pub use scene::{Scene, SceneError};
 pub use shape::Shape;

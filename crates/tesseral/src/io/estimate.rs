@@ -119,7 +119,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
 
     use super::*;
-    use crate::io::random_voxels;
+    use crate::io::{random_voxels, Model};
 
     #[test]
     fn decimal_widths() {
@@ -166,7 +166,8 @@ mod tests {
                     continue;
                 }
                 let path = dir.path().join(format!("c.{ext}"));
-                if crate::io::write_octree(&path, &tree).is_err() {
+                let model = Model::new(tree.clone());
+                if crate::io::write_model(&path, &model).is_err() {
                     continue;
                 }
                 let real = std::fs::metadata(&path).unwrap().len();

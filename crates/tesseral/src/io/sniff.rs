@@ -77,7 +77,7 @@ fn is_binary_stl(bytes: &[u8]) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::io::write_octree;
+    use crate::io::{write_model, Model};
     use crate::linear::LinearOctree;
 
     /// Every format we write is told back from its own bytes.
@@ -90,7 +90,7 @@ mod tests {
             "tess", "xyz", "binvox", "vox", "bt", "ot", "stl", "obj", "ply",
         ] {
             let path = dir.path().join(format!("a.{ext}"));
-            write_octree(&path, &tree).unwrap();
+            write_model(&path, &Model::new(tree.clone())).unwrap();
             let bytes = std::fs::read(&path).unwrap();
             assert_eq!(sniff_format(&bytes), Some(ext), "{ext}");
         }
