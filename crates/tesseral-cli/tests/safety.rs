@@ -349,6 +349,12 @@ fn sigterm_removes_the_temporary() {
     interrupted_convert("-TERM", 143);
 }
 
+/// A closed terminal (SIGHUP) is handled the same way.
+#[test]
+fn sighup_removes_the_temporary() {
+    interrupted_convert("-HUP", 129);
+}
+
 /// Runs a command whose stdout is closed before it writes; it must exit 0 with
 /// nothing on stderr.
 fn quiet_on_broken_pipe(dir: &Path, args: &[&str]) {

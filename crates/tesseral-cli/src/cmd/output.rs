@@ -290,15 +290,15 @@ pub fn with_progress<T>(estimate: u64, write: impl FnOnce() -> T) -> T {
     result
 }
 
-/// Installs the SIGINT/SIGTERM handler: remove the temporaries of writes in progress
-/// and exit with 128 + the signal (130 for Ctrl-C, 143 for SIGTERM), as a shell
-/// reports a process killed by it. SIGKILL cannot be caught: a `kill -9` may leave a
+/// Installs the SIGINT/SIGTERM/SIGHUP handler: remove the temporaries of writes in
+/// progress and exit with 128 + the signal (130 for Ctrl-C, 143 for SIGTERM, 129 when
+/// the terminal goes away), as a shell reports a process killed by it. SIGKILL cannot be caught: a `kill -9` may leave a
 /// `.NAME.*.tmp` file beside the output.
 pub fn install_signal_handler() {
-    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     // If the handler cannot be installed, the default action (die at once, possibly
     // leaving a temporary) still stops the program; that is no reason to refuse work.
-    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
         return;
     };
     std::thread::spawn(move || {
