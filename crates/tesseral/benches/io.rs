@@ -8,7 +8,6 @@
 //! `readBinary`.
 
 use std::hint::black_box;
-use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
@@ -116,7 +115,7 @@ fn bench_mesh(c: &mut Criterion) {
         let label = if surface_only { "surface" } else { "solid" };
         g.bench_function(
             format!("voxelize_{label}/{n}_triangles_depth_{depth}"),
-            |b| b.iter(|| voxelize(black_box(&sphere), &opts, Path::new("s.stl")).unwrap()),
+            |b| b.iter(|| voxelize(black_box(&sphere), &opts).unwrap()),
         );
     }
     let solid = voxelize(
@@ -125,7 +124,6 @@ fn bench_mesh(c: &mut Criterion) {
             resolution: Resolution::Depth(8),
             surface_only: false,
         },
-        Path::new("s"),
     )
     .unwrap();
     let mesh = boundary_mesh(&solid.tree);

@@ -198,7 +198,7 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
     codes.sort_unstable();
     let tree =
         LinearOctree::from_sorted_leaves(depth, shift, codes.into_iter().map(|c| Leaf::new(c, 0)))
-            .map_err(|e| FormatError::octree(e))?;
+            .map_err(FormatError::octree)?;
     Ok(Model::new(tree).with_frame(Frame::new(voxel_size, rest)))
 }
 
@@ -218,7 +218,7 @@ fn parse_n<T: std::str::FromStr>(values: &[&str], n: usize) -> Result<Vec<T>, St
 /// [`FormatError::Unsupported`] when the bounding box is wider than
 /// [`MAX_WRITE_DIM`]; [`FormatError::Io`].
 pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
-    let bytes = encode(model).map_err(|m| FormatError::unsupported(m))?;
+    let bytes = encode(model).map_err(|m| FormatError::unsupported(m).with_path(path))?;
     super::write_atomic(path, |w| w.write_all(&bytes))
 }
 

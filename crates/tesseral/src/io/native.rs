@@ -239,8 +239,8 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
             payload_end - payload.pos
         )));
     }
-    let tree = LinearOctree::from_sorted_leaves(depth, origin, leaves)
-        .map_err(|e| FormatError::octree(e))?;
+    let tree =
+        LinearOctree::from_sorted_leaves(depth, origin, leaves).map_err(FormatError::octree)?;
     let mut tail = Reader {
         bytes: body,
         pos: payload_end,
@@ -282,8 +282,7 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
             let rgba = tail.take(4).map_err(&bad)?;
             pairs.push((tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]));
         }
-        colors =
-            Some(Layer::from_voxels(depth, origin, pairs).map_err(|e| FormatError::octree(e))?);
+        colors = Some(Layer::from_voxels(depth, origin, pairs).map_err(FormatError::octree)?);
     }
     if flags & FLAG_COLOR_LAYER != 0 {
         colors = Some(

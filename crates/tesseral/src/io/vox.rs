@@ -284,9 +284,9 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
     } else {
         LinearOctree::from_voxels_fitted(&voxels)
     }
-    .map_err(|e| FormatError::octree(e))?;
-    let colors = Layer::from_voxels(tree.depth(), tree.origin(), placed)
-        .map_err(|e| FormatError::octree(e))?;
+    .map_err(FormatError::octree)?;
+    let colors =
+        Layer::from_voxels(tree.depth(), tree.origin(), placed).map_err(FormatError::octree)?;
     Ok(Model {
         colors: Some(colors),
         ..Model::new(tree)
@@ -338,7 +338,7 @@ impl Reader<'_> {
 /// # Errors
 /// [`FormatError::Unsupported`] when the bounding box is wider than 256 voxels.
 pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
-    let bytes = encode(model).map_err(|m| FormatError::unsupported(m))?;
+    let bytes = encode(model).map_err(|m| FormatError::unsupported(m).with_path(path))?;
     super::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
 

@@ -1,5 +1,5 @@
 //! Mesh files: STL (ASCII and binary), Wavefront OBJ, PLY (ASCII and binary) and
-//! glTF binary (write only). Reading parses a [`TriMesh`] and voxelizes it
+//! glTF binary (write only). Reading parses a [`crate::mesh::TriMesh`] and voxelizes it
 //! ([`crate::mesh::voxelize`]); writing meshes the octree
 //! ([`crate::mesh::boundary_mesh`] or [`crate::mesh::smooth_mesh`]) in world units.
 

@@ -157,8 +157,7 @@ pub fn decode_bt(bytes: &[u8]) -> Result<Model, FormatError> {
         return Ok(Model::new(octomap_space()).with_frame(frame));
     }
     let data = &bytes[header.data_start..];
-    let (leaves, free, nodes, used) =
-        decode_bt_stream(data).map_err(|m| FormatError::corrupt(m))?;
+    let (leaves, free, nodes, used) = decode_bt_stream(data).map_err(FormatError::corrupt)?;
     if nodes != header.size {
         return Err(FormatError::corrupt(format!(
             "header says {} nodes, the data holds {nodes}",
@@ -167,9 +166,9 @@ pub fn decode_bt(bytes: &[u8]) -> Result<Model, FormatError> {
     }
     let _ = used;
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
-        .map_err(|e| FormatError::octree(e))?;
+        .map_err(FormatError::octree)?;
     let free = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free)
-        .map_err(|e| FormatError::octree(e))?;
+        .map_err(FormatError::octree)?;
     Ok(Model {
         free: Some(free),
         ..Model::new(tree).with_frame(frame)
@@ -344,8 +343,8 @@ pub fn decode_ot(bytes: &[u8]) -> Result<Model, FormatError> {
         )));
     }
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
-        .map_err(|e| FormatError::octree(e))?;
-    let oct = |e| FormatError::octree(e);
+        .map_err(FormatError::octree)?;
+    let oct = FormatError::octree;
     let colors = if color {
         Some(Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaf_colors).map_err(oct)?)
     } else {

@@ -137,7 +137,7 @@ pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
     } else {
         encode_bt(model)
     }
-    .map_err(|m| FormatError::unsupported(m))?;
+    .map_err(|m| FormatError::unsupported(m).with_path(path))?;
     crate::io::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
 
