@@ -8,7 +8,7 @@ fuzz_target!(|data: &[u8]| {
     if let Ok(m) = mesh::read::parse(data, "obj") {
         if m.triangles.len() <= 1000 {
             for surface_only in [false, true] {
-                let opts = VoxelizeOptions { resolution: Resolution::Depth(5), surface_only };
+                let opts = VoxelizeOptions { resolution: Resolution::Depth(5), surface_only, ..Default::default() };
                 if let Ok(model) = mesh::voxelize(&m, &opts, Path::new("fuzz.obj")) {
                     model.tree.assert_valid();
                 }

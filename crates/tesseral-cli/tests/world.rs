@@ -310,3 +310,40 @@ fn item_8_garbage_is_not_read_as_an_obj() {
     fails(d, &["convert", "empty.obj", "x.tess"], "no triangles");
     assert!(!d.join("x.tess").exists() && !d.join("n.tess").exists());
 }
+
+#[test]
+fn item_9_a_voxelization_over_budget_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("oct.stl"), octahedron([0.0; 3], 1.0)).unwrap();
+    // About 2.7e8 crossings and 4.6e8 surface leaves at depth 14: over what 1 GiB
+    // allows, refused at once.
+    fails(
+        d,
+        &[
+            "convert", "oct.stl", "big.tess", "--depth", "14", "--memory", "1G",
+        ],
+        "--memory",
+    );
+    assert!(!d.join("big.tess").exists());
+    // At the default budget, the leaves are estimated from the surface area first:
+    // about 4.6e8 at depth 14, refused at once naming the flags.
+    fails(
+        d,
+        &["convert", "oct.stl", "big.tess", "--depth", "14"],
+        "raise --max-leaves",
+    );
+    // Within the budget it is built.
+    ok(
+        d,
+        &[
+            "convert",
+            "oct.stl",
+            "small.tess",
+            "--depth",
+            "8",
+            "--memory",
+            "1G",
+        ],
+    );
+}

@@ -111,6 +111,7 @@ fn bench_mesh(c: &mut Criterion) {
         let opts = VoxelizeOptions {
             resolution: Resolution::Depth(depth),
             surface_only,
+            ..Default::default()
         };
         let label = if surface_only { "surface" } else { "solid" };
         g.bench_function(
@@ -123,6 +124,7 @@ fn bench_mesh(c: &mut Criterion) {
         &VoxelizeOptions {
             resolution: Resolution::Depth(8),
             surface_only: false,
+            ..Default::default()
         },
     )
     .unwrap();

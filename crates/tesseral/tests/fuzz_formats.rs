@@ -282,6 +282,7 @@ fn parse_mesh(b: &[u8], ext: &str) -> bool {
             let opts = VoxelizeOptions {
                 resolution: Resolution::Depth(4),
                 surface_only,
+                ..Default::default()
             };
             let _ = mesh::voxelize(&m, &opts);
         }

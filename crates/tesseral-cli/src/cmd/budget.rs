@@ -41,7 +41,7 @@ impl Default for Budget {
 
 impl Budget {
     /// The leaf cap: `--max-leaves`, or fewer if `--memory` cannot hold that many.
-    fn leaf_cap(&self) -> usize {
+    pub fn leaf_cap(&self) -> usize {
         let by_memory = usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX);
         self.max_leaves.min(by_memory)
     }

@@ -76,8 +76,8 @@ pub const MAX_VOXELIZE_DEPTH: u8 = 14;
 const FRAC_BITS: u32 = 20;
 const ONE: i64 = 1 << FRAC_BITS;
 const HALF: i64 = ONE / 2;
-/// The most column crossings held in memory (8 bytes each).
-const MAX_CROSSINGS: usize = 1 << 27;
+/// The default budget of column crossings held in memory (8 bytes each, 1 GiB).
+pub const MAX_CROSSINGS: usize = 1 << 27;
 /// The most triangle references held by the bin grid.
 const MAX_BIN_ENTRIES: u64 = 1 << 25;
 
@@ -100,6 +100,13 @@ pub struct VoxelizeOptions {
     /// Keep only voxels whose closed cube meets a triangle (no inside test, so the
     /// mesh need not be watertight).
     pub surface_only: bool,
+    /// The most ray crossings (8 bytes each) a solid voxelization may hold; bounded
+    /// from the triangles before any work.
+    pub max_crossings: usize,
+    /// The most leaves the octree may have, estimated from the surface area before
+    /// any work (a surface leaf per unit of area: the leaves of a voxelized surface
+    /// are about 1–1.4 times its area in voxels).
+    pub max_leaves: usize,
 }
 
 impl Default for VoxelizeOptions {
@@ -107,6 +114,8 @@ impl Default for VoxelizeOptions {
         Self {
             resolution: Resolution::Depth(8),
             surface_only: false,
+            max_crossings: MAX_CROSSINGS,
+            max_leaves: crate::csg::DEFAULT_MAX_LEAVES,
         }
     }
 }
@@ -131,7 +140,7 @@ type Tri = [[i64; 3]; 3];
 /// let obj = "v 0 0 0\nv 4 0 0\nv 0 4 0\nv 4 4 0\nv 0 0 4\nv 4 0 4\nv 0 4 4\nv 4 4 4\n\
 ///            f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
 /// let mesh = tesseral::io::mesh::parse_obj(obj.as_bytes()).unwrap();
-/// let opts = VoxelizeOptions { resolution: Resolution::VoxelSize(0.5), surface_only: false };
+/// let opts = VoxelizeOptions { resolution: Resolution::VoxelSize(0.5), ..Default::default() };
 /// let model = voxelize(&mesh, &opts).unwrap();
 /// assert_eq!(model.tree.voxel_count(), 8 * 8 * 8);
 /// ```
@@ -224,11 +233,29 @@ pub fn voxelize(mesh: &TriMesh, options: &VoxelizeOptions) -> Result<Model, Voxe
             [0, 1, 2].map(|a| translate[a] + h * (origin[a] as f64 + p[a] as f64 / ONE as f64))
         })?;
     }
+    let area = surface_area(&tris);
+    if area > options.max_leaves as f64 {
+        return Err(VoxelizeError::TooLarge(format!(
+            "the surface at depth {depth} is about {area:.0} voxels in area, so the octree would have about that many leaves, more than the budget of {} (raise --max-leaves or --memory, or lower --depth)",
+            options.max_leaves
+        )));
+    }
+    if !options.surface_only {
+        // The budget is checked before any work, from the triangles alone.
+        let bound = crossing_bound(&tris);
+        if bound > options.max_crossings as u64 {
+            return Err(VoxelizeError::TooLarge(format!(
+                "a solid voxelization at depth {depth} needs up to {bound} ray crossings ({} MiB at 8 bytes each), more than the budget of {} (raise --memory, lower --depth, or use --surface-only)",
+                bound.saturating_mul(8) >> 20,
+                options.max_crossings
+            )));
+        }
+    }
     let bins = Bins::new(&tris, depth);
     let columns = if options.surface_only {
         Columns::default()
     } else {
-        Columns::new(&tris, depth).map_err(VoxelizeError::too_large)?
+        Columns::new(&tris, depth, options.max_crossings).map_err(VoxelizeError::too_large)?
     };
     let classifier = MeshClassifier {
         tris,
@@ -310,7 +337,7 @@ struct Columns {
 const DENSE_COLUMNS: i64 = 1 << 24;
 
 impl Columns {
-    fn new(tris: &[Tri], depth: u8) -> Result<Self, String> {
+    fn new(tris: &[Tri], depth: u8, max_crossings: usize) -> Result<Self, String> {
         let side = 1i64 << depth;
         let parts: Vec<Vec<u64>> = tris
             .par_chunks(4096)
@@ -318,7 +345,7 @@ impl Columns {
                 let mut out = Vec::new();
                 for t in chunk {
                     rasterize(t, side, &mut out);
-                    if out.len() > MAX_CROSSINGS {
+                    if out.len() > max_crossings {
                         break;
                     }
                 }
@@ -326,9 +353,9 @@ impl Columns {
             })
             .collect();
         let total: usize = parts.iter().map(Vec::len).sum();
-        if total > MAX_CROSSINGS {
+        if total > max_crossings {
             return Err(format!(
-                "more than {MAX_CROSSINGS} ray crossings at depth {depth}"
+                "more than {max_crossings} ray crossings at depth {depth}"
             ));
         }
         let mut entries: Vec<u64> = Vec::with_capacity(total);
@@ -405,6 +432,54 @@ impl Columns {
 
 /// Appends `(column << 32) | flip` for every column centre that `t`'s xy-projection
 /// covers.
+/// An upper bound on the ray crossings of a solid voxelization: per triangle, the
+/// column centres its projection can hold, at most those of its bounding box and at
+/// most `A + P/2 + 1` (Nosarzewska's bound on the lattice points of a convex region
+/// of area A and perimeter P). O(triangles).
+#[must_use]
+fn crossing_bound(tris: &[Tri]) -> u64 {
+    let one = ONE as f64;
+    tris.iter()
+        .map(|t| {
+            let p = t.map(|v| [v[0] as f64 / one, v[1] as f64 / one]);
+            let area = ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]))
+                .abs()
+                / 2.0;
+            if area == 0.0 {
+                return 0;
+            }
+            let len = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+            let perimeter = len(p[0], p[1]) + len(p[1], p[2]) + len(p[2], p[0]);
+            let span = |a: usize| {
+                let lo = p.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min);
+                let hi = p.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max);
+                (hi - lo).floor() + 2.0
+            };
+            let convex = area + perimeter / 2.0 + 1.0;
+            (span(0) * span(1)).min(convex).ceil() as u64
+        })
+        .sum()
+}
+
+/// The total area of the triangles in voxel units. O(triangles).
+fn surface_area(tris: &[Tri]) -> f64 {
+    let one = ONE as f64;
+    tris.iter()
+        .map(|t| {
+            let p = t.map(|v| v.map(|c| c as f64 / one));
+            let u = [0, 1, 2].map(|a| p[1][a] - p[0][a]);
+            let w = [0, 1, 2].map(|a| p[2][a] - p[0][a]);
+            let c = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() / 2.0
+        })
+        .sum()
+}
+
 fn rasterize(t: &Tri, side: i64, out: &mut Vec<u64>) {
     let [a, mut b, mut c] = *t;
     let (w, _) = edge_sign(a, b, c[0], c[1]);
@@ -771,6 +846,7 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(h),
                 surface_only: false,
+                ..Default::default()
             };
             let m = voxelize(&box_mesh(lo, hi), &opts).unwrap();
             m.tree.assert_valid();
@@ -790,6 +866,7 @@ mod tests {
         let opts = VoxelizeOptions {
             resolution: Resolution::VoxelSize(1.0),
             surface_only: false,
+            ..Default::default()
         };
         let whole = voxelize(&box_mesh([0.5; 3], [4.5; 3]), &opts).unwrap();
         assert_eq!(whole.tree.voxel_count(), 64);
@@ -820,6 +897,7 @@ mod tests {
         let opts = VoxelizeOptions {
             resolution: Resolution::VoxelSize(0.25),
             surface_only: false,
+            ..Default::default()
         };
         let v = voxelize(&m, &opts).unwrap();
         // L-shaped prism: area 6*2 + 2*4 = 20, height 3 → 60 units → 60 * 64 voxels.
@@ -827,6 +905,7 @@ mod tests {
         let shell = VoxelizeOptions {
             resolution: Resolution::VoxelSize(0.25),
             surface_only: true,
+            ..Default::default()
         };
         let s = voxelize(&m, &shell).unwrap();
         s.tree.assert_valid();
@@ -840,6 +919,41 @@ mod tests {
             });
             assert!(near, "{vox:?}");
         }
+    }
+
+    #[test]
+    fn the_crossing_bound_holds_and_the_budget_is_checked_first() {
+        let side = 1i64 << 8;
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |m: i64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % m as u64) as i64
+        };
+        for seed in 0..300 {
+            let t: Tri =
+                std::array::from_fn(|_| [next(side * ONE), next(side * ONE), next(side * ONE)]);
+            let mut out = Vec::new();
+            rasterize(&t, side, &mut out);
+            let bound = crossing_bound(&[t]);
+            assert!(
+                out.len() as u64 <= bound,
+                "seed {seed}: {} > {bound}",
+                out.len()
+            );
+        }
+        // A budget below the bound is refused before any work, naming the flag.
+        let opts = VoxelizeOptions {
+            resolution: Resolution::Depth(6),
+            max_crossings: 100,
+            ..Default::default()
+        };
+        let e = voxelize(&box_mesh([0.0; 3], [1.0; 3]), &opts).unwrap_err();
+        assert!(
+            matches!(e, VoxelizeError::TooLarge(_)) && e.to_string().contains("--memory"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -924,6 +1038,7 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(1.0),
                 surface_only: true,
+                ..Default::default()
             };
             let got = voxelize(&mesh, &opts).unwrap();
             got.tree.assert_valid();
@@ -995,6 +1110,7 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(h),
                 surface_only: false,
+                ..Default::default()
             };
             let got = voxelize(&mesh, &opts).unwrap();
             got.tree.assert_valid();
