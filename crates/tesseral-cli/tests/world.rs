@@ -396,3 +396,35 @@ fn item_2_coloured_meshes_carry_their_colours() {
         1
     );
 }
+
+#[test]
+fn collisions_follow_the_frame_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let tree = LinearOctree::from_voxels(3, [0; 3], (0..4).map(|x| [x, 0, 0])).unwrap();
+    let a = Model::new(tree.clone()).with_frame(Frame::new(0.5, [0.0; 3]));
+    // B's frame places it 3 voxels along x from A's: the solids overlap in one voxel.
+    let b = Model::new(tree.clone()).with_frame(Frame::new(0.5, [1.5, 0.0, 0.0]));
+    write_model(&d.join("a.tess"), &a).unwrap();
+    write_model(&d.join("b.tess"), &b).unwrap();
+    write_model(
+        &d.join("b0.tess"),
+        &Model::new(tree.clone()).with_frame(Frame::new(0.5, [0.0; 3])),
+    )
+    .unwrap();
+    let framed = json(d, &["collide", "a.tess", "b.tess", "--json"]);
+    let moved = json(
+        d,
+        &[
+            "collide", "a.tess", "b0.tess", "--offset", "3,0,0", "--json",
+        ],
+    );
+    assert_eq!(framed["overlap_voxels"], 1, "{framed}");
+    assert_eq!(framed["overlap_voxels"], moved["overlap_voxels"]);
+    write_model(
+        &d.join("c.tess"),
+        &Model::new(tree).with_frame(Frame::new(0.25, [0.0; 3])),
+    )
+    .unwrap();
+    fails(d, &["collide", "a.tess", "c.tess"], "voxel sizes differ");
+}

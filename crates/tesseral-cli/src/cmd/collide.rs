@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{clearance, interference, read_solid, Aabb, Placement, Rotation};
+use tesseral::motion::{clearance, interference, Aabb, Placement, Rotation};
 use tesseral::Voxel;
 
 /// Arguments of `tesseral collide`.
@@ -15,7 +15,9 @@ pub struct Args {
     a: PathBuf,
     /// The second octree file, turned by --rotate and then moved by --offset.
     b: PathBuf,
-    /// Integer offset X,Y,Z added to B's voxels (after the rotation).
+    /// Integer offset X,Y,Z in A's voxels, added to B's voxels (after the rotation).
+    /// B is first placed where its frame puts it in A's frame: the two frames must
+    /// have equal voxel sizes and placements a whole number of voxels apart.
     #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true, default_value = "0,0,0")]
     offset: Voxel,
     /// Rotation of B by quarter turns about the origin, applied left to right, such
@@ -58,11 +60,19 @@ struct Report {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let a = read_solid(&args.a).context("reading the first octree")?;
-    let b = read_solid(&args.b).context("reading the second octree")?;
+    let a = super::octree::read(&args.a).context("reading the first octree")?;
+    let b = super::octree::read(&args.b).context("reading the second octree")?;
+    // Two frames line up exactly or not at all: B's lattice origin sits at a whole
+    // number of A's voxels, which is added to --offset (in A's voxels).
+    let frame_offset = a
+        .frame
+        .offset_to(&b.frame)
+        .with_context(|| format!("colliding {} and {}", args.a.display(), args.b.display()))?;
+    let offset: Voxel = std::array::from_fn(|i| args.offset[i] + frame_offset[i]);
+    let (a, b) = (a.tree, b.tree);
     let place = Placement {
         rotation: args.rotate,
-        offset: args.offset,
+        offset,
     };
     let hit = interference(&a, &b, place, args.contacts);
     let report = Report {
