@@ -3,14 +3,14 @@
 
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand};
 
 mod cmd;
 
 /// Octrees of 3-D solids and surfaces.
 #[derive(Parser)]
 #[command(name = "tesseral", version, about)]
-struct Cli {
+pub(crate) struct Cli {
     #[command(subcommand)]
     command: Command,
 }
@@ -51,10 +51,19 @@ enum Command {
     Render(cmd::render::Args),
     /// Builds a scene's octree and writes it to a file.
     Build(cmd::build::Args),
+    /// Prints a shell completion script (bash, zsh, fish, elvish, powershell).
+    Completions(cmd::shell::CompletionsArgs),
+    /// Prints the man page (roff; view it with `tesseral man | man -l -`).
+    Man(cmd::shell::ManArgs),
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let matches = cmd::help::grouped(Cli::command()).get_matches();
+    let cli = match Cli::from_arg_matches(&matches) {
+        Ok(cli) => cli,
+        Err(e) => e.exit(),
+    };
+    cmd::output::install_signal_handler();
     let result = match cli.command {
         Command::Calc(args) => cmd::calc::run(args),
         Command::Replay(args) => cmd::replay::run(args),
@@ -73,6 +82,8 @@ fn main() -> ExitCode {
         Command::Complement(args) => cmd::transform::complement(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Build(args) => cmd::build::run(args),
+        Command::Completions(args) => cmd::shell::completions(&args, Cli::command()),
+        Command::Man(args) => cmd::shell::man(&args, Cli::command()),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -105,8 +116,12 @@ fn one_line(err: &anyhow::Error) -> String {
 
 /// A reader that closed our stdout early (`tesseral ... | head`) is not an error.
 fn is_broken_pipe(err: &anyhow::Error) -> bool {
+    use std::io::ErrorKind::BrokenPipe;
     err.chain().any(|e| {
         e.downcast_ref::<std::io::Error>()
-            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            .is_some_and(|io| io.kind() == BrokenPipe)
+            // serde_json wraps the writer's error in its own type.
+            || e.downcast_ref::<serde_json::Error>()
+                .is_some_and(|j| j.io_error_kind() == Some(BrokenPipe))
     })
 }

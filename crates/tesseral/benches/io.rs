@@ -12,7 +12,7 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
-use tesseral::io::{binvox, native, octomap, VoxelModel};
+use tesseral::io::{binvox, native, octomap, Model};
 use tesseral::linear::LinearOctree;
 use tesseral::mesh::{boundary_mesh, voxelize, Resolution, TriMesh, VoxelizeOptions};
 
@@ -33,7 +33,7 @@ fn random_tree(n: usize, side: i64, seed: u64) -> LinearOctree {
 fn bench_io(c: &mut Criterion) {
     let bt_bytes = match std::env::var_os("TESSERAL_BT_FILE") {
         Some(p) => std::fs::read(&p).expect("TESSERAL_BT_FILE must be readable"),
-        None => octomap::encode_bt(&VoxelModel::new(random_tree(1_000_000, 512, 8))).unwrap(),
+        None => octomap::encode_bt(&Model::new(random_tree(1_000_000, 512, 8))).unwrap(),
     };
     let model = octomap::decode_bt(&bt_bytes, Path::new("b.bt")).unwrap();
     let leaves = model.tree.leaf_count();
@@ -53,7 +53,7 @@ fn bench_io(c: &mut Criterion) {
     g.bench_function(format!("tess_write/{leaves}_leaves"), |b| {
         b.iter(|| native::encode(black_box(&model)))
     });
-    let small = VoxelModel::new(random_tree(200_000, 256, 9));
+    let small = Model::new(random_tree(200_000, 256, 9));
     let bv = binvox::encode(&small).unwrap();
     g.throughput(Throughput::Elements(small.tree.voxel_count()));
     g.bench_function("binvox_read/200k_voxels_256", |b| {

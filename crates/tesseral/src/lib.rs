@@ -1,7 +1,7 @@
 //! # tesseral
 //!
 //! Octrees of 3-D solids and surfaces. See `ARCHITECTURE.md` at the repository root
-//! for how the parts fit together, and `../shared/DESIGN.md` for the conventions
+//! for how the parts fit together, and `docs/conventions.md` for the conventions
 //! every module shares (axes, child labels, depth, voxel centres).
 //!
 //! Conventions in one breath: x east, y north, z up; a child label is
@@ -16,6 +16,7 @@ pub mod dynamic;
 pub mod io;
 pub mod linear;
 pub mod mesh;
+pub mod model;
 pub mod motion;
 pub mod pointer;
 pub mod render;

@@ -12,9 +12,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use rand::{Rng, SeedableRng};
-use tesseral::io::{binvox, native, octomap, vox, xyz, ColorMap, Frame, VoxelModel};
+use tesseral::io::{binvox, native, octomap, vox, xyz, Frame, Model};
 use tesseral::linear::LinearOctree;
 use tesseral::mesh::{self, Resolution, VoxelizeOptions};
+use tesseral::model::Layer;
 
 struct Counting;
 static LIVE: AtomicUsize = AtomicUsize::new(0);
@@ -181,22 +182,28 @@ fn sample_trees() -> Vec<LinearOctree> {
         .collect()
 }
 
-fn models() -> Vec<VoxelModel> {
+fn models() -> Vec<Model> {
     sample_trees()
         .into_iter()
         .map(|tree| {
-            let colors: ColorMap = tree
-                .voxels()
-                .map(|v| (v, [v[0] as u8, 3, 4, 255]))
-                .collect();
-            VoxelModel {
+            let pairs = tree.voxels().map(|v| (v, [v[0] as u8, 3, 4, 255]));
+            let colors = Layer::from_voxels(tree.depth(), tree.origin(), pairs).unwrap();
+            // Free space and log-odds too, so every section of every format is fuzzed.
+            let free = tree.complement();
+            let odds = Layer::from_voxels(
+                tree.depth(),
+                tree.origin(),
+                tree.voxels().take(64).map(|v| (v, 0.85f32)),
+            )
+            .unwrap();
+            Model::from_parts(
                 tree,
-                frame: Some(Frame {
-                    voxel_size: 0.25,
-                    translate: [1.0, 2.0, 3.0],
-                }),
-                colors: Some(colors),
-            }
+                Frame::new(0.25, [1.0, 2.0, 3.0]),
+                Some(colors),
+                Some(free),
+                Some(odds),
+            )
+            .unwrap()
         })
         .collect()
 }
@@ -266,7 +273,7 @@ fn fuzz_octomap_ot() {
     seeds.extend(
         sample_trees()
             .into_iter()
-            .map(|t| octomap::encode_ot(&VoxelModel::new(t)).unwrap()),
+            .map(|t| octomap::encode_ot(&Model::new(t)).unwrap()),
     );
     fuzz(
         "ot",

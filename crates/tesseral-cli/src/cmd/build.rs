@@ -6,6 +6,9 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use tesseral::csg::Scene;
 
+use super::budget::Budget;
+use super::octree;
+
 /// Arguments of `tesseral build`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -17,15 +20,21 @@ pub struct Args {
     /// Print the size and timing as JSON on stdout.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.scene], &args.limits)?;
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
-    let tree = scene.build()?;
+    let model = args.budget.build_scene_model(&args.scene)?;
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
-    tesseral::io::write_octree(&args.output, &tree)
+    octree::save(&args.output, &model, &args.limits, &Default::default())
         .with_context(|| format!("writing {}", args.output.display()))?;
+    let tree = &model.tree;
     if args.json {
         let out = serde_json::json!({
             "scene": args.scene,
@@ -38,8 +47,9 @@ pub fn run(args: Args) -> Result<()> {
             "voxels": tree.voxel_count(),
             "leaves_by_depth": tree.leaves_by_depth(),
             "build_ms": build_ms,
+            "colors": model.colors.as_ref().map(|c| c.region_count()),
         });
-        println!("{out}");
+        crate::outln!("{out}")?;
     }
     Ok(())
 }

@@ -25,6 +25,11 @@ pub struct Args {
     /// Show the digit-by-digit work with carries, as the papers lay it out.
     #[arg(long, global = true)]
     explain: bool,
+    /// Print JSON: `result` (the code, or `x y z` for decode), `coordinates` (decode
+    /// and encode), `carry` (the digit lost out of a bounded space, 0 if none),
+    /// `digits` (N, or null for the hypercube), `explanation` (lines, with --explain).
+    #[arg(long, global = true)]
+    json: bool,
     #[command(subcommand)]
     op: Op,
 }
@@ -183,16 +188,7 @@ pub fn run(args: Args) -> Result<()> {
                     explain_add(&mode, ca, cb, &mut out);
                 }
                 writeln!(out, "{}", mode.show(r.code))?;
-                print!("{}", tidy(&out));
-                if r.carry != 0 {
-                    eprintln!(
-                        "note: carry {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
-                        r.carry,
-                        axes_of(r.carry),
-                        mode.depth()
-                    );
-                }
-                return Ok(());
+                return finish(&args, &mode, &out, None, ("carry", r.carry));
             }
             let sum = s
                 .checked_add_signed(ca, cb)
@@ -215,16 +211,8 @@ pub fn run(args: Args) -> Result<()> {
                 explain_sub(&mode, ca, cb, &mut out)?;
             }
             writeln!(out, "{}", mode.show(code))?;
-            print!("{}", tidy(&out));
-            if mode.bounded && r.carry != 0 {
-                eprintln!(
-                    "note: borrow {} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
-                    r.carry,
-                    axes_of(r.carry),
-                    mode.depth()
-                );
-            }
-            return Ok(());
+            let carry = if mode.bounded { r.carry } else { 0 };
+            return finish(&args, &mode, &out, None, ("borrow", carry));
         }
         Op::Neg { a } => {
             let ca = mode.parse("A", a)?;
@@ -261,22 +249,60 @@ pub fn run(args: Args) -> Result<()> {
                 explain_bits(&mode, code, &mut out, true);
             }
             writeln!(out, "{}", mode.show(code))?;
+            return finish(&args, &mode, &out, Some(p), ("carry", 0));
         }
         Op::Decode { code } => {
             let c = mode.parse("CODE", code)?;
             if args.explain {
                 explain_bits(&mode, c, &mut out, false);
             }
-            if mode.bounded {
-                let [x, y, z] = s.decode_unsigned(c);
-                writeln!(out, "{x} {y} {z}")?;
+            let p = if mode.bounded {
+                s.decode_unsigned(c).map(|v| v as i64)
             } else {
-                let [x, y, z] = s.decode_signed(c);
-                writeln!(out, "{x} {y} {z}")?;
-            }
+                s.decode_signed(c)
+            };
+            writeln!(out, "{} {} {}", p[0], p[1], p[2])?;
+            return finish(&args, &mode, &out, Some(p), ("carry", 0));
         }
     }
-    print!("{}", tidy(&out));
+    finish(&args, &mode, &out, None, ("carry", 0))
+}
+
+/// Prints the work and result (text, or JSON with --json), and notes on stderr a
+/// carry (or borrow) lost out of a bounded space.
+fn finish(
+    args: &Args,
+    mode: &Mode,
+    out: &str,
+    coordinates: Option<[i64; 3]>,
+    (kind, carry): (&str, u8),
+) -> Result<()> {
+    let text = tidy(out);
+    if args.json {
+        let mut lines: Vec<&str> = text.lines().collect();
+        let result = lines.pop().unwrap_or_default();
+        let mut v = serde_json::json!({
+            "result": result,
+            "carry": carry,
+            "digits": mode.bounded.then(|| mode.depth()),
+        });
+        if let Some(p) = coordinates {
+            v["coordinates"] = serde_json::json!(p);
+        }
+        if args.explain {
+            v["explanation"] = serde_json::json!(lines);
+        }
+        crate::outln!("{v}")?;
+    } else {
+        crate::out!("{text}")?;
+    }
+    if carry != 0 {
+        eprintln!(
+            "note: {kind} {carry} lost out of the top digit (along {}); the result wrapped around the {}-digit space",
+            axes_of(carry),
+            mode.depth()
+        );
+    }
     Ok(())
 }
 
@@ -472,7 +498,7 @@ fn explain_sub(mode: &Mode, a: u128, b: u128, out: &mut String) -> Result<()> {
     Ok(())
 }
 
-/// The bit interleave of Harakal & Chmúrny §3 (x in bit 0 of a digit, DESIGN.md).
+/// The bit interleave of Harakal & Chmúrny §3 (x in bit 0 of a digit, docs/conventions.md).
 fn explain_bits(mode: &Mode, code: u128, out: &mut String, encoding: bool) {
     let n = if mode.bounded {
         mode.depth()

@@ -12,13 +12,30 @@ use anyhow::{bail, Result};
 use tesseral::io::{self, ReadOptions, WriteOptions};
 use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
+use super::budget::Budget;
+use super::octree;
+
+fn output_is_stdout(path: &std::path::Path) -> bool {
+    super::output::is_stdio(path)
+}
+
+/// The mesh formats read (voxelized) and written (meshed).
+const MESH_IN: [&str; 3] = ["stl", "obj", "ply"];
+const MESH_OUT: [&str; 4] = ["stl", "obj", "ply", "glb"];
+
 /// Arguments of `tesseral convert`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply.
+    /// The input file: .tess, .xyz, .binvox, .vox, .bt, .ot, a mesh .stl, .obj, .ply,
+    /// or a .tss scene (built as `build` does).
     pub input: PathBuf,
-    /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj, .ply, .glb.
-    pub output: PathBuf,
+    /// The output file: .tess, .xyz, .binvox, .vox, .bt, .ot, or a mesh .stl, .obj,
+    /// .ply, .glb (or give it with -o).
+    #[arg(value_name = "OUTPUT", required_unless_present = "output")]
+    pub output_positional: Option<PathBuf>,
+    /// The output file, as the second argument.
+    #[arg(short, long, conflicts_with = "output_positional")]
+    pub output: Option<PathBuf>,
     /// Voxelize an input mesh with 2^DEPTH voxels along its longest side (default 8).
     #[arg(long, conflicts_with = "voxel_size")]
     pub depth: Option<u8>,
@@ -36,10 +53,44 @@ pub struct Args {
     /// Print a summary as JSON.
     #[arg(long)]
     pub json: bool,
+    #[command(flatten)]
+    pub limits: octree::OutArgs,
+    #[command(flatten)]
+    pub budget: Budget,
 }
 
 /// Runs the command.
-pub fn run(args: Args) -> Result<()> {
+pub fn run(mut args: Args) -> Result<()> {
+    let Some(out) = args.output.take().or(args.output_positional.take()) else {
+        bail!("convert: give the output file, as `convert IN OUT` or `convert IN -o OUT`");
+    };
+    octree::guard(&out, &[&args.input], &args.limits)?;
+    if output_is_stdout(&out) && args.json {
+        bail!("--json: standard output already holds the octree (-o -)");
+    }
+    // Flags that do not apply are errors, not silently ignored.
+    let mesh_in = MESH_IN.contains(&io::extension(&args.input).as_str());
+    let mesh_out = MESH_OUT.contains(&args.limits.format_of(&out).as_str());
+    if !mesh_in {
+        for (flag, given) in [
+            ("--depth", args.depth.is_some()),
+            ("--voxel-size", args.voxel_size.is_some()),
+            ("--surface-only", args.surface_only),
+        ] {
+            if given {
+                bail!(
+                    "{flag} voxelizes a mesh input (.stl, .obj, .ply); {} is not a mesh",
+                    args.input.display()
+                );
+            }
+        }
+    }
+    if args.smooth && !mesh_out {
+        bail!(
+            "--smooth shapes a mesh output (.stl, .obj, .ply, .glb); {} is not a mesh",
+            out.display()
+        );
+    }
     let resolution = match (args.depth, args.voxel_size) {
         (Some(d), _) => {
             if d > MAX_VOXELIZE_DEPTH {
@@ -66,24 +117,25 @@ pub fn run(args: Args) -> Result<()> {
             smooth: args.smooth,
         },
     };
-    let model = io::read_model_with(&args.input, &read).map_err(|e| anyhow::anyhow!("{e}"))?;
-    io::write_model_with(&args.output, &model, &write).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let model = octree::read_model(&args.input, &args.budget, &read)?;
+    octree::save(&out, &model, &args.limits, &write)?;
     if args.json {
         let bbox = model.tree.bbox();
         let summary = serde_json::json!({
             "input": args.input,
-            "output": args.output,
+            "output": out,
             "voxels": model.tree.voxel_count(),
             "leaves": model.tree.leaf_count(),
             "depth": model.tree.depth(),
             "origin": model.tree.origin(),
             "bbox_min": bbox.map(|b| b.0),
             "bbox_max": bbox.map(|b| b.1),
-            "voxel_size": model.frame.map(|f| f.voxel_size),
-            "translate": model.frame.map(|f| f.translate),
-            "colors": model.colors.as_ref().map(|c| c.len()),
+            "voxel_size": model.frame.voxel_size,
+            "translate": model.frame.translate,
+            "colors": model.colors.as_ref().map(|c| c.voxel_count()),
+            "free_voxels": model.free.as_ref().map(|f| f.voxel_count()),
         });
-        println!("{summary}");
+        crate::outln!("{summary}")?;
     }
     Ok(())
 }

@@ -5,17 +5,22 @@ use std::path::PathBuf;
 use anyhow::Result;
 use serde::Serialize;
 
+use super::budget::Budget;
 use super::octree;
 
 /// Arguments of `tesseral info`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The octree file; its format is chosen by the extension.
+    /// The octree file (its format is chosen by the extension), or a .tss scene,
+    /// which is built.
     file: PathBuf,
     /// Print JSON (keys: voxels, leaves, depth, origin, bbox_min, bbox_max,
-    /// leaves_by_depth, bytes).
+    /// leaves_by_depth, bytes, voxel_size, translate, world_min, world_max, colors,
+    /// colored_voxels, free_voxels, free_leaves, log_odds).
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 /// The `--json` output. Its keys are a public interface: only ever add to them.
@@ -37,11 +42,31 @@ struct Info {
     leaves_by_depth: Vec<u64>,
     /// Memory of the linear octree's leaves: 8 bytes per leaf.
     bytes: u64,
+    /// The side of a voxel in world units.
+    voxel_size: f64,
+    /// The world position of voxel (0, 0, 0)'s lowest corner.
+    translate: [f64; 3],
+    /// The world box of the black voxels (lowest corner), or null when empty.
+    world_min: Option<[f64; 3]>,
+    /// The world box of the black voxels (highest corner), or null when empty.
+    world_max: Option<[f64; 3]>,
+    /// Distinct colours, or null when the file has no colours.
+    colors: Option<usize>,
+    /// Black voxels with a colour.
+    colored_voxels: u64,
+    /// Voxels known to be free, or null when the file has no free space.
+    free_voxels: Option<u64>,
+    /// Leaves of the free space, or null.
+    free_leaves: Option<usize>,
+    /// Whether per-voxel occupancy log-odds are stored.
+    log_odds: bool,
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let tree = octree::read(&args.file)?;
+    let model = octree::read_model(&args.file, &args.budget, &Default::default())?;
+    let tree = &model.tree;
     let bbox = tree.bbox();
+    let frame = model.frame;
     let info = Info {
         voxels: tree.voxel_count(),
         leaves: tree.leaf_count(),
@@ -51,27 +76,57 @@ pub fn run(args: Args) -> Result<()> {
         bbox_max: bbox.map(|b| b.1),
         leaves_by_depth: tree.leaves_by_depth(),
         bytes: 8 * tree.leaf_count() as u64,
+        voxel_size: frame.voxel_size,
+        translate: frame.translate,
+        world_min: bbox.map(|b| frame.voxel_corner(b.0)),
+        world_max: bbox.map(|b| frame.voxel_corner(b.1.map(|c| c + 1))),
+        colors: model.colors.as_ref().map(|c| c.region_count()),
+        colored_voxels: model.colors.as_ref().map_or(0, |c| c.voxel_count()),
+        free_voxels: model.free.as_ref().map(|f| f.voxel_count()),
+        free_leaves: model.free.as_ref().map(|f| f.leaf_count()),
+        log_odds: model.log_odds.is_some(),
     };
     if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        crate::outln!("{}", serde_json::to_string_pretty(&info)?)?;
         return Ok(());
     }
-    println!("file     {}", args.file.display());
-    println!("voxels   {}", info.voxels);
-    println!("leaves   {}", info.leaves);
-    println!(
+    crate::outln!("file     {}", args.file.display())?;
+    crate::outln!("voxels   {}", info.voxels)?;
+    crate::outln!("leaves   {}", info.leaves)?;
+    crate::outln!(
         "space    depth {} ({} per axis) from {}",
         info.depth,
         1u64 << info.depth,
         octree::fmt_voxel(info.origin)
-    );
+    )?;
     match bbox {
-        Some((lo, hi)) => println!(
+        Some((lo, hi)) => crate::outln!(
             "bbox     {} to {}",
             octree::fmt_voxel(lo),
             octree::fmt_voxel(hi)
-        ),
-        None => println!("bbox     (empty)"),
+        )?,
+        None => crate::outln!("bbox     (empty)")?,
+    }
+    crate::outln!("frame    {}", frame)?;
+    if let (Some(lo), Some(hi)) = (info.world_min, info.world_max) {
+        crate::outln!(
+            "world    ({}, {}, {}) to ({}, {}, {})",
+            lo[0],
+            lo[1],
+            lo[2],
+            hi[0],
+            hi[1],
+            hi[2]
+        )?;
+    }
+    if let Some(n) = info.colors {
+        crate::outln!("colours  {n} distinct on {} voxels", info.colored_voxels)?;
+    }
+    if let (Some(v), Some(l)) = (info.free_voxels, info.free_leaves) {
+        crate::outln!("free     {v} voxels in {l} leaves")?;
+    }
+    if info.log_odds {
+        crate::outln!("log-odds stored per known voxel")?;
     }
     let by_depth: Vec<String> = info
         .leaves_by_depth
@@ -80,12 +135,12 @@ pub fn run(args: Args) -> Result<()> {
         .filter(|(_, &n)| n > 0)
         .map(|(d, n)| format!("{d}:{n}"))
         .collect();
-    println!("by depth {}", by_depth.join(" "));
+    crate::outln!("by depth {}", by_depth.join(" "))?;
     let per_voxel = if info.voxels == 0 {
         0.0
     } else {
         info.bytes as f64 / info.voxels as f64
     };
-    println!("bytes    {} ({per_voxel:.3} per voxel)", info.bytes);
+    crate::outln!("bytes    {} ({per_voxel:.3} per voxel)", info.bytes)?;
     Ok(())
 }

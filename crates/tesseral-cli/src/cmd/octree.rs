@@ -4,39 +4,172 @@
 use std::path::Path;
 
 use anyhow::Result;
-use tesseral::linear::{Axis, LinearOctree};
+use tesseral::linear::Axis;
+use tesseral::model::Model;
 
-/// Reads an octree, in any format `tesseral::io` knows by the extension.
-pub fn read(path: &Path) -> Result<LinearOctree> {
+use super::budget::Budget;
+use super::output::{self, Limits};
+use super::stdio::{self, Stdin};
+
+/// Reads a model: a `.tss` scene is built within `budget` with its frame (the
+/// scene's voxel size and lower corner) and its objects' colours; any other file is
+/// read in the format its extension names, with what the format carries.
+pub fn read_model(
+    path: &Path,
+    budget: &Budget,
+    options: &tesseral::io::ReadOptions,
+) -> Result<Model> {
+    if output::is_stdio(path) {
+        let stdin = Stdin::read()?;
+        return read_model(&stdin.path, budget, options).map_err(|e| stdin.rename(&e));
+    }
+    if tesseral::io::extension(path) == "tss" {
+        return budget.build_scene_model(path);
+    }
     // The library's message already names the file and its cause; keep it as one
     // line rather than repeating the cause from the error chain.
-    tesseral::io::read_octree(path).map_err(|e| anyhow::anyhow!("{e}"))
+    tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
-/// The most voxels a command writes as a voxel list (`.xyz` holds one line per
-/// voxel, so a scaled-up or complemented solid could otherwise fill the disk).
-pub const MAX_LISTED_VOXELS: u64 = 1 << 27;
+/// Reads a model from an octree file (any format `tesseral::io` knows by the
+/// extension), a `.tss` scene (built within the default budget), or `-` for
+/// standard input.
+pub fn read(path: &Path) -> Result<Model> {
+    read_model(path, &Budget::default(), &Default::default())
+}
 
-/// Writes an octree atomically, in the format named by the extension, and prints a
-/// one-line summary.
-pub fn write(path: &Path, tree: &LinearOctree) -> Result<()> {
-    if tesseral::io::extension(path) == "xyz" && tree.voxel_count() > MAX_LISTED_VOXELS {
-        anyhow::bail!(
-            "{}: {} voxels is too many for a voxel list (at most {MAX_LISTED_VOXELS}); \
-             write a block-based format instead",
-            path.display(),
-            tree.voxel_count()
-        );
+/// The output flags of commands that write an octree.
+#[derive(clap::Args, Clone, Debug)]
+pub struct OutArgs {
+    #[command(flatten)]
+    pub limits: Limits,
+    /// The format written to standard output by `-o -`: an extension such as tess,
+    /// xyz or stl.
+    #[arg(long, value_name = "EXT")]
+    pub format: Option<String>,
+}
+
+impl OutArgs {
+    /// The format of `path`: its extension, or `--format` for `-`.
+    pub fn format_of(&self, path: &Path) -> String {
+        match (&self.format, output::is_stdio(path)) {
+            (Some(f), true) => f.trim_start_matches('.').to_ascii_lowercase(),
+            _ => tesseral::io::extension(path),
+        }
     }
-    tesseral::io::write_octree(path, tree).map_err(|e| anyhow::anyhow!("{e}"))?;
-    println!(
-        "wrote {}: {} voxels, {} leaves, depth {}, origin {}",
+}
+
+/// Checks an octree output before any work: a format we write (`--format` for `-`,
+/// and only then), and not an input.
+pub fn guard(path: &Path, inputs: &[&Path], out: &OutArgs) -> Result<()> {
+    let formats = output::octree_formats();
+    match (output::is_stdio(path), &out.format) {
+        (true, None) => anyhow::bail!(
+            "--output -: give the format of standard output with --format (one of {})",
+            formats.join(", ")
+        ),
+        (false, Some(f)) => {
+            anyhow::bail!("--format {f}: only for --output - (a file's extension names its format)")
+        }
+        (true, Some(_)) => {
+            let f = out.format_of(path);
+            if !formats.contains(&f.as_str()) {
+                anyhow::bail!(
+                    "--format {f}: not a format we write (one of {})",
+                    formats.join(", ")
+                );
+            }
+            Ok(())
+        }
+        (false, None) => output::guard("--output", path, &formats, inputs),
+    }
+}
+
+/// Writes a model to `path` (or standard output for `-`), after checking its
+/// estimated size against `--max-output`.
+pub fn save(
+    path: &Path,
+    model: &Model,
+    out: &OutArgs,
+    options: &tesseral::io::WriteOptions,
+) -> Result<()> {
+    let ext = out.format_of(path);
+    let estimate = tesseral::io::estimate_output_bytes(&model.tree, &ext);
+    if let Some(bytes) = estimate {
+        output::check_size(path, bytes, out.limits.max_output)?;
+    }
+    let write = |p: &Path| {
+        tesseral::io::write_model_with(p, model, options).map_err(|e| anyhow::anyhow!("{e}"))
+    };
+    if output::is_stdio(path) {
+        stdio::to_stdout(&ext, write)
+    } else {
+        output::with_progress(estimate.unwrap_or(0), || write(path))
+    }
+}
+
+/// How a command that writes an octree reports: a line of text, or with `--json` an
+/// object with the keys `output`, `voxels`, `leaves`, `depth`, `origin`, `bbox_min`,
+/// `bbox_max` (null when empty), plus the command's own keys in `extra`.
+pub struct Report {
+    /// Print JSON instead of text.
+    pub json: bool,
+    /// The command's own keys (a JSON object), added to the JSON output.
+    pub extra: serde_json::Value,
+}
+
+/// Writes a model atomically, in the format named by the extension, and reports it
+/// (see [`Report`]; JSON also has `voxel_size` and `translate`, the frame). Refuses,
+/// before writing, an output estimated above `--max-output`.
+pub fn write(path: &Path, model: &Model, out: &OutArgs, report: Report) -> Result<()> {
+    let tree = &model.tree;
+    if output::is_stdio(path) && report.json {
+        anyhow::bail!("--json: standard output already holds the octree (-o -)");
+    }
+    save(path, model, out, &Default::default())?;
+    if output::is_stdio(path) {
+        // Standard output holds the octree; the report goes to standard error.
+        eprintln!(
+            "wrote <stdout>: {} voxels, {} leaves, depth {}, origin {}",
+            tree.voxel_count(),
+            tree.leaf_count(),
+            tree.depth(),
+            fmt_voxel(tree.origin())
+        );
+        return Ok(());
+    }
+    if report.json {
+        let bbox = tree.bbox();
+        let mut v = serde_json::json!({
+            "output": path,
+            "voxels": tree.voxel_count(),
+            "leaves": tree.leaf_count(),
+            "depth": tree.depth(),
+            "origin": tree.origin(),
+            "bbox_min": bbox.map(|b| b.0),
+            "bbox_max": bbox.map(|b| b.1),
+            "voxel_size": model.frame.voxel_size,
+            "translate": model.frame.translate,
+        });
+        if let (Some(map), serde_json::Value::Object(extra)) = (v.as_object_mut(), report.extra) {
+            map.extend(extra);
+        }
+        crate::outln!("{v}")?;
+        return Ok(());
+    }
+    let frame = if model.frame.is_unit() {
+        String::new()
+    } else {
+        format!(", {}", model.frame)
+    };
+    crate::outln!(
+        "wrote {}: {} voxels, {} leaves, depth {}, origin {}{frame}",
         path.display(),
         tree.voxel_count(),
         tree.leaf_count(),
         tree.depth(),
         fmt_voxel(tree.origin())
-    );
+    )?;
     Ok(())
 }
 

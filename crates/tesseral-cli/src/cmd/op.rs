@@ -33,9 +33,15 @@ pub struct Args {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, op.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
 }
 
 pub fn run(args: Args) -> Result<()> {
+    octree::guard(&args.output, &[&args.a, &args.b], &args.limits)?;
     let a = octree::read(&args.a)?;
     let b = octree::read(&args.b)?;
     let op = match args.op {
@@ -44,8 +50,24 @@ pub fn run(args: Args) -> Result<()> {
         OpArg::Difference => SetOp::Difference,
         OpArg::Xor => SetOp::SymmetricDifference,
     };
-    let r = a
-        .set_op(&b, op)
-        .with_context(|| format!("combining {} and {}", args.a.display(), args.b.display()))?;
-    octree::write(&args.output, &r)
+    let r = a.set_op(&b, op).with_context(|| {
+        format!(
+            "combining {} ({}) and {} ({})",
+            args.a.display(),
+            a.frame,
+            args.b.display(),
+            b.frame
+        )
+    })?;
+    let name = match args.op {
+        OpArg::Union => "union",
+        OpArg::Intersection => "intersection",
+        OpArg::Difference => "difference",
+        OpArg::Xor => "xor",
+    };
+    let report = octree::Report {
+        json: args.json,
+        extra: serde_json::json!({ "op": name }),
+    };
+    octree::write(&args.output, &r, &args.limits, report)
 }

@@ -5,11 +5,13 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::motion::{estimate_plan, plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
 use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
+use super::budget::Budget;
 use super::collide::parse_voxel;
+use super::output::{self, Size};
 
 /// Arguments of `tesseral plan`.
 #[derive(clap::Args)]
@@ -48,6 +50,11 @@ pub struct Args {
     /// The view of the picture: top, iso, front or side.
     #[arg(long, default_value = "top", value_parser = parse_view)]
     view: View,
+    /// The picture's size, WIDTHxHEIGHT (with --output). [default: 800x600]
+    #[arg(long, requires = "output", value_parser = output::parse_size)]
+    size: Option<Size>,
+    #[command(flatten)]
+    budget: Budget,
 }
 
 fn parse_view(s: &str) -> Result<View, String> {
@@ -96,6 +103,9 @@ struct NotFound {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(path) = &args.output {
+        output::guard("--output", path, &["png"], &[&args.env, &args.obj])?;
+    }
     let env = read_solid(&args.env).context("reading the environment")?;
     let obj = read_solid(&args.obj).context("reading the object")?;
     let options = PlanOptions {
@@ -105,6 +115,20 @@ pub fn run(args: Args) -> Result<()> {
         region: args.region,
         ..PlanOptions::default()
     };
+    // Refuse a region too large for memory before the search grows into it; a
+    // region the object cannot use at all is left to `plan` to explain.
+    if let Ok(e) = estimate_plan(&env, &obj, args.from, args.to, &options) {
+        let hint = if args.region.is_some() {
+            ", or give a smaller --region"
+        } else {
+            ", or lower --margin (or give --region)"
+        };
+        args.budget.check_memory(
+            &format!("the planning region ({} free cells)", e.free_cells),
+            e.bytes,
+            hint,
+        )?;
+    }
     let result = plan(&env, &obj, args.from, args.to, &options);
     if let Some(path) = &args.output {
         picture(
@@ -176,7 +200,13 @@ fn picture(
     args: &Args,
     waypoints: Option<&[Voxel]>,
 ) -> Result<()> {
+    let size = args.size.unwrap_or(Size {
+        width: 800,
+        height: 600,
+    });
     let opts = RenderOptions {
+        width: size.width,
+        height: size.height,
         camera: Camera::view(args.view),
         ..RenderOptions::default()
     };

@@ -9,18 +9,22 @@ use tesseral::io;
 use tesseral::linear::LinearOctree;
 use tesseral::render::{self, Camera, Clip, Projection, RenderOptions, View};
 
+use super::budget::Budget;
+use super::octree;
+use super::output::{self, Size, MAX_SIDE};
+
 /// Arguments of `tesseral render`.
 #[derive(clap::Args)]
 pub struct Args {
     /// A scene (`.tss`) or an octree file in any format `tesseral` reads. An octree
     /// file is drawn as it is, never rebuilt.
     input: PathBuf,
-    /// The PNG file to write.
+    /// The PNG file to write (`-`: standard output).
     #[arg(short, long)]
     output: PathBuf,
     /// Image size, WIDTHxHEIGHT (for a contact sheet: of each view).
-    #[arg(long, default_value = "800x600")]
-    size: String,
+    #[arg(long, default_value = "800x600", value_parser = output::parse_size)]
+    size: Size,
     /// A named view: iso, front, top or side.
     #[arg(long, default_value = "iso")]
     view: String,
@@ -36,9 +40,9 @@ pub struct Args {
     /// Perspective projection instead of orthographic.
     #[arg(long)]
     perspective: bool,
-    /// Vertical field of view of the perspective camera, degrees.
-    #[arg(long, default_value_t = 40.0)]
-    fov: f64,
+    /// Vertical field of view of the perspective camera, degrees (with --perspective).
+    #[arg(long, requires = "perspective")]
+    fov: Option<f64>,
     /// Draw the outlines of the octree blocks (the decomposition).
     #[arg(long)]
     outline: bool,
@@ -56,17 +60,18 @@ pub struct Args {
     /// (scene units for a scene, voxels for an octree file) with its block outlines.
     #[arg(long)]
     slice: Option<String>,
-    /// Pixels per voxel of a slice.
-    #[arg(long, default_value_t = 4)]
-    slice_scale: usize,
+    /// Pixels per voxel of a slice (with --slice). [default: 4]
+    #[arg(long, requires = "slice", value_parser = clap::value_parser!(u16).range(1..=4096))]
+    slice_scale: Option<u16>,
     /// A contact sheet of the four named views (iso, front, top, side), 2 x 2.
     #[arg(long)]
     sheet: bool,
     /// Background colour, a name or #rrggbb.
     #[arg(long, default_value = "#fafafc")]
     background: String,
-    /// Colour of an octree file's solid (a scene's objects carry their own).
-    #[arg(long, default_value = "#96a5b9")]
+    /// Colour of an octree file's solid (a scene's objects carry their own); also
+    /// spelled --color.
+    #[arg(long, visible_alias = "color", default_value = "#96a5b9")]
     colour: String,
     /// Shading: `faces` shows the blocks' faces, `smooth` the surface's normals (a
     /// scene's own, else estimated from the octree), `auto` picks smooth where voxels
@@ -76,32 +81,8 @@ pub struct Args {
     /// Print sizes and timings as JSON on stdout.
     #[arg(long)]
     json: bool,
-}
-
-/// The largest image side we draw.
-const MAX_SIDE: usize = 8192;
-/// The most pixels in one view (a contact sheet has four).
-const MAX_PIXELS: usize = 16 << 20;
-
-fn parse_size(s: &str) -> Result<(usize, usize)> {
-    let (w, h) = s
-        .split_once('x')
-        .with_context(|| format!("--size {s:?}: expected WIDTHxHEIGHT, e.g. 800x600"))?;
-    let w: usize = w
-        .trim()
-        .parse()
-        .with_context(|| format!("--size {s:?}: bad width"))?;
-    let h: usize = h
-        .trim()
-        .parse()
-        .with_context(|| format!("--size {s:?}: bad height"))?;
-    if w == 0 || h == 0 || w > MAX_SIDE || h > MAX_SIDE {
-        bail!("--size {s:?}: each side must be from 1 to {MAX_SIDE}");
-    }
-    if w * h > MAX_PIXELS {
-        bail!("--size {s:?}: more than {MAX_PIXELS} pixels");
-    }
-    Ok((w, h))
+    #[command(flatten)]
+    budget: Budget,
 }
 
 /// Parses `x<C`, `x>C` or `x=C`: the axis, the comparison and the value.
@@ -137,14 +118,36 @@ fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    let (width, height) = parse_size(&args.size)?;
+    output::guard("--output", &args.output, &["png"], &[&args.input])?;
+    if output::is_stdio(&args.output) && args.json {
+        bail!("--json: standard output already holds the picture (-o -)");
+    }
+    let Size { width, height } = args.size;
     let view = View::parse(&args.view)
         .with_context(|| format!("--view {:?}: expected iso, front, top or side", args.view))?;
     if !(args.zoom.is_finite() && args.zoom > 0.0) {
         bail!("--zoom {}: must be a positive number", args.zoom);
     }
-    if !(args.fov > 0.0 && args.fov < 180.0) {
-        bail!("--fov {}: must lie between 0 and 180 degrees", args.fov);
+    let fov = args.fov.unwrap_or(40.0);
+    if !(fov > 0.0 && fov < 180.0) {
+        bail!("--fov {fov}: must lie between 0 and 180 degrees");
+    }
+    for (flag, value) in [("azimuth", args.azimuth), ("elevation", args.elevation)] {
+        if value.is_some_and(|v| !v.is_finite()) {
+            bail!(
+                "--{flag} {}: must be a finite number of degrees",
+                value.unwrap_or_default()
+            );
+        }
+    }
+    if args.elevation.is_some_and(|e| e.abs() > 90.0) {
+        bail!(
+            "--elevation {}: must lie between -90 and 90 degrees",
+            args.elevation.unwrap_or_default()
+        );
+    }
+    if args.sheet && (args.slice.is_some() || args.azimuth.is_some() || args.elevation.is_some()) {
+        bail!("--sheet draws the four named views: it takes no --slice, --azimuth or --elevation");
     }
     if args.ao > 256 {
         bail!("--ao {}: at most 256 rays per pixel", args.ao);
@@ -172,26 +175,52 @@ pub fn run(args: Args) -> Result<()> {
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
+    let mut colors = None;
     // A scene's cut and slice positions are in scene units: (scale, lower corner).
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
         let scene = Scene::read(&args.input)?;
         let csg = scene.csg()?;
-        let tree = scene.build()?;
+        let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
-        let tree = io::read_octree(&args.input)
-            .with_context(|| format!("reading {}", args.input.display()))?;
-        (tree, None, (1.0, [0.0; 3]))
+        let model = octree::read(&args.input)?;
+        let frame = model.frame;
+        colors = model.colors;
+        (model.tree, None, (frame.voxel_size, frame.translate))
     };
     let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
+    if let Some((axis, op, c)) = cut {
+        // A plane outside the solid keeps all of it or none of it; say which, since
+        // an empty picture alone looks like a failure.
+        let clip = Clip {
+            axis,
+            at: to_voxel(axis, c),
+            keep_above: op == '>',
+        };
+        let kept = render::crop_to_clip(&tree, clip).voxel_count();
+        let spec = args.cut.as_deref().unwrap_or_default();
+        if kept == 0 && !tree.is_empty() {
+            eprintln!("note: --cut '{spec}' keeps nothing of the solid; the picture is empty");
+        } else if kept == tree.voxel_count() && !tree.is_empty() {
+            eprintln!("note: --cut '{spec}' keeps all of the solid (the plane does not cross it)");
+        }
+    }
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let shader = csg
         .as_ref()
         .map(|c| move |p: [f64; 3]| c.colour_at(p).map_or(solid_colour, |k| k.0));
+    // An octree file's stored colours: the voxel holding the sample point.
+    let stored = colors.as_ref().map(|l| {
+        move |p: [f64; 3]| {
+            l.get(p.map(|c| c.floor() as i64))
+                .map_or(solid_colour, |c| [c[0], c[1], c[2]])
+        }
+    });
     let fixed = move |_: [f64; 3]| solid_colour;
-    let shader_ref: &(dyn Fn([f64; 3]) -> [u8; 3] + Sync) = match &shader {
-        Some(s) => s,
-        None => &fixed,
+    let shader_ref: &(dyn Fn([f64; 3]) -> [u8; 3] + Sync) = match (&shader, &stored) {
+        (Some(s), _) => s,
+        (None, Some(s)) => s,
+        (None, None) => &fixed,
     };
     let normal_fn = csg.as_ref().map(|c| move |p: [f64; 3]| c.normal_at(p));
     let surface = render::Surface {
@@ -215,7 +244,7 @@ pub fn run(args: Args) -> Result<()> {
             elevation_deg: args.elevation.unwrap_or(el),
             zoom: args.zoom,
             projection: if args.perspective {
-                Projection::Perspective { fov_deg: args.fov }
+                Projection::Perspective { fov_deg: fov }
             } else {
                 Projection::Orthographic
             },
@@ -235,13 +264,12 @@ pub fn run(args: Args) -> Result<()> {
     let image = if let Some((axis, _, c)) = slice {
         let layer = to_voxel(axis, c).floor() as i64;
         let side = tree.side() as usize;
-        if side.saturating_mul(args.slice_scale.max(1)) > MAX_SIDE {
+        let scale = usize::from(args.slice_scale.unwrap_or(4));
+        if side.saturating_mul(scale) > MAX_SIDE {
             bail!(
-                "--slice: the tree is {side} voxels across; at {} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)",
-                args.slice_scale.max(1)
+                "--slice: the tree is {side} voxels across; at {scale} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)"
             );
         }
-        let scale = args.slice_scale.max(1);
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)
@@ -249,9 +277,15 @@ pub fn run(args: Args) -> Result<()> {
         render::render(&tree, surface, &opts)
     };
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
-    image
-        .write_png(&args.output)
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    if output::is_stdio(&args.output) {
+        super::stdio::to_stdout("png", |p| {
+            image.write_png(p).map_err(|e| anyhow::anyhow!("{e}"))
+        })?;
+    } else {
+        image
+            .write_png(&args.output)
+            .with_context(|| format!("writing {}", args.output.display()))?;
+    }
     if args.json {
         let out = serde_json::json!({
             "input": args.input,
@@ -265,7 +299,7 @@ pub fn run(args: Args) -> Result<()> {
             "load_ms": load_ms,
             "render_ms": render_ms,
         });
-        println!("{out}");
+        crate::outln!("{out}")?;
     }
     Ok(())
 }

@@ -27,6 +27,10 @@ pub struct Args {
     /// Without it the face count is computed once at the end.
     #[arg(long)]
     track_faces: bool,
+    /// The final report is always one JSON object (keys above); the flag is accepted
+    /// so that every command takes --json.
+    #[arg(long)]
+    json: bool,
 }
 
 /// What a line asks for.

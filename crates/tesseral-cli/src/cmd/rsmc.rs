@@ -42,8 +42,14 @@ pub struct Args {
     /// Lattice implementation.
     #[arg(long, value_enum, default_value_t = Backend::Octree)]
     backend: Backend,
-    /// Folder for series.csv, area.png, the mesh and checkpoint.json.
-    #[arg(long, default_value = "rsmc-out")]
+    /// Folder for series.csv, area.png, the mesh and checkpoint.json (also spelled
+    /// --out).
+    #[arg(
+        short = 'o',
+        long = "output",
+        alias = "out",
+        default_value = "rsmc-out"
+    )]
     out: PathBuf,
     /// Steps between rows of series.csv.
     #[arg(long, default_value_t = 1000)]
@@ -61,8 +67,15 @@ pub struct Args {
     mesh: MeshFormat,
     /// Width in pixels of surface.png, the rendered final surface (height 3/4 of it);
     /// 0: no picture.
-    #[arg(long, default_value_t = 800)]
-    render_width: usize,
+    #[arg(long, hide = true, conflicts_with_all = ["size", "no_picture"])]
+    render_width: Option<usize>,
+    /// The size of surface.png, the rendered final surface, WIDTHxHEIGHT.
+    /// [default: 800x600]
+    #[arg(long, value_parser = super::output::parse_size, conflicts_with = "no_picture")]
+    size: Option<super::output::Size>,
+    /// Draw no surface.png.
+    #[arg(long)]
+    no_picture: bool,
     /// Continue the run saved in OUT/checkpoint.json.
     #[arg(long)]
     resume: bool,
@@ -225,14 +238,51 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
+/// A step rate for people: three significant figures, with k or M.
+fn rate_text(per_second: f64) -> String {
+    let (value, unit) = if per_second >= 1e6 {
+        (per_second / 1e6, "M ")
+    } else if per_second >= 1e3 {
+        (per_second / 1e3, "k ")
+    } else {
+        (per_second, "")
+    };
+    let decimals = if value >= 100.0 {
+        0
+    } else if value >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{value:.decimals$} {unit}steps/s")
+}
+
+/// The size of surface.png: --size, or the older --render-width W (W × 3W/4; 0:
+/// none); `None` draws no picture.
+fn picture_size(args: &Args) -> Option<super::output::Size> {
+    match (args.no_picture, args.size, args.render_width) {
+        (true, _, _) | (_, _, Some(0)) => None,
+        (_, Some(size), _) => Some(size),
+        (_, None, Some(w)) => Some(super::output::Size {
+            width: w,
+            height: w * 3 / 4,
+        }),
+        (_, None, None) => Some(super::output::Size {
+            width: 800,
+            height: 600,
+        }),
+    }
+}
+
 /// Runs `tesseral rsmc`.
 pub fn run(args: Args) -> Result<()> {
     ensure!(args.sample_every >= 1, "--sample-every must be at least 1");
-    ensure!(
-        args.render_width == 0 || (16..=8192).contains(&args.render_width),
-        "--render-width {} is outside 16..=8192 (or 0 for no picture)",
-        args.render_width
-    );
+    if let Some(w) = args.render_width {
+        ensure!(
+            w == 0 || (16..=8192).contains(&w),
+            "--render-width {w} is outside 16..=8192 (or 0 for no picture)"
+        );
+    }
     ensure!(
         args.steps / args.sample_every <= MAX_ROWS,
         "--steps {} / --sample-every {} gives more than {MAX_ROWS} CSV rows; raise --sample-every",
@@ -349,9 +399,15 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     }
     bar.set_style(
         ProgressStyle::with_template(
-            "{bar:40} {percent:>3}% {human_pos}/{human_len} steps, {per_sec}, eta {eta} {msg}",
+            "{bar:40} {percent:>3}% {human_pos}/{human_len} steps, {rate}, eta {eta} {msg}",
         )
-        .expect("valid template"),
+        .expect("valid template")
+        .with_key(
+            "rate",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                let _ = w.write_str(&rate_text(state.per_sec()));
+            },
+        ),
     );
     let save = |chain: &mut Chain<L>, rows: &[Row], base: (u64, u64)| -> Result<()> {
         let cp = CliCheckpoint {
@@ -417,12 +473,12 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         MeshFormat::Obj => mesh::write_obj(&faces, w),
         MeshFormat::Ply => mesh::write_ply(&faces, w),
     })?;
-    if args.render_width > 0 {
+    if let Some(size) = picture_size(&args) {
         let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
             .context("building the octree to render")?;
         let opts = RenderOptions {
-            width: args.render_width,
-            height: args.render_width * 3 / 4,
+            width: size.width,
+            height: size.height,
             ao_samples: 4,
             ..RenderOptions::default()
         };
@@ -454,9 +510,9 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             "backend": args.backend,
             "out": args.out.display().to_string(),
         });
-        println!("{summary}");
+        crate::outln!("{summary}")?;
     } else {
-        println!(
+        crate::outln!(
             "{} steps ({} this run, {:.2} M steps/s): area {}, volume {}, Euler characteristic {}, {} accepted; wrote {}",
             k.steps,
             ran,
@@ -466,7 +522,21 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             report.euler(),
             k.accepted,
             args.out.display()
-        );
+        )?;
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate_text;
+
+    #[test]
+    fn rates_read_well() {
+        assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
+        assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
+        assert_eq!(rate_text(999.4), "999 steps/s");
+        assert_eq!(rate_text(1.23456), "1.23 steps/s");
+        assert_eq!(rate_text(0.0), "0.00 steps/s");
+    }
 }

@@ -8,6 +8,8 @@ use serde::Serialize;
 use tesseral::motion::{read_world, render_frame, Aabb, Body, Frame};
 use tesseral::render::{Camera, RenderOptions, View};
 
+use super::output::{self, Limits, Size};
+
 /// Arguments of `tesseral simulate`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -25,12 +27,17 @@ pub struct Args {
     /// The view of the frames: iso, front, top or side.
     #[arg(long, default_value = "iso", value_parser = parse_view)]
     view: View,
-    /// The frames' width in pixels.
-    #[arg(long, default_value_t = 480, value_parser = clap::value_parser!(u32).range(16..=4096))]
-    width: u32,
-    /// The frames' height in pixels.
-    #[arg(long, default_value_t = 360, value_parser = clap::value_parser!(u32).range(16..=4096))]
-    height: u32,
+    /// The frames' size, WIDTHxHEIGHT (with --frames). [default: 480x360]
+    #[arg(long, requires = "frames", value_parser = output::parse_size)]
+    size: Option<Size>,
+    /// The frames' width in pixels (older spelling; use --size).
+    #[arg(long, hide = true, requires = "frames", conflicts_with = "size", value_parser = clap::value_parser!(u32).range(16..=4096))]
+    width: Option<u32>,
+    /// The frames' height in pixels (older spelling; use --size).
+    #[arg(long, hide = true, requires = "frames", conflicts_with = "size", value_parser = clap::value_parser!(u32).range(16..=4096))]
+    height: Option<u32>,
+    #[command(flatten)]
+    limits: Limits,
 }
 
 #[derive(Serialize)]
@@ -61,24 +68,45 @@ fn name(b: &Body) -> String {
     }
 }
 
+/// `1 object`, `2 objects`.
+fn plural(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
+}
+
 fn parse_view(s: &str) -> Result<View, String> {
     View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(dir) = &args.frames {
+        if output::same_file(dir, &args.world) {
+            anyhow::bail!(
+                "--frames {}: this is the world file; give a folder for the pictures",
+                dir.display()
+            );
+        }
+    }
     let wf = read_world(&args.world).context("reading the world file")?;
     let world = &wf.world;
+    let size = args.size.unwrap_or(Size {
+        width: args.width.map_or(480, |w| w as usize),
+        height: args.height.map_or(360, |h| h as usize),
+    });
+    if let Some(dir) = &args.frames {
+        // One picture per step and one of the start, each estimated before any work.
+        let each = tesseral::io::estimate_image_bytes(size.width as u64, size.height as u64);
+        let total = each.saturating_mul(wf.steps.saturating_add(1));
+        output::check_size(dir, total, args.limits.max_output)?;
+    }
     let sim = world
         .simulate(wf.time_step, wf.steps)
         .context("keeping the objects' octrees current")?;
     if let Some(dir) = &args.frames {
-        write_frames(
-            dir,
-            world,
-            &sim,
-            args.view,
-            (args.width as usize, args.height as usize),
-        )?;
+        write_frames(dir, world, &sim, args.view, (size.width, size.height))?;
     }
     let contacts: Vec<ContactOut> = sim
         .contacts
@@ -120,11 +148,11 @@ pub fn run(args: Args) -> Result<()> {
         }
         writeln!(
             out,
-            "{} contacts in {} steps of {} ({} objects)",
-            contacts.len(),
-            wf.steps,
+            "{} in {} of {} ({})",
+            plural(contacts.len() as u64, "contact"),
+            plural(wf.steps, "step"),
             wf.time_step,
-            world.objects.len()
+            plural(world.objects.len() as u64, "object")
         )?;
     }
     Ok(())

@@ -37,7 +37,7 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         tables.iter().map(render).collect::<Vec<_>>().join("\n")
     };
-    print!("{text}");
+    crate::out!("{text}")?;
     Ok(())
 }
 

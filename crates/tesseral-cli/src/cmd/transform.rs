@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::{Context, Result};
+use tesseral::model::Model;
 use tesseral::pointer::PointerOctree;
 
 use super::octree::{self, AxisArg};
@@ -24,12 +25,22 @@ pub struct TranslateArgs {
     /// The input octree file.
     input: PathBuf,
     /// The displacement `DX,DY,DZ` in voxels (negative allowed: `--by=-4,-50,0` or
-    /// `--by -4,-50,0`).
-    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true)]
-    by: [i64; 3],
+    /// `--by -4,-50,0`). The frame is kept, so the world moves by DX·voxel size.
+    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true,
+          required_unless_present = "by_world", conflicts_with = "by_world")]
+    by: Option<[i64; 3]>,
+    /// The displacement `X,Y,Z` in world units (metres for an OctoMap map); it must be
+    /// a whole number of voxels.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_world_vector, allow_hyphen_values = true)]
+    by_world: Option<[f64; 3]>,
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, by, method, dropped (with --clip), nodes_visited and root_expansions (with --method labels).
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
     /// The algorithm.
     #[arg(long, value_enum, default_value_t)]
     method: Method,
@@ -40,10 +51,26 @@ pub struct TranslateArgs {
 }
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
-    let tree = octree::read(&args.input)?;
-    let by = args.by;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
+    let model = octree::read(&args.input)?;
+    let by = match (args.by, args.by_world) {
+        (Some(by), _) => by,
+        (None, Some(w)) => model
+            .frame
+            .world_to_voxels(w)
+            .map_err(|e| anyhow::anyhow!("--by-world: {e}"))?,
+        (None, None) => anyhow::bail!("give --by or --by-world"),
+    };
+    let tree = &model.tree;
+    let mut extra = serde_json::json!({
+        "by": by,
+        "method": match args.method {
+            Method::Linear => "linear",
+            Method::Labels => "labels",
+        },
+    });
     let moved = match (args.method, args.clip) {
-        (Method::Linear, false) => tree.translate(by).with_context(|| {
+        (Method::Linear, false) => model.translate(by).with_context(|| {
             format!(
                 "translating {} by {}",
                 args.input.display(),
@@ -51,37 +78,60 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             )
         })?,
         (Method::Linear, true) => {
-            let (moved, dropped) = tree
-                .translate_clipped(by)
+            // Moved, then put back in the input's space: what leaves it is dropped.
+            let moved = model
+                .translate(by)
+                .and_then(|m| Ok(m.in_space(tree.depth(), tree.origin())?))
                 .with_context(|| format!("translating {}", args.input.display()))?;
-            println!("clipped: {dropped} voxels left the space and were dropped");
+            let dropped = tree.voxel_count() - moved.tree.voxel_count();
+            if args.json {
+                extra["dropped"] = dropped.into();
+            } else {
+                crate::outln!("clipped: {dropped} voxels left the space and were dropped")?;
+            }
             moved
         }
         (Method::Labels, true) => {
             anyhow::bail!("--clip works only with --method linear")
         }
         (Method::Labels, false) => {
-            let mut p = PointerOctree::from_linear(&tree);
+            let mut p = PointerOctree::from_linear(tree);
             let stats = p
                 .translate(by)
                 .with_context(|| format!("translating {}", args.input.display()))?;
+            extra["nodes_visited"] = stats.nodes_visited().into();
+            extra["root_expansions"] = stats.root_expansions.into();
             for (name, s) in ["x", "y", "z"].iter().zip(stats.axes.iter()) {
-                if s.displacement != 0 {
-                    println!(
+                if s.displacement != 0 && !args.json {
+                    crate::outln!(
                         "axis {name}: by {}, nodes of side 2^{} moved: {}, traversed {}, path steps {}, compaction {}, split {}",
                         s.displacement, s.moved_size_log2, s.moved, s.traversed, s.path_steps, s.compacted, s.split_created
-                    );
+                    )?;
                 }
             }
-            println!(
-                "nodes visited: {} (root expansions: {})",
-                stats.nodes_visited(),
-                stats.root_expansions
-            );
-            p.to_linear()
+            if !args.json {
+                crate::outln!(
+                    "nodes visited: {} (root expansions: {})",
+                    stats.nodes_visited(),
+                    stats.root_expansions
+                )?;
+            }
+            // The labels move the voxels; the colours and free space follow them.
+            let rest = model.translate(by)?;
+            Model::from_parts(
+                p.to_linear(),
+                model.frame,
+                rest.colors,
+                rest.free,
+                rest.log_odds,
+            )?
         }
     };
-    octree::write(&args.output, &moved)
+    let report = octree::Report {
+        json: args.json,
+        extra,
+    };
+    octree::write(&args.output, &moved, &args.limits, report)
 }
 
 /// Arguments of `tesseral rotate`.
@@ -98,11 +148,25 @@ pub struct RotateArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis, turns.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
 }
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
-    let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.rotate(args.axis.into(), args.turns))
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
+    let model = octree::read(&args.input)?;
+    octree::write(
+        &args.output,
+        &model.rotate_in_space(args.axis.into(), args.turns)?,
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "axis": axis_name(args.axis), "turns": args.turns }),
+        },
+    )
 }
 
 /// Arguments of `tesseral mirror`.
@@ -116,11 +180,25 @@ pub struct MirrorArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
 }
 
 pub fn mirror(args: MirrorArgs) -> Result<()> {
-    let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.mirror(args.axis.into()))
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
+    let model = octree::read(&args.input)?;
+    octree::write(
+        &args.output,
+        &model.mirror_in_space(args.axis.into())?,
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "axis": axis_name(args.axis) }),
+        },
+    )
 }
 
 /// Arguments of `tesseral scale`.
@@ -135,18 +213,32 @@ pub struct ScaleArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, scale_log2.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
 }
 
 pub fn scale(args: ScaleArgs) -> Result<()> {
-    let tree = octree::read(&args.input)?;
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
+    let model = octree::read(&args.input)?;
     let k = args.by;
     let scaled = if k >= 0 {
-        tree.scale_up(k as u8)
+        model.scale_up(k as u8)
     } else {
-        tree.scale_down(k.unsigned_abs() as u8)
+        model.scale_down(k.unsigned_abs() as u8)
     }
     .with_context(|| format!("scaling {} by 2^{k}", args.input.display()))?;
-    octree::write(&args.output, &scaled)
+    octree::write(
+        &args.output,
+        &scaled,
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({ "scale_log2": k }),
+        },
+    )
 }
 
 /// Arguments of `tesseral complement`.
@@ -157,9 +249,49 @@ pub struct ComplementArgs {
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max.
+    #[arg(long)]
+    json: bool,
+    #[command(flatten)]
+    limits: octree::OutArgs,
 }
 
 pub fn complement(args: ComplementArgs) -> Result<()> {
-    let tree = octree::read(&args.input)?;
-    octree::write(&args.output, &tree.complement())
+    octree::guard(&args.output, &[&args.input], &args.limits)?;
+    let model = octree::read(&args.input)?;
+    octree::write(
+        &args.output,
+        &model.complement(),
+        &args.limits,
+        octree::Report {
+            json: args.json,
+            extra: serde_json::json!({}),
+        },
+    )
+}
+
+/// Parses `X,Y,Z` in world units.
+fn parse_world_vector(text: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
+    if parts.len() != 3 {
+        return Err(format!("expected three numbers `X,Y,Z`, got `{text}`"));
+    }
+    let mut v = [0.0; 3];
+    for (a, p) in parts.iter().enumerate() {
+        v[a] = p
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("`{p}` is not a finite number (in `{text}`)"))?;
+    }
+    Ok(v)
+}
+
+/// The axis's name in JSON output.
+fn axis_name(a: AxisArg) -> &'static str {
+    match a {
+        AxisArg::X => "x",
+        AxisArg::Y => "y",
+        AxisArg::Z => "z",
+    }
 }

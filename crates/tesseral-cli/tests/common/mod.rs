@@ -5,8 +5,11 @@
 
 #![allow(dead_code)]
 
+use std::fs;
 use std::path::Path;
 use std::process::{Command, Output};
+
+use serde_json::Value;
 
 /// Runs `tesseral args...` with `dir` as its working directory.
 pub fn run(dir: &Path, args: &[&str]) -> Output {
@@ -38,4 +41,39 @@ pub fn expect_success(out: &Output) -> String {
         String::from_utf8_lossy(&out.stderr)
     );
     String::from_utf8(out.stdout.clone()).expect("utf-8 stdout")
+}
+
+/// Runs a command that must fail with status 2 and `needle` in its error.
+pub fn fails(dir: &Path, args: &[&str], needle: &str) {
+    let out = run(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    assert!(
+        err.contains(needle),
+        "{args:?}: expected {needle:?} in {err}"
+    );
+}
+
+/// Runs a command that must succeed and prints one JSON object.
+pub fn json(dir: &Path, args: &[&str]) -> Value {
+    let out = expect_success(&run(dir, args));
+    // One object on the last line, or (info) one pretty-printed object.
+    let last = out.lines().last().unwrap_or_default();
+    serde_json::from_str(last)
+        .or_else(|_| serde_json::from_str(&out))
+        .unwrap_or_else(|e| panic!("{args:?}: {e}: {out}"))
+}
+
+/// A folder with `a.xyz`, `b.xyz` and a small scene `s.tss`.
+pub fn setup() -> tempfile::TempDir {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("a.xyz"), "0 0 0\n1 0 0\n1 1 0\n3 3 3\n").unwrap();
+    fs::write(d.join("b.xyz"), "1 0 0\n5 5 5\n").unwrap();
+    fs::write(
+        d.join("s.tss"),
+        "depth 5\nbox(size = [10, 8, 6]) at [0, 0, 3] colour \"olive\"\n",
+    )
+    .unwrap();
+    dir
 }

@@ -6,7 +6,7 @@
 //! step with label increments (their Table 1) and label transitions with carry (their
 //! Table 2). Every table here is computed from the definition (add the coordinates of
 //! two cells axis by axis); the papers' printed entries are kept only to mark where the
-//! print differs (two errata, DESIGN.md). The adder here is slow on purpose: it is the
+//! print differs (two errata, docs/conventions.md). The adder here is slow on purpose: it is the
 //! reference the word-parallel [`crate::code::Space::add`] is tested against, and the
 //! trace `tesseral calc --explain` shows.
 

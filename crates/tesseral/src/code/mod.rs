@@ -65,7 +65,7 @@ pub fn undilate3(d: u64) -> u32 {
 /// The tesseral code of `(x, y, z)`; each coordinate keeps its low 21 bits.
 ///
 /// ```
-/// // DESIGN.md: (1, 0, 3) has the octal code 45.
+/// // docs/conventions.md: (1, 0, 3) has the octal code 45.
 /// assert_eq!(tesseral::code::encode(1, 0, 3), 0o45);
 /// ```
 #[inline]

@@ -371,7 +371,7 @@ fn harakal_table1_is_the_definition_and_has_one_erratum() {
     assert_eq!(ADD_TABLE[3][6], (2, 5));
     assert_eq!(ADD_TABLE[5][7], (5, 2));
     assert_eq!(ADD_TABLE[7][7], (7, 0));
-    // DESIGN.md erratum: row 5, column 5 printed 16; the sum 5 + 5 is 50.
+    // docs/conventions.md erratum: row 5, column 5 printed 16; the sum 5 + 5 is 50.
     assert_eq!(ADD_TABLE[5][5], (5, 0));
     let t = &digits::harakal_tables()[0];
     let errata: Vec<_> = t
@@ -405,7 +405,7 @@ fn harakal_table2_inverts_table1_and_has_one_erratum() {
     // Worked entries of the paper's example: (2 - 0) is (2, 2).
     assert_eq!(SUB_TABLE[2][0], (2, 2));
     assert_eq!(SUB_TABLE[6][3], (4, 5));
-    // DESIGN.md erratum: row 4, column 0 printed 2,2; the entry is 4,4.
+    // docs/conventions.md erratum: row 4, column 0 printed 2,2; the entry is 4,4.
     assert_eq!(SUB_TABLE[4][0], (4, 4));
     let t = &digits::harakal_tables()[1];
     let errata: Vec<_> = t
@@ -497,7 +497,7 @@ fn harakal_worked_examples() {
     assert_eq!(s.add(0o642, 0o752), 0o6530);
     assert_eq!(add_by_table(0o642u64, 0o752, 21).code, 0o6530);
     assert_eq!(s.sub(0o6530, 0o642), 0o752);
-    // Their 45 is (3, 0, 1) with x in the high bit; ours is (1, 0, 3) (DESIGN.md).
+    // Their 45 is (3, 0, 1) with x in the high bit; ours is (1, 0, 3) (docs/conventions.md).
     assert_eq!(encode(1, 0, 3), 0o45);
 }
 

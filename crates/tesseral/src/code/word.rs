@@ -18,7 +18,7 @@ mod sealed {
 /// (depth up to 42).
 ///
 /// Bit `3i` of a code is bit `i` of x, bit `3i + 1` is bit `i` of y and bit `3i + 2`
-/// is bit `i` of z (DESIGN.md). The trait is sealed: only `u64` and `u128` implement it.
+/// is bit `i` of z (docs/conventions.md). The trait is sealed: only `u64` and `u128` implement it.
 ///
 /// ```
 /// use tesseral::code::CodeWord;

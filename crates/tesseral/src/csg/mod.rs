@@ -22,6 +22,8 @@
 //! predicate. The build therefore equals a dense per-voxel evaluation, voxel for voxel,
 //! and its cost follows the surface: only cells the surface may cross are split.
 
+mod budget;
+mod colours;
 mod compile;
 pub mod scene;
 mod shape;
@@ -29,6 +31,7 @@ mod shape;
 #[cfg(test)]
 pub(crate) mod tests;
 
+pub use colours::colour_parts;
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};
 pub use scene::{Scene, SceneError};
 pub use shape::Shape;

@@ -171,7 +171,7 @@ pub struct Scene {
     pub bounds_min: [f64; 3],
     /// The number of top-level objects.
     pub objects: usize,
-    path: PathBuf,
+    pub(super) path: PathBuf,
 }
 
 impl Scene {

@@ -18,7 +18,7 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::{FormatError, Frame, VoxelModel, MAX_DENSE_VOXELS};
+use super::{FormatError, Frame, Model, MAX_DENSE_VOXELS};
 use crate::code;
 use crate::linear::{Leaf, LinearOctree};
 
@@ -31,7 +31,7 @@ pub const MAX_WRITE_DIM: u64 = 2048;
 /// # Errors
 /// [`FormatError::Syntax`] for a bad header line, [`FormatError::Corrupt`] for bad
 /// run-length data, [`FormatError::TooLarge`] past [`MAX_DENSE_VOXELS`] filled voxels.
-pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
     decode(&bytes, path)
 }
@@ -43,7 +43,7 @@ pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let syntax = |line: usize, message: String| FormatError::Syntax {
         path: path.to_owned(),
         line,
@@ -208,14 +208,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
     let tree =
         LinearOctree::from_sorted_leaves(depth, shift, codes.into_iter().map(|c| Leaf::new(c, 0)))
             .map_err(|e| FormatError::octree(path, e))?;
-    Ok(VoxelModel {
-        tree,
-        frame: Some(Frame {
-            voxel_size,
-            translate: rest,
-        }),
-        colors: None,
-    })
+    Ok(Model::new(tree).with_frame(Frame::new(voxel_size, rest)))
 }
 
 fn parse_n<T: std::str::FromStr>(values: &[&str], n: usize) -> Result<Vec<T>, String> {
@@ -233,7 +226,7 @@ fn parse_n<T: std::str::FromStr>(values: &[&str], n: usize) -> Result<Vec<T>, St
 /// # Errors
 /// [`FormatError::Unsupported`] when the bounding box is wider than
 /// [`MAX_WRITE_DIM`]; [`FormatError::Io`].
-pub fn write_file(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
+pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
     let bytes = encode(model).map_err(|m| FormatError::unsupported(path, m))?;
     super::write_atomic(path, |w| w.write_all(&bytes))
 }
@@ -242,7 +235,7 @@ pub fn write_file(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
 ///
 /// # Errors
 /// [`io::ErrorKind::InvalidInput`] when the grid would be too large; I/O errors of `w`.
-pub fn write(w: &mut dyn Write, model: &VoxelModel) -> io::Result<()> {
+pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     let bytes = encode(model).map_err(|m| io::Error::new(io::ErrorKind::InvalidInput, m))?;
     w.write_all(&bytes)
 }
@@ -257,16 +250,16 @@ pub fn write(w: &mut dyn Write, model: &VoxelModel) -> io::Result<()> {
 /// A message when the grid would exceed [`MAX_WRITE_DIM`].
 ///
 /// ```
-/// use tesseral::io::{binvox, VoxelModel};
+/// use tesseral::io::{binvox, Model};
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(3, [0, 0, 0], [[0, 0, 0], [2, 1, 0]]).unwrap();
-/// let bytes = binvox::encode(&VoxelModel::new(tree.clone())).unwrap();
+/// let bytes = binvox::encode(&Model::new(tree.clone())).unwrap();
 /// let back = binvox::decode(&bytes, "t.binvox".as_ref()).unwrap();
 /// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
 /// ```
-pub fn encode(model: &VoxelModel) -> Result<Vec<u8>, String> {
+pub fn encode(model: &Model) -> Result<Vec<u8>, String> {
     let tree = &model.tree;
-    let frame = model.frame.unwrap_or_default();
+    let frame = model.frame;
     let (lo, hi) = tree.bbox().unwrap_or((tree.origin(), tree.origin()));
     let dim = (0..3)
         .map(|a| (hi[a] - lo[a]) as u64 + 1)
@@ -346,7 +339,7 @@ mod tests {
         let m = decode(&bytes, Path::new("t.binvox")).unwrap();
         let v: HashSet<Voxel> = m.tree.voxels().collect();
         assert_eq!(v, HashSet::from([[0, 1, 0], [0, 0, 1], [1, 0, 0]]));
-        assert_eq!(m.frame.unwrap().voxel_size, 1.0);
+        assert_eq!(m.frame.voxel_size, 1.0);
     }
 
     #[test]
@@ -354,7 +347,7 @@ mod tests {
         let mut bytes = b"#binvox 1\ndim 4 4 4\ntranslate -0.5 0.25 0.1\nscale 2\ndata\n".to_vec();
         bytes.extend_from_slice(&[0, 5, 1, 3, 0, 56]);
         let m = decode(&bytes, Path::new("t.binvox")).unwrap();
-        let f = m.frame.unwrap();
+        let f = m.frame;
         assert_eq!(f.voxel_size, 0.5);
         // -0.5 is one whole voxel; 0.25 is half a voxel, so it stays in the frame.
         assert_eq!(m.tree.origin()[0], -1);
@@ -364,7 +357,7 @@ mod tests {
             again.tree.voxels().collect::<Vec<_>>(),
             m.tree.voxels().collect::<Vec<_>>()
         );
-        let g = again.frame.unwrap();
+        let g = again.frame;
         assert!((g.voxel_size - 0.5).abs() < 1e-12);
         for a in 0..3 {
             assert!((g.translate[a] - f.translate[a]).abs() < 1e-12);
@@ -378,7 +371,7 @@ mod tests {
             let (origin, voxels) = crate::io::random_voxels(&mut rng, 9, 16, 500);
             let voxels: HashSet<Voxel> = voxels.into_iter().collect();
             let tree = LinearOctree::from_voxels(4, origin, voxels.iter().copied()).unwrap();
-            let bytes = encode(&VoxelModel::new(tree)).unwrap();
+            let bytes = encode(&Model::new(tree)).unwrap();
             let back = decode(&bytes, Path::new("t.binvox"))
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             back.tree.assert_valid();

@@ -18,21 +18,28 @@
 //! | `.stl`, `.obj`, `.ply` | meshes, voxelized on read, meshed on write | [`crate::mesh`] |
 //! | `.glb` | glTF binary mesh (write only) | [`crate::mesh`] |
 
+mod atomic;
 pub mod binvox;
+mod estimate;
+mod leafstream;
 pub mod native;
 pub mod octomap;
 mod reframe;
+mod sniff;
 pub mod vox;
 pub mod xyz;
 
+pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
+pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
+pub use sniff::sniff_format;
 
-use std::collections::BTreeMap;
 use std::fs;
-use std::io::{self, BufWriter, Write};
+use std::io;
 use std::path::{Path, PathBuf};
 
 use crate::linear::{LinearOctree, OctreeError};
+#[cfg(test)]
 use crate::Voxel;
 
 /// What can go wrong reading or writing a file.
@@ -147,55 +154,7 @@ impl FormatError {
     }
 }
 
-/// Where the voxel lattice sits in the world of a file: the corner of voxel
-/// `(i, j, k)` is `translate + voxel_size * (i, j, k)`.
-///
-/// OctoMap's resolution and binvox's translate and scale become a `Frame`, so a
-/// round trip through tesseral keeps them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Frame {
-    /// The side of one voxel, in world units (metres for OctoMap).
-    pub voxel_size: f64,
-    /// The world position of the corner of voxel `(0, 0, 0)`.
-    pub translate: [f64; 3],
-}
-
-impl Default for Frame {
-    fn default() -> Self {
-        Self {
-            voxel_size: 1.0,
-            translate: [0.0; 3],
-        }
-    }
-}
-
-/// Per-voxel colours `[r, g, b, a]`, kept beside the octree for formats that carry
-/// colour (MagicaVoxel palettes, OctoMap `ColorOcTree`). Voxels that are not black
-/// in the tree are ignored when written.
-pub type ColorMap = BTreeMap<Voxel, [u8; 4]>;
-
-/// An octree with what a file says about it beyond its voxels.
-#[derive(Debug, Clone, PartialEq)]
-pub struct VoxelModel {
-    /// The black voxels.
-    pub tree: LinearOctree,
-    /// Voxel size and placement in the world, when the file has them.
-    pub frame: Option<Frame>,
-    /// Per-voxel colours, when the file has them.
-    pub colors: Option<ColorMap>,
-}
-
-impl VoxelModel {
-    /// A model with no frame and no colours.
-    #[must_use]
-    pub fn new(tree: LinearOctree) -> Self {
-        Self {
-            tree,
-            frame: None,
-            colors: None,
-        }
-    }
-}
+pub use crate::model::{Frame, Model};
 
 /// How to read formats that need a choice (meshes need a resolution).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -230,7 +189,7 @@ pub fn read_octree(path: &Path) -> Result<LinearOctree, FormatError> {
 ///
 /// # Errors
 /// [`FormatError`] naming the file, and the line and column or field at fault.
-pub fn read_model(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read_model(path: &Path) -> Result<Model, FormatError> {
     read_model_with(path, &ReadOptions::default())
 }
 
@@ -238,10 +197,10 @@ pub fn read_model(path: &Path) -> Result<VoxelModel, FormatError> {
 ///
 /// # Errors
 /// [`FormatError`] naming the file, and the line and column or field at fault.
-pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<VoxelModel, FormatError> {
+pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<Model, FormatError> {
     match extension(path).as_str() {
         "tess" => native::read(path),
-        "xyz" => xyz::read(path).map(VoxelModel::new),
+        "xyz" => xyz::read(path).map(Model::new),
         "binvox" => binvox::read(path),
         "vox" => vox::read(path),
         "bt" | "ot" => octomap::read(path),
@@ -258,14 +217,14 @@ pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<VoxelModel,
 /// # Errors
 /// [`FormatError`] naming the file.
 pub fn write_octree(path: &Path, tree: &LinearOctree) -> Result<(), FormatError> {
-    write_model(path, &VoxelModel::new(tree.clone()))
+    write_model(path, &Model::new(tree.clone()))
 }
 
 /// Writes a model with its frame and colours, with default options.
 ///
 /// # Errors
 /// [`FormatError`] naming the file.
-pub fn write_model(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
+pub fn write_model(path: &Path, model: &Model) -> Result<(), FormatError> {
     write_model_with(path, model, &WriteOptions::default())
 }
 
@@ -277,7 +236,7 @@ pub fn write_model(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
 /// does not fit the format (for example a `.vox` wider than 256 voxels).
 pub fn write_model_with(
     path: &Path,
-    model: &VoxelModel,
+    model: &Model,
     options: &WriteOptions,
 ) -> Result<(), FormatError> {
     match extension(path).as_str() {
@@ -301,36 +260,6 @@ pub fn extension(path: &Path) -> String {
         .and_then(|e| e.to_str())
         .unwrap_or("")
         .to_ascii_lowercase()
-}
-
-/// Writes a file through `body` to a temporary name beside `path`, then renames it
-/// into place. On any error the temporary file is removed and `path` is untouched.
-///
-/// # Errors
-/// [`FormatError::Io`] naming `path`.
-pub fn write_atomic(
-    path: &Path,
-    body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
-) -> Result<(), FormatError> {
-    let wrap = |source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    };
-    let mut tmp_name = path.file_name().unwrap_or_default().to_os_string();
-    tmp_name.push(format!(".{}.tmp", std::process::id()));
-    let tmp = path.with_file_name(tmp_name);
-    let result = (|| {
-        let mut w = BufWriter::new(fs::File::create(&tmp)?);
-        body(&mut w)?;
-        w.into_inner()
-            .map_err(io::IntoInnerError::into_error)?
-            .sync_all()?;
-        fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = fs::remove_file(&tmp);
-    }
-    result.map_err(wrap)
 }
 
 /// Reads a whole file, refusing files larger than `limit` bytes.

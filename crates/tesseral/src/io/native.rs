@@ -7,18 +7,26 @@
 //! |---|---|---|
 //! | 0 | 8 | magic `89 54 45 53 53 52 4C 0A` (`\x89TESSRL\n`) |
 //! | 8 | 2 | version, `1` |
-//! | 10 | 2 | flags: bit 0 a frame follows the leaves, bit 1 colours follow |
+//! | 10 | 2 | flags: which sections follow the leaves (below) |
 //! | 12 | 1 | depth D (≤ 21) |
 //! | 13 | 3 | zero |
 //! | 16 | 24 | origin, three `i64` |
 //! | 40 | 8 | leaf count n |
 //! | 48 | 8 | payload length p in bytes |
 //! | 56 | p | n varints (LEB128): the first packed leaf, then the difference of each packed leaf from the one before |
-//! | … | 32 | if flag 0: voxel size and translate, four `f64` |
-//! | … | … | if flag 1: colour count m (`u64`), then m × (varint code delta, 4 bytes RGBA) |
+//! | … | 32 | flag bit 0: the frame, voxel size and translate, four `f64` |
+//! | … | … | flag bit 1 (read only, written by older versions): colour count m (`u64`), then m × (varint code delta, 4 bytes RGBA) |
+//! | … | … | flag bit 2: colours as regions (a *layer*, below) of 4 bytes RGBA |
+//! | … | … | flag bit 3: known-free space, a *leaf stream* |
+//! | … | … | flag bit 4: occupancy log-odds as a layer of 4-byte `f32` |
 //! | end − 4 | 4 | CRC-32 (IEEE) of every byte before it |
 //!
-//! A packed leaf ([`Leaf::packed`]) holds the code and the block size, and packed
+//! A *leaf stream* is a leaf count n (`u64`) then n varints as in the payload. A
+//! *layer* is a region count r (`u64`), then per region its value's bytes and a leaf
+//! stream of the voxels that hold it; regions are disjoint. Each section is
+//! self-delimiting, so a reader can skip what it does not need.
+//!
+//! A packed leaf ([`crate::linear::Leaf::packed`]) holds the code and the block size, and packed
 //! leaves increase strictly, so the deltas are positive and small: one byte for most
 //! leaves of a solid. The layout has no pointers, so the file can be memory-mapped
 //! and decoded in one pass ([`read`] maps it with `memmap2`).
@@ -30,8 +38,10 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::{ColorMap, FormatError, Frame, VoxelModel};
-use crate::linear::{Leaf, LinearOctree, MAX_DEPTH};
+use super::leafstream::{put_leaves, read_leaves, Reader};
+use super::FormatError;
+use crate::linear::{LinearOctree, MAX_DEPTH};
+use crate::model::{Frame, Layer, LayerValue, Model};
 
 /// The eight bytes every `.tess` file starts with.
 pub const MAGIC: [u8; 8] = *b"\x89TESSRL\n";
@@ -39,7 +49,10 @@ pub const MAGIC: [u8; 8] = *b"\x89TESSRL\n";
 pub const VERSION: u16 = 1;
 const FLAG_FRAME: u16 = 1;
 const FLAG_COLORS: u16 = 2;
-const KNOWN_FLAGS: u16 = FLAG_FRAME | FLAG_COLORS;
+const FLAG_COLOR_LAYER: u16 = 4;
+const FLAG_FREE: u16 = 8;
+const FLAG_LOG_ODDS: u16 = 16;
+const KNOWN_FLAGS: u16 = FLAG_FRAME | FLAG_COLORS | FLAG_COLOR_LAYER | FLAG_FREE | FLAG_LOG_ODDS;
 const HEADER_LEN: usize = 56;
 
 /// Reads a `.tess` file by memory-mapping it, falling back to reading it into memory
@@ -51,7 +64,7 @@ const HEADER_LEN: usize = 56;
 /// # Errors
 /// [`FormatError::Corrupt`] naming the field for a truncated, corrupted or hostile
 /// file; [`FormatError::Io`] when the file cannot be read.
-pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read(path: &Path) -> Result<Model, FormatError> {
     let file = std::fs::File::open(path).map_err(|e| FormatError::io(path, e))?;
     // SAFETY: the map is read-only and dropped before we return. Another process
     // truncating or rewriting the file while we decode could change the bytes under
@@ -72,7 +85,7 @@ pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
 ///
 /// # Errors
 /// As [`read`].
-pub fn read_unmapped(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read_unmapped(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
     decode(&bytes, path)
 }
@@ -80,15 +93,15 @@ pub fn read_unmapped(path: &Path) -> Result<VoxelModel, FormatError> {
 /// Encodes a model into `.tess` bytes.
 ///
 /// ```
-/// use tesseral::io::{native, VoxelModel};
+/// use tesseral::io::{native, Model};
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(4, [-8, 0, 0], [[-8, 0, 0], [3, 2, 1]]).unwrap();
-/// let bytes = native::encode(&VoxelModel::new(tree.clone()));
+/// let bytes = native::encode(&Model::new(tree.clone()));
 /// let back = native::decode(&bytes, "mem.tess".as_ref()).unwrap();
 /// assert_eq!(back.tree, tree);
 /// ```
 #[must_use]
-pub fn encode(model: &VoxelModel) -> Vec<u8> {
+pub fn encode(model: &Model) -> Vec<u8> {
     let mut out = Vec::new();
     write(&mut out, model).expect("writing to a Vec cannot fail");
     out
@@ -101,43 +114,27 @@ pub fn encode(model: &VoxelModel) -> Vec<u8> {
 ///
 /// # Errors
 /// Any I/O error of `w`.
-pub fn write(w: &mut dyn Write, model: &VoxelModel) -> io::Result<()> {
+pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     let tree = &model.tree;
     let mut payload = Vec::with_capacity(tree.leaf_count() + 16);
-    let mut prev = 0u64;
-    for leaf in tree.leaves() {
-        put_varint(&mut payload, leaf.packed() - prev);
-        prev = leaf.packed();
-    }
-    let mut flags = 0u16;
+    put_leaves(&mut payload, tree.leaves());
+    let mut flags = FLAG_FRAME;
     let mut tail = Vec::new();
-    if let Some(frame) = &model.frame {
-        flags |= FLAG_FRAME;
-        tail.extend_from_slice(&frame.voxel_size.to_le_bytes());
-        for t in frame.translate {
-            tail.extend_from_slice(&t.to_le_bytes());
-        }
+    tail.extend_from_slice(&model.frame.voxel_size.to_le_bytes());
+    for t in model.frame.translate {
+        tail.extend_from_slice(&t.to_le_bytes());
     }
     if let Some(colors) = &model.colors {
-        flags |= FLAG_COLORS;
-        let mut coded: Vec<(u64, [u8; 4])> = colors
-            .iter()
-            .filter_map(|(v, c)| {
-                if tree.contains(*v) {
-                    tree.code_of(*v).map(|code| (code, *c))
-                } else {
-                    None
-                }
-            })
-            .collect();
-        coded.sort_unstable_by_key(|e| e.0);
-        tail.extend_from_slice(&(coded.len() as u64).to_le_bytes());
-        let mut prev = 0u64;
-        for (code, rgba) in coded {
-            put_varint(&mut tail, code - prev);
-            prev = code;
-            tail.extend_from_slice(&rgba);
-        }
+        flags |= FLAG_COLOR_LAYER;
+        put_layer(&mut tail, colors, |c| c.to_vec());
+    }
+    if let Some(free) = &model.free {
+        flags |= FLAG_FREE;
+        put_stream(&mut tail, free);
+    }
+    if let Some(odds) = &model.log_odds {
+        flags |= FLAG_LOG_ODDS;
+        put_layer(&mut tail, odds, |x| x.to_le_bytes().to_vec());
     }
     let mut header = Vec::with_capacity(HEADER_LEN);
     header.extend_from_slice(&MAGIC);
@@ -165,7 +162,7 @@ pub fn write(w: &mut dyn Write, model: &VoxelModel) -> io::Result<()> {
 ///
 /// # Errors
 /// [`FormatError::Corrupt`] naming the field at fault.
-pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let bad = |m: String| FormatError::corrupt(path, m);
     if bytes.len() < 8 || bytes[..8] != MAGIC {
         return Err(bad("not a tesseral .tess file (bad magic number)".into()));
@@ -233,45 +230,11 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
         )));
     }
     let space_end = 1u64 << (3 * u32::from(depth));
-    let mut leaves = Vec::with_capacity(leaf_count as usize);
     let mut payload = Reader {
         bytes: &body[..payload_end],
         pos: HEADER_LEN,
     };
-    let mut prev: Option<Leaf> = None;
-    let mut packed = 0u64;
-    for index in 0..leaf_count {
-        let delta = payload
-            .varint()
-            .map_err(|m| bad(format!("leaf {index}: {m}")))?;
-        if prev.is_some() && delta == 0 {
-            return Err(bad(format!("leaf {index}: repeats the leaf before it")));
-        }
-        packed = packed
-            .checked_add(delta)
-            .ok_or_else(|| bad(format!("leaf {index}: code overflows")))?;
-        let leaf = Leaf::from_packed(packed);
-        let k = leaf.size_log2();
-        if packed.trailing_ones() != 3 * u32::from(k) || k > depth || packed >> 63 != 0 {
-            return Err(bad(format!(
-                "leaf {index}: invalid packed leaf {packed:#x}"
-            )));
-        }
-        if leaf.end() > space_end {
-            return Err(bad(format!(
-                "leaf {index}: lies outside the depth-{depth} space"
-            )));
-        }
-        if let Some(p) = prev {
-            if p.end() > leaf.code() {
-                return Err(bad(format!(
-                    "leaf {index}: overlaps or precedes the leaf before it"
-                )));
-            }
-        }
-        prev = Some(leaf);
-        leaves.push(leaf);
-    }
+    let leaves = read_leaves(&mut payload, leaf_count, depth, "leaf").map_err(&bad)?;
     if payload.pos != payload_end {
         return Err(bad(format!(
             "payload has {} byte(s) after the last of {leaf_count} leaves",
@@ -295,14 +258,12 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
         {
             return Err(bad(format!("frame: voxel size {voxel_size} or translate {translate:?} is not finite and positive")));
         }
-        Some(Frame {
-            voxel_size,
-            translate,
-        })
+        Frame::new(voxel_size, translate)
     } else {
-        None
+        Frame::default()
     };
-    let colors = if flags & FLAG_COLORS != 0 {
+    let mut colors = None;
+    if flags & FLAG_COLORS != 0 {
         let count = tail.u64().map_err(&bad)?;
         let remaining = (body.len() - tail.pos) as u64;
         if count > remaining / 5 {
@@ -310,7 +271,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
                 "colour count {count} cannot fit in {remaining} bytes"
             )));
         }
-        let mut map = ColorMap::new();
+        let mut pairs = Vec::with_capacity(count as usize);
         let mut code = 0u64;
         for index in 0..count {
             let delta = tail
@@ -321,9 +282,32 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
                 .filter(|&c| c < space_end && (index == 0 || delta > 0))
                 .ok_or_else(|| bad(format!("colour {index}: bad voxel code")))?;
             let rgba = tail.take(4).map_err(&bad)?;
-            map.insert(tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]);
+            pairs.push((tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]));
         }
-        Some(map)
+        colors = Some(
+            Layer::from_voxels(depth, origin, pairs).map_err(|e| FormatError::octree(path, e))?,
+        );
+    }
+    if flags & FLAG_COLOR_LAYER != 0 {
+        colors = Some(
+            read_layer(&mut tail, depth, origin, "colour", |b| {
+                [b[0], b[1], b[2], b[3]]
+            })
+            .map_err(&bad)?,
+        );
+    }
+    let free = if flags & FLAG_FREE != 0 {
+        Some(read_stream(&mut tail, depth, origin, "free leaf").map_err(&bad)?)
+    } else {
+        None
+    };
+    let log_odds = if flags & FLAG_LOG_ODDS != 0 {
+        Some(
+            read_layer(&mut tail, depth, origin, "log-odds", |b| {
+                f32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            })
+            .map_err(&bad)?,
+        )
     } else {
         None
     };
@@ -333,82 +317,110 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
             body.len() - tail.pos
         )));
     }
-    Ok(VoxelModel {
+    let model = Model {
         tree,
         frame,
         colors,
-    })
+        free,
+        log_odds,
+    };
+    check_parts(&model).map_err(bad)?;
+    Ok(model)
 }
 
-/// Appends `v` as an unsigned LEB128 varint.
-pub(crate) fn put_varint(out: &mut Vec<u8>, mut v: u64) {
-    while v >= 0x80 {
-        out.push((v as u8) | 0x80);
-        v >>= 7;
-    }
-    out.push(v as u8);
-}
-
-/// A bounds-checked cursor over untrusted bytes.
-pub(crate) struct Reader<'a> {
-    pub(crate) bytes: &'a [u8],
-    pub(crate) pos: usize,
-}
-
-impl<'a> Reader<'a> {
-    pub(crate) fn take(&mut self, n: usize) -> Result<&'a [u8], String> {
-        let end = self
-            .pos
-            .checked_add(n)
-            .filter(|&e| e <= self.bytes.len())
-            .ok_or_else(|| format!("truncated at byte {} (needed {n} more)", self.pos))?;
-        let s = &self.bytes[self.pos..end];
-        self.pos = end;
-        Ok(s)
-    }
-    pub(crate) fn u8(&mut self) -> Result<u8, String> {
-        Ok(self.take(1)?[0])
-    }
-    pub(crate) fn u16(&mut self) -> Result<u16, String> {
-        let b = self.take(2)?;
-        Ok(u16::from_le_bytes([b[0], b[1]]))
-    }
-    pub(crate) fn u32(&mut self) -> Result<u32, String> {
-        let b = self.take(4)?;
-        Ok(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    }
-    pub(crate) fn u64(&mut self) -> Result<u64, String> {
-        let b = self.take(8)?;
-        let mut a = [0u8; 8];
-        a.copy_from_slice(b);
-        Ok(u64::from_le_bytes(a))
-    }
-    pub(crate) fn i64(&mut self) -> Result<i64, String> {
-        self.u64().map(|v| v as i64)
-    }
-    pub(crate) fn f64(&mut self) -> Result<f64, String> {
-        self.u64().map(f64::from_bits)
-    }
-    pub(crate) fn varint(&mut self) -> Result<u64, String> {
-        let mut v = 0u64;
-        for i in 0..10 {
-            let b = self.u8()?;
-            let bits = u64::from(b & 0x7f);
-            if i == 9 && bits > 1 {
-                return Err(format!("varint overflows 64 bits at byte {}", self.pos - 1));
-            }
-            v |= bits << (7 * i);
-            if b & 0x80 == 0 {
-                return Ok(v);
-            }
+/// Checks what the sections claim against each other: colours on black voxels, free
+/// space disjoint from them, log-odds on known voxels.
+fn check_parts(m: &Model) -> Result<(), String> {
+    use crate::linear::SetOp;
+    if let Some(c) = &m.colors {
+        if !c
+            .domain()
+            .set_op_same_space(&m.tree, SetOp::Difference)
+            .is_empty()
+        {
+            return Err("colour section: colours on voxels that are not black".into());
         }
-        Err(format!("varint longer than 10 bytes at byte {}", self.pos))
     }
+    if let Some(f) = &m.free {
+        if !f.set_op_same_space(&m.tree, SetOp::Intersection).is_empty() {
+            return Err("free section: free voxels that are also black".into());
+        }
+    }
+    if let Some(l) = &m.log_odds {
+        if !l
+            .domain()
+            .set_op_same_space(&m.known(), SetOp::Difference)
+            .is_empty()
+        {
+            return Err("log-odds section: values on unknown voxels".into());
+        }
+    }
+    Ok(())
+}
+
+fn put_stream(out: &mut Vec<u8>, tree: &LinearOctree) {
+    out.extend_from_slice(&(tree.leaf_count() as u64).to_le_bytes());
+    put_leaves(out, tree.leaves());
+}
+
+fn put_layer<T: LayerValue>(out: &mut Vec<u8>, layer: &Layer<T>, bytes: impl Fn(&T) -> Vec<u8>) {
+    out.extend_from_slice(&(layer.region_count() as u64).to_le_bytes());
+    for (x, t) in layer.regions() {
+        out.extend_from_slice(&bytes(x));
+        put_stream(out, t);
+    }
+}
+
+fn read_stream(
+    r: &mut Reader<'_>,
+    depth: u8,
+    origin: crate::Voxel,
+    what: &str,
+) -> Result<LinearOctree, String> {
+    let count = r.u64()?;
+    let leaves = read_leaves(r, count, depth, what)?;
+    LinearOctree::from_sorted_leaves(depth, origin, leaves).map_err(|e| format!("{what}: {e}"))
+}
+
+fn read_layer<T: LayerValue>(
+    r: &mut Reader<'_>,
+    depth: u8,
+    origin: crate::Voxel,
+    what: &str,
+    value: impl Fn(&[u8]) -> T,
+) -> Result<Layer<T>, String> {
+    let count = r.u64()?;
+    let remaining = (r.bytes.len() - r.pos) as u64;
+    // A region takes at least 4 + 8 bytes.
+    if count > remaining / 12 {
+        return Err(format!(
+            "{what} region count {count} cannot fit in {remaining} bytes"
+        ));
+    }
+    let mut regions = Vec::with_capacity(count as usize);
+    let mut keys = std::collections::HashSet::new();
+    for i in 0..count {
+        let x = value(r.take(4)?);
+        if !keys.insert(x.key()) {
+            return Err(format!("{what} region {i}: repeats a value"));
+        }
+        regions.push((
+            x,
+            read_stream(r, depth, origin, &format!("{what} region {i} leaf"))?,
+        ));
+    }
+    let layer = Layer::from_regions(depth, origin, regions).map_err(|e| e.to_string())?;
+    let total: u64 = layer.regions().iter().map(|(_, t)| t.voxel_count()).sum();
+    if layer.domain().voxel_count() != total {
+        return Err(format!("{what} section: regions overlap"));
+    }
+    Ok(layer)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::leafstream::put_varint;
     use rand::{Rng, SeedableRng};
 
     fn random_tree(seed: u64) -> LinearOctree {
@@ -435,23 +447,41 @@ mod tests {
     fn round_trips_random_trees_with_frame_and_colours() {
         for seed in 0..200 {
             let tree = random_tree(seed);
-            let colors: ColorMap = tree
+            let pairs = tree
                 .voxels()
                 .step_by(3)
-                .map(|v| (v, [v[0] as u8, v[1] as u8, 9, 255]))
-                .collect();
-            let model = VoxelModel {
-                tree: tree.clone(),
-                frame: (seed % 2 == 0).then_some(Frame {
-                    voxel_size: 0.05,
-                    translate: [1.5, -2.0, 0.25],
-                }),
-                colors: (seed % 3 == 0).then_some(colors),
+                .map(|v| (v, [v[0] as u8, v[1] as u8, 9, 255]));
+            let colors = Layer::from_voxels(tree.depth(), tree.origin(), pairs).unwrap();
+            // Free space: the voxels of the space's first octant that are not black.
+            let octant = LinearOctree::full(tree.depth().saturating_sub(1), tree.origin()).unwrap();
+            let free = octant.difference(&tree).unwrap();
+            let known = tree.union(&free).unwrap();
+            let odds = Layer::from_voxels(
+                tree.depth(),
+                tree.origin(),
+                known
+                    .voxels()
+                    .map(|v| (v, if v[0] % 2 == 0 { 0.85f32 } else { -0.4 })),
+            )
+            .unwrap();
+            let frame = if seed % 2 == 0 {
+                Frame::new(0.05, [1.5, -2.0, 0.25])
+            } else {
+                Frame::default()
             };
+            let model = Model::from_parts(
+                tree.clone(),
+                frame,
+                (seed % 3 == 0).then_some(colors),
+                (seed % 4 < 2).then_some(free),
+                (seed % 4 == 0).then_some(odds),
+            )
+            .unwrap();
+            model.assert_valid();
             let bytes = encode(&model);
             let back =
                 decode(&bytes, Path::new("t.tess")).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-            back.tree.assert_valid();
+            back.assert_valid();
             assert_eq!(back, model, "seed {seed}");
         }
     }
@@ -459,7 +489,7 @@ mod tests {
     #[test]
     fn every_truncation_and_bit_flip_is_an_error() {
         let tree = random_tree(7);
-        let bytes = encode(&VoxelModel::new(tree));
+        let bytes = encode(&Model::new(tree));
         for len in 0..bytes.len() {
             assert!(
                 decode(&bytes[..len], Path::new("t.tess")).is_err(),
@@ -482,7 +512,7 @@ mod tests {
     fn hostile_counts_with_valid_checksums_are_refused() {
         // A forged header claiming 2^60 leaves, with a correct checksum.
         let tree = LinearOctree::from_voxels(3, [0, 0, 0], [[1, 1, 1]]).unwrap();
-        let mut bytes = encode(&VoxelModel::new(tree));
+        let mut bytes = encode(&Model::new(tree));
         bytes[40..48].copy_from_slice(&(1u64 << 60).to_le_bytes());
         let n = bytes.len();
         let crc = crc32fast::hash(&bytes[..n - 4]);
@@ -490,7 +520,7 @@ mod tests {
         let err = decode(&bytes, Path::new("t.tess")).unwrap_err().to_string();
         assert!(err.contains("leaf count"), "{err}");
         // Depth beyond the limit.
-        let mut bytes = encode(&VoxelModel::new(LinearOctree::empty(2, [0; 3]).unwrap()));
+        let mut bytes = encode(&Model::new(LinearOctree::empty(2, [0; 3]).unwrap()));
         bytes[12] = 40;
         let crc = crc32fast::hash(&bytes[..bytes.len() - 4]);
         let n = bytes.len();
@@ -526,7 +556,7 @@ mod tests {
     fn mapped_and_unmapped_reads_agree() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("t.tess");
-        let model = VoxelModel::new(random_tree(3));
+        let model = Model::new(random_tree(3));
         crate::io::write_model(&path, &model).unwrap();
         assert_eq!(read(&path).unwrap(), model);
         assert_eq!(read_unmapped(&path).unwrap(), model);

@@ -1,7 +1,7 @@
 //! MagicaVoxel `.vox`: RIFF-style chunks holding models of up to 256³ voxels, each
 //! voxel a palette index, with a 256-entry RGBA palette.
 //!
-//! Reading keeps every voxel's palette colour in [`VoxelModel::colors`]. Files with
+//! Reading keeps every voxel's palette colour in [`Model::colors`]. Files with
 //! several models are assembled with the translations of their scene graph (`nTRN`,
 //! `nGRP`, `nSHP`), placing model voxel `v` at `t + v − ⌊size/2⌋` as MagicaVoxel
 //! does; a rotated model is refused rather than placed wrongly. A file with one model
@@ -14,9 +14,10 @@
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;
 
-use super::native::Reader;
-use super::{ColorMap, FormatError, VoxelModel, MAX_DENSE_VOXELS};
+use super::leafstream::Reader;
+use super::{FormatError, Model, MAX_DENSE_VOXELS};
 use crate::linear::LinearOctree;
+use crate::model::Layer;
 use crate::Voxel;
 
 /// The colour given to voxels that have none when written.
@@ -27,7 +28,7 @@ pub const DEFAULT_COLOR: [u8; 4] = [200, 200, 200, 255];
 /// # Errors
 /// [`FormatError::Corrupt`] naming the chunk at fault; [`FormatError::Unsupported`]
 /// for a rotated model in a scene.
-pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
     decode(&bytes, path)
 }
@@ -50,7 +51,7 @@ enum Node {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let bad = |m: String| FormatError::corrupt(path, m);
     if bytes.len() < 8 || &bytes[..4] != b"VOX " {
         return Err(bad("not a MagicaVoxel file (no `VOX ` magic)".into()));
@@ -287,11 +288,11 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
         LinearOctree::from_voxels_fitted(&voxels)
     }
     .map_err(|e| FormatError::octree(path, e))?;
-    let colors: ColorMap = placed.into_iter().collect();
-    Ok(VoxelModel {
-        tree,
-        frame: None,
+    let colors = Layer::from_voxels(tree.depth(), tree.origin(), placed)
+        .map_err(|e| FormatError::octree(path, e))?;
+    Ok(Model {
         colors: Some(colors),
+        ..Model::new(tree)
     })
 }
 
@@ -339,7 +340,7 @@ impl Reader<'_> {
 ///
 /// # Errors
 /// [`FormatError::Unsupported`] when the bounding box is wider than 256 voxels.
-pub fn write_file(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
+pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
     let bytes = encode(model).map_err(|m| FormatError::unsupported(path, m))?;
     super::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
@@ -350,13 +351,13 @@ pub fn write_file(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
 /// A message when the bounding box is wider than 256 voxels on some axis.
 ///
 /// ```
-/// use tesseral::io::{vox, VoxelModel};
+/// use tesseral::io::{vox, Model};
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(2, [0, 0, 0], [[0, 0, 0], [3, 1, 2]]).unwrap();
-/// let back = vox::decode(&vox::encode(&VoxelModel::new(tree.clone())).unwrap(), "t.vox".as_ref()).unwrap();
+/// let back = vox::decode(&vox::encode(&Model::new(tree.clone())).unwrap(), "t.vox".as_ref()).unwrap();
 /// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
 /// ```
-pub fn encode(model: &VoxelModel) -> Result<Vec<u8>, String> {
+pub fn encode(model: &Model) -> Result<Vec<u8>, String> {
     let tree = &model.tree;
     let (lo, hi) = tree.bbox().unwrap_or(([0; 3], [0; 3]));
     // Keep coordinates as they are when they already fit 0..256.
@@ -378,7 +379,7 @@ pub fn encode(model: &VoxelModel) -> Result<Vec<u8>, String> {
         model
             .colors
             .as_ref()
-            .and_then(|m| m.get(v).copied())
+            .and_then(|m| m.get(*v))
             .unwrap_or(DEFAULT_COLOR)
     };
     let mut freq: HashMap<[u8; 4], u64> = HashMap::new();
@@ -455,7 +456,7 @@ mod tests {
     fn colours_survive_a_round_trip() {
         for seed in 0..30u64 {
             let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let colours: ColorMap = (0..rng.random_range(1..300))
+            let colours: std::collections::BTreeMap<Voxel, [u8; 4]> = (0..rng.random_range(1..300))
                 .map(|_| {
                     let v = [
                         rng.random_range(0..40),
@@ -474,11 +475,9 @@ mod tests {
                 })
                 .collect();
             let tree = LinearOctree::from_voxels(6, [0; 3], colours.keys().copied()).unwrap();
-            let model = VoxelModel {
-                tree,
-                frame: None,
-                colors: Some(colours.clone()),
-            };
+            let layer =
+                Layer::from_voxels(6, [0; 3], colours.iter().map(|(v, c)| (*v, *c))).unwrap();
+            let model = Model::new(tree).with_colors(layer).unwrap();
             let back = decode(&encode(&model).unwrap(), Path::new("t.vox"))
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             back.tree.assert_valid();
@@ -487,26 +486,33 @@ mod tests {
                 colours.keys().copied().collect(),
                 "seed {seed}"
             );
-            assert_eq!(back.colors.unwrap(), colours, "seed {seed}");
+            let back_colours: std::collections::BTreeMap<Voxel, [u8; 4]> = back
+                .colors
+                .unwrap()
+                .to_voxels()
+                .into_iter()
+                .map(|(v, _, c)| (v, c))
+                .collect();
+            assert_eq!(back_colours, colours, "seed {seed}");
         }
     }
 
     #[test]
     fn negative_coordinates_are_shifted_and_too_wide_is_refused() {
         let tree = LinearOctree::from_voxels(4, [-8; 3], [[-8, -8, -8], [7, 7, 7]]).unwrap();
-        let back = decode(&encode(&VoxelModel::new(tree)).unwrap(), Path::new("t.vox")).unwrap();
+        let back = decode(&encode(&Model::new(tree)).unwrap(), Path::new("t.vox")).unwrap();
         assert_eq!(
             back.tree.voxels().collect::<Vec<_>>(),
             vec![[0, 0, 0], [15, 15, 15]]
         );
         let wide = LinearOctree::from_voxels(9, [0; 3], [[0, 0, 0], [300, 0, 0]]).unwrap();
-        assert!(encode(&VoxelModel::new(wide)).is_err());
+        assert!(encode(&Model::new(wide)).is_err());
     }
 
     #[test]
     fn hostile_chunks_are_errors() {
         let tree = LinearOctree::from_voxels(2, [0; 3], [[1, 2, 3]]).unwrap();
-        let good = encode(&VoxelModel::new(tree)).unwrap();
+        let good = encode(&Model::new(tree)).unwrap();
         for len in 0..good.len() {
             let _ = decode(&good[..len], Path::new("t.vox"));
         }

@@ -20,7 +20,8 @@ use std::path::Path;
 pub use boundary::{boundary_mesh, smooth_mesh};
 pub use voxelize::{voxelize, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
-use crate::io::{FormatError, VoxelModel};
+use crate::io::FormatError;
+use crate::model::Model;
 
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from outside.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -93,7 +94,7 @@ pub struct MeshOptions {
 /// Parser errors naming the file and line; [`FormatError::NotWatertight`] for a
 /// solid voxelization of an open mesh; [`FormatError::TooLarge`] past
 /// [`MAX_VOXELIZE_DEPTH`].
-pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<VoxelModel, FormatError> {
+pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<Model, FormatError> {
     let mesh = read::read(path)?;
     voxelize(&mesh, options, path)
 }
@@ -103,18 +104,13 @@ pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<VoxelMod
 ///
 /// # Errors
 /// [`FormatError::Io`]; [`FormatError::UnknownFormat`] for another extension.
-pub fn write_meshed(
-    path: &Path,
-    model: &VoxelModel,
-    options: &MeshOptions,
-) -> Result<(), FormatError> {
+pub fn write_meshed(path: &Path, model: &Model, options: &MeshOptions) -> Result<(), FormatError> {
     let mut mesh = if options.smooth {
         smooth_mesh(&model.tree)
     } else {
         boundary_mesh(&model.tree)
     };
-    if let Some(f) = model.frame {
-        mesh.transform(|p| [0, 1, 2].map(|a| f.translate[a] + f.voxel_size * p[a]));
-    }
+    let f = model.frame;
+    mesh.transform(|p| f.to_world(p));
     write::write_file(path, &mesh)
 }

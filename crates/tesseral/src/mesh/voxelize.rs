@@ -27,8 +27,9 @@ use std::path::Path;
 use rayon::prelude::*;
 
 use super::TriMesh;
-use crate::io::{FormatError, Frame, VoxelModel};
+use crate::io::FormatError;
 use crate::linear::{CellClass, Classifier, LinearOctree};
+use crate::model::{Frame, Model};
 use crate::Voxel;
 
 /// The deepest voxelization we attempt (16384 voxels per axis).
@@ -101,7 +102,7 @@ pub fn voxelize(
     mesh: &TriMesh,
     options: &VoxelizeOptions,
     path: &Path,
-) -> Result<VoxelModel, FormatError> {
+) -> Result<Model, FormatError> {
     let n = mesh.positions.len();
     if let Some(t) = mesh
         .triangles
@@ -125,11 +126,7 @@ pub fn voxelize(
         }
     }
     if mesh.triangles.is_empty() {
-        return Ok(VoxelModel {
-            tree: LinearOctree::empty(0, [0; 3]).expect("depth 0"),
-            frame: Some(Frame::default()),
-            colors: None,
-        });
+        return Ok(Model::new(LinearOctree::empty(0, [0; 3]).expect("depth 0")));
     }
     let (depth, origin, h, translate) = match options.resolution {
         Resolution::Depth(d) => {
@@ -217,14 +214,7 @@ pub fn voxelize(
     };
     let tree = LinearOctree::from_classifier(depth, origin, &classifier)
         .map_err(|e| FormatError::octree(path, e))?;
-    Ok(VoxelModel {
-        tree,
-        frame: Some(Frame {
-            voxel_size: h,
-            translate,
-        }),
-        colors: None,
-    })
+    Ok(Model::new(tree).with_frame(Frame::new(h, translate)))
 }
 
 fn check_watertight(

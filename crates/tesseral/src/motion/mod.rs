@@ -20,6 +20,7 @@ mod draw;
 mod interfere;
 mod orient;
 mod plan;
+mod plan_estimate;
 mod sweep;
 mod traverse;
 mod view;
@@ -38,6 +39,7 @@ pub use orient::{Rotation, RotationError};
 pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
+pub use plan_estimate::{estimate_plan, PlanEstimate, PLAN_BYTES_PER_CELL};
 #[cfg(test)]
 use sweep::first_contact_brute;
 pub use sweep::{first_contact, Fraction, SweptContact};

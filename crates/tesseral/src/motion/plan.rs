@@ -470,34 +470,7 @@ pub fn plan(
     options: &PlanOptions,
 ) -> Result<Plan, NoPath> {
     let rotation = options.rotation;
-    let obj_box = rotated(object, rotation)
-        .bbox()
-        .ok_or(NoPath::EmptyObject)?;
-    let region = match options.region {
-        Some(r) => r,
-        None => {
-            let (mut lo, mut hi) = environment.bbox().unwrap_or((from, from));
-            for p in [from, to] {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a].saturating_add(obj_box.0[a]));
-                    hi[a] = hi[a].max(p[a].saturating_add(obj_box.1[a]));
-                }
-            }
-            let m = options.margin.max(0);
-            Aabb {
-                min: lo.map(|c| c.saturating_sub(m)),
-                max: hi.map(|c| c.saturating_add(m)),
-            }
-        }
-    };
-    // The offsets that keep the object's voxels inside the region.
-    let bounds = Aabb {
-        min: [0, 1, 2].map(|a| region.min[a].saturating_sub(obj_box.0[a])),
-        max: [0, 1, 2].map(|a| region.max[a].saturating_sub(obj_box.1[a])),
-    };
-    if (0..3).any(|a| bounds.max[a] < bounds.min[a]) {
-        return Err(NoPath::ObjectTooLarge);
-    }
+    let bounds = plan_bounds(environment, object, from, to, options)?;
     let inside = |p: Voxel| (0..3).all(|a| bounds.min[a] <= p[a] && p[a] <= bounds.max[a]);
     if !inside(from) {
         return Err(NoPath::StartOutOfBounds {
@@ -585,6 +558,50 @@ pub fn plan(
         free_cells: space.cells.len(),
         settled: search.settled,
     })
+}
+
+/// The offsets of the object that keep it inside the planning region (the region
+/// of `options`, or the bounding box grown by the margin).
+///
+/// # Errors
+/// [`NoPath::EmptyObject`], [`NoPath::ObjectTooLarge`].
+pub(crate) fn plan_bounds(
+    environment: &LinearOctree,
+    object: &LinearOctree,
+    from: Voxel,
+    to: Voxel,
+    options: &PlanOptions,
+) -> Result<Aabb, NoPath> {
+    let rotation = options.rotation;
+    let obj_box = rotated(object, rotation)
+        .bbox()
+        .ok_or(NoPath::EmptyObject)?;
+    let region = match options.region {
+        Some(r) => r,
+        None => {
+            let (mut lo, mut hi) = environment.bbox().unwrap_or((from, from));
+            for p in [from, to] {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a].saturating_add(obj_box.0[a]));
+                    hi[a] = hi[a].max(p[a].saturating_add(obj_box.1[a]));
+                }
+            }
+            let m = options.margin.max(0);
+            Aabb {
+                min: lo.map(|c| c.saturating_sub(m)),
+                max: hi.map(|c| c.saturating_add(m)),
+            }
+        }
+    };
+    // The offsets that keep the object's voxels inside the region.
+    let bounds = Aabb {
+        min: [0, 1, 2].map(|a| region.min[a].saturating_sub(obj_box.0[a])),
+        max: [0, 1, 2].map(|a| region.max[a].saturating_sub(obj_box.1[a])),
+    };
+    if (0..3).any(|a| bounds.max[a] < bounds.min[a]) {
+        return Err(NoPath::ObjectTooLarge);
+    }
+    Ok(bounds)
 }
 
 struct Search {

@@ -12,12 +12,16 @@
 //!   ([`section`]), and contact sheets of several views ([`contact_sheet`]).
 //! - PNG output through the `png` crate ([`Image::write_png`]), written atomically.
 
+mod cut;
 mod trace;
 
 #[cfg(test)]
 mod tests;
 
+pub use cut::crop_to_clip;
 pub use trace::{Hit, Ray, RayTree, TraversalStack};
+
+use cut::Cut;
 
 use std::io::Write;
 use std::path::Path;
@@ -188,7 +192,8 @@ impl Default for Camera {
 }
 
 /// An axis-aligned clipping plane for cross-sections: the voxels with coordinate on
-/// `axis` at or above `at` are removed (or below it, when `keep_above`).
+/// `axis` at or above `at` are removed (or below it, when `keep_above`). The removed
+/// voxels are gone for every ray, shadows included (see [`crop_to_clip`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Clip {
     /// 0 for x, 1 for y, 2 for z.
@@ -466,29 +471,6 @@ impl Frame {
     }
 }
 
-/// The parameter interval of `ray` inside the clip's kept half-space.
-fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
-    let Some(c) = clip else {
-        return (0.0, f64::INFINITY);
-    };
-    let (o, d) = (ray.origin[c.axis], ray.dir[c.axis]);
-    // Kept: coordinate < at (or ≥ at when keep_above).
-    let inside_now = if c.keep_above { o >= c.at } else { o < c.at };
-    if d.abs() < 1e-15 {
-        return if inside_now {
-            (0.0, f64::INFINITY)
-        } else {
-            (1.0, 0.0)
-        };
-    }
-    let t = (c.at - o) / d;
-    if inside_now {
-        (0.0, t.max(0.0))
-    } else {
-        (t.max(0.0), f64::INFINITY)
-    }
-}
-
 /// Renders `tree` as seen by `opts.camera`. `surface` gives colours and normals when
 /// known (a scene's); by default the solid is [`DEFAULT_COLOUR`].
 ///
@@ -506,13 +488,35 @@ fn clip_interval(ray: &Ray, clip: Option<Clip>) -> (f64, f64) {
 /// ```
 #[must_use]
 pub fn render(tree: &LinearOctree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
-    let rt = RayTree::new(tree);
-    render_with(&rt, surface, opts)
+    match opts.clip {
+        None => render_with(&RayTree::new(tree), surface, opts),
+        Some(clip) => {
+            let kept = crop_to_clip(tree, clip);
+            let cut = Cut {
+                clip,
+                original: tree,
+            };
+            render_cut(&RayTree::new(&kept), surface, opts, Some(cut))
+        }
+    }
 }
 
 /// As [`render`], with the ray index already built (for several views of one tree).
+/// It draws `rt` as it is: `opts.clip` needs the tree and is ignored here; pass a
+/// tree cropped by [`crop_to_clip`], or use [`render`] or [`contact_sheet`], which
+/// also mark the cut faces.
 #[must_use]
 pub fn render_with(rt: &RayTree, surface: Surface<'_>, opts: &RenderOptions) -> Image {
+    render_cut(rt, surface, opts, None)
+}
+
+/// Draws `rt`, marking the faces `cut` made (hatched, darker).
+fn render_cut(
+    rt: &RayTree,
+    surface: Surface<'_>,
+    opts: &RenderOptions,
+    cut: Option<Cut<'_>>,
+) -> Image {
     let frame = Frame::new(rt, opts);
     let (w, h) = (opts.width, opts.height);
     let tiles_x = w.div_ceil(TILE);
@@ -528,7 +532,7 @@ pub fn render_with(rt: &RayTree, surface: Surface<'_>, opts: &RenderOptions) -> 
             let mut stack = TraversalStack::default();
             trace_block(rt, &frame, opts, xr, yr, &mut stack, |x, y, ray, hit| {
                 buf[(y - yr[0]) * tw + (x - xr[0])] =
-                    shade_pixel(rt, &frame, surface, opts, ray, hit);
+                    shade_pixel(rt, &frame, surface, opts, cut, ray, hit);
             });
             (ti, buf)
         })
@@ -567,16 +571,15 @@ fn trace_block(
             for y in by..by1 {
                 for x in bx..bx1 {
                     let ray = pixel_ray(frame, w, h, x, y);
-                    let (t0, t1) = clip_interval(&ray, opts.clip);
-                    let from = t0.max(start - margin);
-                    let mut hit = if start.is_finite() && from <= t1 {
-                        rt.cast_with(&ray, from, t1, stack)
+                    let from = (start - margin).max(0.0);
+                    let mut hit = if start.is_finite() {
+                        rt.cast_with(&ray, from, f64::INFINITY, stack)
                     } else {
                         None
                     };
-                    if hit.is_some_and(|h| h.at_start) && from > t0 {
+                    if hit.is_some_and(|h| h.at_start) && from > 0.0 {
                         // Only rounding can put a hit at the beam's start: cast again.
-                        hit = rt.cast_with(&ray, t0, t1, stack);
+                        hit = rt.cast_with(&ray, 0.0, f64::INFINITY, stack);
                     }
                     each(x, y, &ray, hit);
                 }
@@ -619,6 +622,7 @@ fn shade_pixel(
     frame: &Frame,
     surface: Surface<'_>,
     opts: &RenderOptions,
+    cut: Option<Cut<'_>>,
     ray: &Ray,
     hit: Option<Hit>,
 ) -> [u8; 3] {
@@ -630,7 +634,7 @@ fn shade_pixel(
     };
     match hit {
         Some(h) if ground_t.is_none_or(|g| h.t <= g) => {
-            shade_hit(rt, frame, surface, opts, ray, &h)
+            shade_hit(rt, frame, surface, opts, cut, ray, &h)
         }
         _ => match ground_t {
             Some(g) => shade_ground(rt, frame, opts, ray, g),
@@ -644,20 +648,16 @@ fn shade_hit(
     frame: &Frame,
     surface: Surface<'_>,
     opts: &RenderOptions,
+    cut_by: Option<Cut<'_>>,
     ray: &Ray,
     h: &Hit,
 ) -> [u8; 3] {
     let p = ray.at(h.t);
     let mut n = [0.0; 3];
-    let cut = h.at_start && opts.clip.is_some();
-    if cut {
-        let c = opts.clip.expect("cut implies a clip");
-        n[c.axis] = if c.keep_above { -1.0 } else { 1.0 };
-    } else {
-        n[h.axis] = -ray.dir[h.axis].signum();
-    }
+    n[h.axis] = -ray.dir[h.axis].signum();
     // Sample the colour half a voxel inside the surface.
     let inside = add(p, scale(n, -0.5));
+    let cut = cut_by.is_some_and(|c| c.is_cut_face(inside.map(|v| v.floor() as i64), n));
     let face = n;
     let smooth = match opts.normals {
         Normals::Faces => false,
@@ -709,7 +709,7 @@ fn shade_hit(
             if ax == h.axis && !cut {
                 continue;
             }
-            if cut && ax == opts.clip.map_or(3, |c| c.axis) {
+            if cut && ax == cut_by.map_or(3, |c| c.clip.axis) {
                 continue;
             }
             let u = pa - ba as f64;
@@ -832,7 +832,12 @@ pub fn contact_sheet(
     views: &[View],
     columns: usize,
 ) -> Image {
-    let rt = RayTree::new(tree);
+    let kept = opts.clip.map(|c| crop_to_clip(tree, c));
+    let rt = RayTree::new(kept.as_ref().unwrap_or(tree));
+    let cut = opts.clip.map(|clip| Cut {
+        clip,
+        original: tree,
+    });
     let columns = columns.clamp(1, views.len().max(1));
     let rows = views.len().div_ceil(columns);
     let gap = 4;
@@ -846,7 +851,7 @@ pub fn contact_sheet(
         let (az, el) = v.angles();
         o.camera.azimuth_deg = az;
         o.camera.elevation_deg = el;
-        let img = render_with(&rt, surface, &o);
+        let img = render_cut(&rt, surface, &o, cut);
         let (c, r) = (i % columns, i / columns);
         sheet.blit(
             &img,

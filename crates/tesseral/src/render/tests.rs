@@ -497,7 +497,8 @@ fn images_modes_and_png() {
         shadows: false,
         ..base.clone()
     };
-    assert_eq!(primary_hits(&RayTree::new(&tree), &none), 0);
+    let kept = crop_to_clip(&tree, none.clip.unwrap());
+    assert_eq!(primary_hits(&RayTree::new(&kept), &none), 0);
     let persp = render(
         &tree,
         Surface::default(),
@@ -567,16 +568,10 @@ fn beams_change_no_hit() {
                 }
             },
         };
-        let clip = (trial % 3 == 0).then(|| Clip {
-            axis: trial % 3,
-            at: rng.range(10.0, 50.0),
-            keep_above: trial % 4 == 0,
-        });
         let opts = RenderOptions {
             width: 90,
             height: 70,
             camera,
-            clip,
             ..Default::default()
         };
         let frame = Frame::new(&rt, &opts);
@@ -590,8 +585,7 @@ fn beams_change_no_hit() {
             [0, 70],
             &mut stack,
             |x, y, ray, hit| {
-                let (t0, t1) = clip_interval(ray, opts.clip);
-                let alone = if t0 <= t1 { rt.cast(ray, t0, t1) } else { None };
+                let alone = rt.cast(ray, 0.0, f64::INFINITY);
                 match (hit, alone) {
                     (None, None) => {}
                     (Some(a), Some(b)) => assert!(

@@ -420,7 +420,7 @@ fn libes_worked_examples_on_the_octree() {
     use crate::dynamic::DynamicOctree;
     use legality::{legal_grow, legal_shrink};
     let p = [0, 0, 0];
-    // East = +x, south = −y, up = +z (DESIGN.md axes).
+    // East = +x, south = −y, up = +z (docs/conventions.md axes).
     let mut t = DynamicOctree::with_faces();
     t.insert([0, 0, -1]); // below p: p is proposed from this voxel's top face
     t.insert([0, -1, -1]);

@@ -9,8 +9,10 @@
 //! (`computeChildIdx`: x = 1, y = 2, z = 4) is ours, so a preorder walk of the file
 //! yields leaves in tesseral order with no sorting.
 //!
-//! Occupied leaves become black; free and unknown space is white. Writing emits
-//! black leaves as occupied and leaves the rest unknown.
+//! Occupied leaves become black, free leaves the model's known-free space, and in
+//! `.ot` files every leaf's log-odds goes into the model's log-odds layer bit for bit
+//! (and `ColorOcTree` colours into its colour layer), so a round trip keeps the map.
+//! Writing emits black voxels as occupied, free ones as free, and the rest unknown.
 //!
 //! `.bt` stream: a text header (`# Octomap OcTree binary file`, then `id`, `size`,
 //! `res`, `data` lines), then per inner node in preorder two bytes holding two bits
@@ -24,8 +26,13 @@
 
 use std::path::Path;
 
-use super::{reframe, ColorMap, FormatError, Frame, VoxelModel, MAX_COLORED_VOXELS};
+mod write;
+
+pub use write::{encode_bt, encode_ot, write_file, FREE_LOG_ODDS};
+
+use super::{FormatError, MAX_COLORED_VOXELS};
 use crate::linear::{Leaf, LinearOctree};
+use crate::model::{Frame, Layer, Model, Rgba};
 
 /// The depth of every OctoMap tree.
 pub const OCTOMAP_DEPTH: u8 = 16;
@@ -43,7 +50,7 @@ const OT_HEADER: &str = "# Octomap OcTree file";
 /// # Errors
 /// [`FormatError::Corrupt`] for a malformed header or stream, a node count that
 /// disagrees with the header, or a tree deeper than 16.
-pub fn read(path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
     if super::extension(path) == "ot" {
         decode_ot(&bytes, path)
@@ -143,21 +150,14 @@ fn octomap_space() -> LinearOctree {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode_bt(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn decode_bt(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let header = parse_header(bytes, BT_HEADER, path)?;
-    let frame = Some(Frame {
-        voxel_size: header.res,
-        translate: [0.0; 3],
-    });
+    let frame = Frame::new(header.res, [0.0; 3]);
     if header.size == 0 {
-        return Ok(VoxelModel {
-            tree: octomap_space(),
-            frame,
-            colors: None,
-        });
+        return Ok(Model::new(octomap_space()).with_frame(frame));
     }
     let data = &bytes[header.data_start..];
-    let (leaves, nodes, used) =
+    let (leaves, free, nodes, used) =
         decode_bt_stream(data).map_err(|m| FormatError::corrupt(path, m))?;
     if nodes != header.size {
         return Err(FormatError::corrupt(
@@ -168,18 +168,23 @@ pub fn decode_bt(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
     let _ = used;
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
         .map_err(|e| FormatError::octree(path, e))?;
-    Ok(VoxelModel {
-        tree,
-        frame,
-        colors: None,
+    let free = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free)
+        .map_err(|e| FormatError::octree(path, e))?;
+    Ok(Model {
+        free: Some(free),
+        ..Model::new(tree).with_frame(frame)
     })
 }
 
-/// Walks a `.bt` data stream; returns the occupied leaves in tesseral order, the
-/// node count (root included) and the bytes used.
-fn decode_bt_stream(data: &[u8]) -> Result<(Vec<Leaf>, u64, usize), String> {
+/// The occupied and the free leaves of a `.bt` stream, each in tesseral order.
+type BtLeaves = (Vec<Leaf>, Vec<Leaf>, u64, usize);
+
+/// Walks a `.bt` data stream; returns the occupied and free leaves in tesseral order,
+/// the node count (root included) and the bytes used.
+fn decode_bt_stream(data: &[u8]) -> Result<BtLeaves, String> {
     // Each inner node takes two bytes and adds at most 8 leaves.
     let mut leaves = Vec::with_capacity((data.len() / 2).min(1 << 24));
+    let mut free = Vec::new();
     let mut nodes = 1u64;
     let mut pos = 0usize;
     // Explicit stack: (child bits, next child, code of the node's first voxel).
@@ -214,7 +219,7 @@ fn decode_bt_stream(data: &[u8]) -> Result<(Vec<Leaf>, u64, usize), String> {
         let child = base + (u64::from(next) << (3 * u32::from(child_log2)));
         match kind {
             2 => leaves.push(Leaf::new(child, child_log2)),
-            1 => {}
+            1 => free.push(Leaf::new(child, child_log2)),
             _ => {
                 if child_log2 == 0 {
                     return Err(format!(
@@ -227,14 +232,14 @@ fn decode_bt_stream(data: &[u8]) -> Result<(Vec<Leaf>, u64, usize), String> {
             }
         }
     }
-    Ok((leaves, nodes, pos))
+    Ok((leaves, free, nodes, pos))
 }
 
 /// Decodes `.ot` bytes (`OcTree`, `ColorOcTree` or `OcTreeStamped`).
 ///
 /// # Errors
 /// As [`read`]; [`FormatError::Unsupported`] for another tree type.
-pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
+pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let header = parse_header(bytes, OT_HEADER, path)?;
     let extra = match header.id.as_str() {
         "OcTree" => 0,
@@ -248,16 +253,15 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
         }
     };
     let color = extra == 3;
-    let frame = Some(Frame {
-        voxel_size: header.res,
-        translate: [0.0; 3],
-    });
+    let frame = Frame::new(header.res, [0.0; 3]);
     let space = octomap_space();
     if header.size == 0 {
-        return Ok(VoxelModel {
-            tree: space,
-            frame,
-            colors: color.then(ColorMap::new),
+        let colors = color.then(|| Layer::empty(OCTOMAP_DEPTH, [KEY_ORIGIN; 3]));
+        return Ok(Model {
+            colors,
+            free: Some(space.clone()),
+            log_odds: Some(Layer::empty(OCTOMAP_DEPTH, [KEY_ORIGIN; 3])),
+            ..Model::new(space).with_frame(frame)
         });
     }
     let data = &bytes[header.data_start..];
@@ -266,7 +270,9 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
     let mut pos = 0usize;
     let mut nodes = 0u64;
     let mut leaves: Vec<Leaf> = Vec::new();
-    let mut leaf_colors: Vec<(Leaf, [u8; 4])> = Vec::new();
+    let mut free: Vec<Leaf> = Vec::new();
+    let mut values: Vec<(Leaf, f32)> = Vec::new();
+    let mut leaf_colors: Vec<(Leaf, Rgba)> = Vec::new();
     let mut coloured_voxels = 0u64;
     // Stack of (children mask, next child, code, depth).
     let mut stack: Vec<(u8, u8, u64, u8)> = Vec::with_capacity(17);
@@ -285,6 +291,18 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
                     "byte {}: a node at depth 16 claims children",
                     *pos - 1
                 )));
+            }
+            if !value.is_finite() {
+                return Err(bad(format!(
+                    "byte {}: log-odds {value} is not finite",
+                    *pos - node_len - 1
+                )));
+            }
+            if children == 0 {
+                values.push((Leaf::new(code, OCTOMAP_DEPTH - depth), value));
+            }
+            if children == 0 && value < 0.0 {
+                free.push(Leaf::new(code, OCTOMAP_DEPTH - depth));
             }
             if children == 0 && value >= 0.0 {
                 let leaf = Leaf::new(code, OCTOMAP_DEPTH - depth);
@@ -329,242 +347,24 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<VoxelModel, FormatError> {
     }
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
         .map_err(|e| FormatError::octree(path, e))?;
-    let colors = color.then(|| {
-        let mut map = ColorMap::new();
-        for (leaf, c) in leaf_colors {
-            for code in leaf.code()..leaf.end() {
-                map.insert(space.voxel_of(code), c);
-            }
-        }
-        map
-    });
-    Ok(VoxelModel {
+    let oct = |e| FormatError::octree(path, e);
+    let colors = if color {
+        Some(Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaf_colors).map_err(oct)?)
+    } else {
+        None
+    };
+    let free =
+        LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free).map_err(oct)?;
+    let log_odds =
+        Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], values).map_err(oct)?;
+    let _ = space;
+    Ok(Model {
         tree,
         frame,
         colors,
+        free: Some(free),
+        log_odds: Some(log_odds),
     })
-}
-
-/// Moves a model into OctoMap's key space, rounding the frame's translate to whole
-/// voxels (OctoMap keys cannot hold a fraction of a voxel).
-fn to_key_space(model: &VoxelModel) -> Result<(LinearOctree, f64, [i64; 3]), String> {
-    let frame = model.frame.unwrap_or_default();
-    let shift = frame
-        .translate
-        .map(|t| (t / frame.voxel_size).round() as i64);
-    let mut shifted_origin = [0i64; 3];
-    for a in 0..3 {
-        shifted_origin[a] = model.tree.origin()[a]
-            .checked_add(shift[a])
-            .ok_or("the frame's translate moves the octree out of range")?;
-    }
-    let shifted = LinearOctree::from_sorted_leaves(
-        model.tree.depth(),
-        shifted_origin,
-        model.tree.leaves().iter().copied(),
-    )
-    .map_err(|e| e.to_string())?;
-    let tree = reframe(&shifted, OCTOMAP_DEPTH, [KEY_ORIGIN; 3])
-        .map_err(|e| format!("{e}: OctoMap keys reach only voxels −32768..32767 on each axis"))?;
-    Ok((tree, frame.voxel_size, shift))
-}
-
-/// Writes `model` as `.bt` or `.ot` (by extension). Colours make the `.ot` a
-/// `ColorOcTree`.
-///
-/// # Errors
-/// [`FormatError::Unsupported`] when a voxel lies outside OctoMap's key range.
-pub fn write_file(path: &Path, model: &VoxelModel) -> Result<(), FormatError> {
-    let bytes = if super::extension(path) == "ot" {
-        encode_ot(model)
-    } else {
-        encode_bt(model)
-    }
-    .map_err(|m| FormatError::unsupported(path, m))?;
-    super::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
-}
-
-/// Encodes `model` as `.bt` bytes.
-///
-/// # Runtime
-/// O(n · 16) for n leaves.
-///
-/// # Errors
-/// A message when a voxel lies outside the key range.
-///
-/// ```
-/// use tesseral::io::{octomap, VoxelModel};
-/// use tesseral::linear::LinearOctree;
-/// let tree = LinearOctree::from_voxels(2, [-2; 3], [[-2, -2, -2], [1, 0, 1]]).unwrap();
-/// let bytes = octomap::encode_bt(&VoxelModel::new(tree.clone())).unwrap();
-/// let back = octomap::decode_bt(&bytes, "t.bt".as_ref()).unwrap();
-/// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
-/// ```
-pub fn encode_bt(model: &VoxelModel) -> Result<Vec<u8>, String> {
-    let (tree, res, _) = to_key_space(model)?;
-    let mut data = Vec::with_capacity(2 * tree.leaf_count() + 16);
-    let mut nodes = 0u64;
-    if !tree.is_empty() {
-        nodes = 1;
-        write_bt_node(tree.leaves(), 0, OCTOMAP_DEPTH, &mut data, &mut nodes);
-    }
-    let mut out = format!(
-        "{BT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid OcTree\nsize {nodes}\nres {res}\ndata\n"
-    )
-    .into_bytes();
-    out.extend_from_slice(&data);
-    Ok(out)
-}
-
-/// Splits `leaves` (sorted, all inside the cell) among the eight children of the cell
-/// at `code` of size `2^k`, calling `f(child index, child code, its leaves, whether one
-/// leaf covers it)`.
-fn split_children<'a>(
-    leaves: &'a [Leaf],
-    code: u64,
-    k: u8,
-    mut f: impl FnMut(usize, u64, &'a [Leaf], bool),
-) {
-    let child_cells = 1u64 << (3 * u32::from(k - 1));
-    let mut rest = leaves;
-    // A leaf covering the whole cell (only possible at the root).
-    if let [only] = leaves {
-        if only.size_log2() >= k {
-            for i in 0..8 {
-                f(i, code + i as u64 * child_cells, &[], true);
-            }
-            return;
-        }
-    }
-    for i in 0..8u64 {
-        let c = code + i * child_cells;
-        let end = c + child_cells;
-        let n = rest.partition_point(|l| l.code() < end);
-        let (mine, tail) = rest.split_at(n);
-        rest = tail;
-        let full = mine.len() == 1 && mine[0].size_log2() == k - 1;
-        f(i as usize, c, mine, full);
-    }
-}
-
-fn write_bt_node(leaves: &[Leaf], code: u64, k: u8, out: &mut Vec<u8>, nodes: &mut u64) {
-    let mut bits = 0u16;
-    let mut inner: [Option<(u64, &[Leaf])>; 8] = [None; 8];
-    split_children(leaves, code, k, |i, c, mine, full| {
-        if full {
-            bits |= 0b10 << (2 * i);
-            *nodes += 1;
-        } else if !mine.is_empty() {
-            bits |= 0b11 << (2 * i);
-            *nodes += 1;
-            inner[i] = Some((c, mine));
-        }
-    });
-    out.extend_from_slice(&bits.to_le_bytes());
-    for (c, mine) in inner.into_iter().flatten() {
-        write_bt_node(mine, c, k - 1, out, nodes);
-    }
-}
-
-/// Encodes `model` as `.ot` bytes: an `OcTree`, or a `ColorOcTree` when the model has
-/// colours (blocks whose voxels differ in colour are split down to single voxels).
-///
-/// # Errors
-/// A message when a voxel lies outside the key range.
-pub fn encode_ot(model: &VoxelModel) -> Result<Vec<u8>, String> {
-    let (tree, res, shift) = to_key_space(model)?;
-    let space = octomap_space();
-    let colour = model.colors.as_ref().map(|map| {
-        move |code: u64| -> [u8; 3] {
-            let v = space.voxel_of(code);
-            let v = [v[0] - shift[0], v[1] - shift[1], v[2] - shift[2]];
-            let c = map.get(&v).copied().unwrap_or(super::vox::DEFAULT_COLOR);
-            [c[0], c[1], c[2]]
-        }
-    });
-    // Split blocks with mixed colours into voxels.
-    let leaves: Vec<Leaf> = match &colour {
-        None => tree.leaves().to_vec(),
-        Some(col) => {
-            let mut out = Vec::new();
-            for l in tree.leaves() {
-                let first = col(l.code());
-                if (l.code()..l.end()).all(|c| col(c) == first) {
-                    out.push(*l);
-                } else {
-                    out.extend((l.code()..l.end()).map(|c| Leaf::new(c, 0)));
-                }
-            }
-            out
-        }
-    };
-    let mut data = Vec::new();
-    let mut nodes = 0u64;
-    if !leaves.is_empty() {
-        write_ot_node(&leaves, 0, OCTOMAP_DEPTH, &colour, &mut data, &mut nodes);
-    }
-    let id = if colour.is_some() {
-        "ColorOcTree"
-    } else {
-        "OcTree"
-    };
-    let mut out = format!(
-        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid {id}\nsize {nodes}\nres {res}\ndata\n"
-    )
-    .into_bytes();
-    out.extend_from_slice(&data);
-    Ok(out)
-}
-
-/// Writes the cell at `code` of size `2^k` (which holds some black) in `.ot` preorder.
-/// Returns its colour (the mean of its children's, as OctoMap's `updateColorChildren`).
-fn write_ot_node(
-    leaves: &[Leaf],
-    code: u64,
-    k: u8,
-    colour: &Option<impl Fn(u64) -> [u8; 3]>,
-    out: &mut Vec<u8>,
-    nodes: &mut u64,
-) -> [u8; 3] {
-    *nodes += 1;
-    let at = out.len();
-    let extra = if colour.is_some() { 3 } else { 0 };
-    out.extend_from_slice(&OCCUPIED_LOG_ODDS.to_le_bytes());
-    out.extend(std::iter::repeat_n(0u8, extra + 1));
-    let is_leaf = leaves.len() == 1 && leaves[0].size_log2() >= k;
-    let rgb = if is_leaf {
-        colour.as_ref().map_or([0; 3], |c| c(code))
-    } else {
-        let mut mask = 0u8;
-        let mut children: Vec<(u64, &[Leaf])> = Vec::with_capacity(8);
-        split_children(leaves, code, k, |i, c, mine, full| {
-            if full || !mine.is_empty() {
-                mask |= 1 << i;
-                children.push((c, mine));
-            }
-        });
-        out[at + 4 + extra] = mask;
-        let mut sum = [0u32; 3];
-        let n = children.len() as u32;
-        for (c, mine) in children {
-            let child_leaves: Vec<Leaf>;
-            let mine = if mine.is_empty() {
-                child_leaves = vec![Leaf::new(c, k - 1)];
-                &child_leaves[..]
-            } else {
-                mine
-            };
-            let rgb = write_ot_node(mine, c, k - 1, colour, out, nodes);
-            for j in 0..3 {
-                sum[j] += u32::from(rgb[j]);
-            }
-        }
-        sum.map(|s| (s / n.max(1)) as u8)
-    };
-    if extra == 3 {
-        out[at + 4..at + 7].copy_from_slice(&rgb);
-    }
-    rgb
 }
 
 #[cfg(test)]
@@ -573,7 +373,7 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use std::collections::HashSet;
 
-    fn random_model(seed: u64) -> VoxelModel {
+    fn random_model(seed: u64) -> Model {
         let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
         let origin = [
             rng.random_range(-40..40),
@@ -594,14 +394,52 @@ mod tests {
         if seed % 5 == 0 {
             tree = LinearOctree::full(3, [origin[0] & !7, origin[1] & !7, origin[2] & !7]).unwrap();
         }
-        VoxelModel {
-            tree,
-            frame: Some(Frame {
-                voxel_size: 0.05,
-                translate: [0.0; 3],
-            }),
-            colors: None,
-        }
+        // Free voxels around the black ones, and log-odds on both.
+        let free_voxels: Vec<_> = (0..rng.random_range(0..300))
+            .map(|_| {
+                [
+                    origin[0] - 8 + rng.random_range(0..32),
+                    origin[1] - 8 + rng.random_range(0..32),
+                    origin[2] + rng.random_range(0..8),
+                ]
+            })
+            .filter(|&v| !tree.contains(v))
+            .collect();
+        let free =
+            LinearOctree::from_voxels(6, [origin[0] - 8, origin[1] - 8, origin[2]], free_voxels)
+                .unwrap();
+        let model =
+            Model::from_parts(tree, Frame::new(0.05, [0.0; 3]), None, Some(free), None).unwrap();
+        let known: Vec<_> = model.known().voxels().collect();
+        let odds = [0.85f32, 3.5, -0.405, -2.0];
+        let pairs = known.iter().map(|&v| {
+            let x = if model.tree.contains(v) {
+                odds[(v[0] & 1) as usize]
+            } else {
+                odds[2 + (v[1] & 1) as usize]
+            };
+            (v, x)
+        });
+        let layer = Layer::from_voxels(model.tree.depth(), model.tree.origin(), pairs).unwrap();
+        let m = Model {
+            log_odds: Some(layer),
+            ..model
+        };
+        m.assert_valid();
+        m
+    }
+
+    fn odds(m: &Model) -> Vec<(crate::Voxel, u32)> {
+        let mut v: Vec<_> = m
+            .log_odds
+            .as_ref()
+            .unwrap()
+            .to_voxels()
+            .into_iter()
+            .map(|(v, k, _)| (v, k as u32))
+            .collect();
+        v.sort_unstable();
+        v
     }
 
     fn set(t: &LinearOctree) -> HashSet<crate::Voxel> {
@@ -616,28 +454,59 @@ mod tests {
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             bt.tree.assert_valid();
             assert_eq!(set(&bt.tree), set(&m.tree), "seed {seed}");
-            assert_eq!(bt.frame.unwrap().voxel_size, 0.05);
+            assert_eq!(bt.frame.voxel_size, 0.05);
+            assert_eq!(
+                set(bt.free.as_ref().unwrap()),
+                set(m.free.as_ref().unwrap()),
+                "seed {seed}"
+            );
+            bt.assert_valid();
             let ot = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot"))
                 .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-            ot.tree.assert_valid();
+            ot.assert_valid();
             assert_eq!(set(&ot.tree), set(&m.tree), "seed {seed}");
+            assert_eq!(
+                set(ot.free.as_ref().unwrap()),
+                set(m.free.as_ref().unwrap()),
+                "seed {seed}"
+            );
+            assert_eq!(odds(&ot), odds(&m), "seed {seed}: log-odds bit for bit");
+            // Written again, the file is the same bytes.
+            assert_eq!(
+                encode_ot(&ot).unwrap(),
+                encode_ot(&m).unwrap(),
+                "seed {seed}"
+            );
         }
     }
 
     #[test]
     fn colour_ot_round_trip() {
         let m = random_model(3);
-        let colors: ColorMap = m
+        let pairs = m
             .tree
             .voxels()
-            .map(|v| (v, [v[0] as u8, v[1] as u8, 7, 255]))
-            .collect();
-        let m = VoxelModel {
+            .map(|v| (v, [v[0] as u8, v[1] as u8, 7, 255]));
+        let colors = Layer::from_voxels(m.tree.depth(), m.tree.origin(), pairs).unwrap();
+        let m = Model {
             colors: Some(colors.clone()),
             ..m
         };
         let back = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot")).unwrap();
-        assert_eq!(back.colors.unwrap(), colors);
+        back.assert_valid();
+        let got: Vec<_> = back
+            .colors
+            .unwrap()
+            .to_voxels()
+            .into_iter()
+            .map(|(v, k, _)| (v, k))
+            .collect();
+        let want: Vec<_> = colors
+            .to_voxels()
+            .into_iter()
+            .map(|(v, k, _)| (v, k))
+            .collect();
+        assert_eq!(got, want);
     }
 
     #[test]
@@ -664,6 +533,6 @@ mod tests {
     #[test]
     fn out_of_key_range_is_refused() {
         let t = LinearOctree::from_voxels(17, [0; 3], [[40000, 0, 0]]).unwrap();
-        assert!(encode_bt(&VoxelModel::new(t)).is_err());
+        assert!(encode_bt(&Model::new(t)).is_err());
     }
 }

@@ -1,0 +1,118 @@
+//! Work budgets, checked before the work: `--max-leaves` and `--memory`.
+//!
+//! A scene build is estimated first (`Scene::estimate_leaves`, a build three levels
+//! coarser), and refused at once when the estimate is over budget; the real build
+//! then stops at the same budget if the estimate was low. `plan` estimates its
+//! configuration space from the region's box (`motion::estimate_plan_bytes`).
+
+use std::path::Path;
+
+use anyhow::{bail, Result};
+use tesseral::csg::{Scene, DEFAULT_MAX_LEAVES};
+use tesseral::linear::LinearOctree;
+
+use super::output::{human_bytes, parse_bytes};
+
+/// Memory per leaf while a scene is built: the leaf itself and its copy in the
+/// per-thread chunks before they are joined.
+const BUILD_BYTES_PER_LEAF: u64 = 16;
+
+/// The budget flags of commands that build scenes or plan.
+#[derive(clap::Args, Clone, Copy, Debug)]
+pub struct Budget {
+    /// Refuse to build an octree of more leaves than this (a scene is estimated before
+    /// it is built).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_LEAVES)]
+    pub max_leaves: usize,
+    /// The working memory the command may use, estimated before the work: bytes, or a
+    /// number with K, M, G or T (powers of 1024).
+    #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = parse_bytes)]
+    pub memory: u64,
+}
+
+impl Default for Budget {
+    fn default() -> Self {
+        Self {
+            max_leaves: DEFAULT_MAX_LEAVES,
+            memory: 8 << 30,
+        }
+    }
+}
+
+impl Budget {
+    /// The leaf cap: `--max-leaves`, or fewer if `--memory` cannot hold that many.
+    fn leaf_cap(&self) -> usize {
+        let by_memory = usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX);
+        self.max_leaves.min(by_memory)
+    }
+
+    /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
+    /// amount), naming the flag that binds.
+    fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
+        let cap = self.leaf_cap();
+        let (flag, limit) = if self.max_leaves == cap {
+            ("--max-leaves", self.max_leaves.to_string())
+        } else {
+            // At 16 bytes a leaf, memory binds before the leaf count does.
+            ("--memory", human_bytes(self.memory))
+        };
+        let count = if leaves == u64::MAX {
+            format!("more than the {cap} leaves that {flag} {limit} allows")
+        } else {
+            format!("about {leaves} leaves, more than the {cap} that {flag} {limit} allows")
+        };
+        anyhow::anyhow!("{what}: the octree would have {count}; raise {flag} or lower the depth")
+    }
+
+    /// Builds a scene's octree within the budget: refused before the work when the
+    /// estimate is over, stopped during it if the estimate was low.
+    ///
+    /// # Errors
+    /// An error naming the scene and the flag that raises the budget.
+    pub fn build_scene(&self, path: &Path, scene: &Scene) -> Result<LinearOctree> {
+        let cap = self.leaf_cap();
+        let what = format!("{} at depth {}", path.display(), scene.depth);
+        let estimate = scene.estimate_leaves(cap)?;
+        if estimate > cap as u64 {
+            return Err(self.refuse(&what, estimate));
+        }
+        match scene.build_limited(cap) {
+            Ok(tree) => Ok(tree),
+            Err(tesseral::csg::SceneError::Build {
+                source: tesseral::csg::CsgError::TooManyLeaves { .. },
+                ..
+            }) => Err(self.refuse(&what, u64::MAX)),
+            Err(e) => Err(e.into()),
+        }
+    }
+
+    /// Reads a scene and builds it as a model (octree, frame, colours) within the
+    /// budget; each colour's part is built under the same leaf cap.
+    ///
+    /// # Errors
+    /// As [`Budget::build_scene`].
+    pub fn build_scene_model(&self, path: &Path) -> Result<tesseral::model::Model> {
+        let scene = Scene::read(path)?;
+        let tree = self.build_scene(path, &scene)?;
+        let colors = scene.colour_layer(&tree, self.leaf_cap())?;
+        Ok(tesseral::model::Model {
+            colors,
+            ..tesseral::model::Model::new(tree).with_frame(scene.frame())
+        })
+    }
+
+    /// Refuses work estimated at `bytes` of memory above `--memory`.
+    ///
+    /// # Errors
+    /// An error naming `what` and `--memory`.
+    pub fn check_memory(&self, what: &str, bytes: u64, hint: &str) -> Result<()> {
+        if bytes > self.memory {
+            bail!(
+                "{what}: about {} of memory, more than --memory {} allows; raise --memory{hint}",
+                human_bytes(bytes),
+                human_bytes(self.memory)
+            );
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,142 @@
+//! Budgets checked before the work, and `render --cut` on the real binary (issue 12
+//! items 5 and 6).
+
+mod common;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use common::{expect_success, run};
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+fn refused(dir: &Path, args: &[&str], needles: &[&str]) -> String {
+    let out = run(dir, args);
+    let err = String::from_utf8_lossy(&out.stderr).into_owned();
+    assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+    for n in needles {
+        assert!(err.contains(n), "{args:?}: expected {n:?} in {err}");
+    }
+    err
+}
+
+/// The tank at depth 16 would need hundreds of millions of leaves: refused before
+/// the build, naming --max-leaves; and --memory binds when it is the tighter.
+#[test]
+fn scene_builds_are_estimated_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let tank = fs::read_to_string(scenes().join("tank.tss")).unwrap();
+    fs::write(d.join("t16.tss"), tank.replace("depth 7", "depth 16")).unwrap();
+    fs::write(d.join("tank.tss"), &tank).unwrap();
+    refused(
+        d,
+        &["build", "t16.tss", "-o", "t.tess"],
+        &["t16.tss", "--max-leaves"],
+    );
+    refused(d, &["render", "t16.tss", "-o", "t.png"], &["--max-leaves"]);
+    refused(
+        d,
+        &["build", "tank.tss", "-o", "t.tess", "--max-leaves", "1000"],
+        &["--max-leaves 1000"],
+    );
+    refused(
+        d,
+        &["build", "tank.tss", "-o", "t.tess", "--memory", "10K"],
+        &["--memory"],
+    );
+    refused(
+        d,
+        &["build", "tank.tss", "-o", "t.tess", "--memory", "ten"],
+        &["not a size"],
+    );
+    assert!(!d.join("t.tess").exists() && !d.join("t.png").exists());
+    // The real tank has about 7,400 leaves: a budget of 20,000 lets it through.
+    let out = expect_success(&run(
+        d,
+        &[
+            "build",
+            "tank.tss",
+            "-o",
+            "t.tess",
+            "--max-leaves",
+            "20000",
+            "--json",
+        ],
+    ));
+    let v: serde_json::Value = serde_json::from_str(&out).unwrap();
+    assert!(v["leaves"].as_u64().unwrap() < 20000);
+}
+
+/// `plan --margin 1000000` grew at 90 MB/s; it is refused at once, naming --memory
+/// and --margin.
+#[test]
+fn plan_regions_are_estimated_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("wall.xyz"), "10 0 0\n10 1 0\n").unwrap();
+    fs::write(d.join("cube.xyz"), "0 0 0\n").unwrap();
+    let base = [
+        "plan", "wall.xyz", "cube.xyz", "--from", "0,0,0", "--to", "20,0,0",
+    ];
+    refused(
+        d,
+        &[&base[..], &["--margin", "1000000"]].concat(),
+        &["--memory", "--margin"],
+    );
+    refused(
+        d,
+        &[
+            &base[..],
+            &["--region", "-900000,-900000,-900000,900000,900000,900000"],
+        ]
+        .concat(),
+        &["--memory", "--region"],
+    );
+    // A modest margin plans as before, and a tiny --memory refuses even that.
+    expect_success(&run(d, &[&base[..], &["--margin", "20"]].concat()));
+    refused(
+        d,
+        &[&base[..], &["--margin", "20", "--memory", "1K"]].concat(),
+        &["--memory"],
+    );
+}
+
+/// Issue 12, item 5: on the tank (x up to 48), `x<100` and `y>-1000` show the whole
+/// tank, `x>100` nothing (with a note); a plane through it differs from both.
+#[test]
+fn cuts_outside_the_solid_keep_all_or_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::copy(scenes().join("tank.tss"), d.join("tank.tss")).unwrap();
+    let render = |name: &str, extra: &[&str]| -> (Vec<u8>, String) {
+        let out = run(
+            d,
+            &[
+                &["render", "tank.tss", "-o", name, "--size", "160x120"][..],
+                extra,
+            ]
+            .concat(),
+        );
+        expect_success(&out);
+        (
+            fs::read(d.join(name)).unwrap(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    let (whole, _) = render("whole.png", &[]);
+    let (below, note) = render("below.png", &["--cut", "x<100"]);
+    assert_eq!(below, whole);
+    assert!(note.contains("keeps all"), "{note}");
+    let (above, _) = render("above.png", &["--cut", "y>-1000"]);
+    assert_eq!(above, whole);
+    let (none, note) = render("none.png", &["--cut", "x>100"]);
+    assert_ne!(none, whole);
+    assert!(note.contains("keeps nothing"), "{note}");
+    let (half, note) = render("half.png", &["--cut", "x<10"]);
+    assert_ne!(half, whole);
+    assert_ne!(half, none);
+    assert!(note.is_empty(), "{note}");
+}
