@@ -128,10 +128,7 @@ fn obj_bounds(path: &Path) -> ([f64; 3], [f64; 3]) {
     let text = std::fs::read_to_string(path).unwrap();
     let mut lo = [f64::MAX; 3];
     let mut hi = [f64::MIN; 3];
-    for line in text
-        .lines()
-        .filter_map(|l| l.trim().strip_prefix("v "))
-    {
+    for line in text.lines().filter_map(|l| l.trim().strip_prefix("v ")) {
         let p: Vec<f64> = line
             .split_whitespace()
             .map(|w| w.parse().unwrap())

@@ -41,14 +41,14 @@ impl Default for Budget {
 
 impl Budget {
     /// The leaf cap: `--max-leaves`, or fewer if `--memory` cannot hold that many.
-    fn leaf_cap(&self) -> usize {
+    pub fn leaf_cap(&self) -> usize {
         let by_memory = usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX);
         self.max_leaves.min(by_memory)
     }
 
     /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
     /// amount), naming the flag that binds.
-    fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
+    pub fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
         let cap = self.leaf_cap();
         let (flag, limit) = if self.max_leaves == cap {
             ("--max-leaves", self.max_leaves.to_string())

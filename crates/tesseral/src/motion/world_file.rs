@@ -69,6 +69,18 @@ pub enum WorldError {
     /// A scene file the world names could not be read or built.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The environment and objects hold more leaves in total than the budget.
+    #[error(
+        "{path}: the environment and objects read so far hold {leaves} leaves, more than the budget of {budget}"
+    )]
+    TooManyLeaves {
+        /// The world file.
+        path: PathBuf,
+        /// The leaves counted when the budget was crossed.
+        leaves: u64,
+        /// The budget.
+        budget: u64,
+    },
 }
 
 #[derive(Deserialize)]
@@ -138,12 +150,25 @@ pub fn read_solid(path: &Path) -> Result<crate::linear::LinearOctree, WorldError
 /// Positions and times must stay where an `i64` offset and an `f64` time are exact.
 const MAX_COORD: f64 = (1u64 << 40) as f64;
 
-/// Reads a world file (see the module documentation for the format).
+/// Reads a world file (see the module documentation for the format), with the
+/// default budget of [`crate::csg::DEFAULT_MAX_LEAVES`] leaves over all its bodies.
+///
+/// # Errors
+/// As [`read_world_limited`].
+pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
+    read_world_limited(path, crate::csg::DEFAULT_MAX_LEAVES as u64)
+}
+
+/// Reads a world file, with a budget on the leaves of the environment and all the
+/// objects together (1,024 objects that each name a large octree would otherwise
+/// hold 1,024 copies of it). The total is checked after each body is read, so at
+/// most one body's leaves are read past the budget.
 ///
 /// # Errors
 /// [`WorldError`] naming the file and the line and column, or the object and field,
-/// at fault; or the octree file that could not be read.
-pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
+/// at fault; or the octree file that could not be read;
+/// [`WorldError::TooManyLeaves`] when the bodies hold more than `max_leaves`.
+pub fn read_world_limited(path: &Path, max_leaves: u64) -> Result<WorldFile, WorldError> {
     let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io {
         path: path.to_owned(),
         source,
@@ -185,6 +210,15 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
     };
     let dir = path.parent().unwrap_or(Path::new(""));
     let environment = read_solid(&dir.join(&spec.environment))?;
+    let mut leaves = environment.leaf_count() as u64;
+    let over = |leaves: u64| WorldError::TooManyLeaves {
+        path: path.to_owned(),
+        leaves,
+        budget: max_leaves,
+    };
+    if leaves > max_leaves {
+        return Err(over(leaves));
+    }
     let mut objects = Vec::with_capacity(spec.objects.len());
     for (i, o) in spec.objects.into_iter().enumerate() {
         let name = o.name.unwrap_or_else(|| format!("object{i}"));
@@ -235,6 +269,10 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
             }
         };
         let tree = read_solid(&dir.join(&o.octree))?;
+        leaves = leaves.saturating_add(tree.leaf_count() as u64);
+        if leaves > max_leaves {
+            return Err(over(leaves));
+        }
         objects.push(MovingObject {
             name,
             tree,
