@@ -91,3 +91,34 @@ fn many_large_objects_exceed_the_world_budget_naming_it() {
     let out = run_capped(d, &["simulate", "many.json"], 2048, 120);
     fails_naming(&out, &["many.json", "leaves", "--max-leaves"]);
 }
+
+/// Octree paths that leave the world file's folder (issue 19, item 9) are refused
+/// unless `--allow-outside` is given.
+#[test]
+fn paths_outside_the_world_folder_need_allow_outside() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::create_dir(d.join("w")).unwrap();
+    std::fs::write(d.join("dot.xyz"), "0 0 0\n").unwrap();
+    std::fs::write(d.join("w/dot.xyz"), "0 0 0\n").unwrap();
+    let abs = d.join("dot.xyz").display().to_string();
+    for (env, obj) in [("../dot.xyz", "dot.xyz"), ("dot.xyz", abs.as_str())] {
+        let world = format!(
+            r#"{{"environment": "{env}", "steps": 1, "objects": [{{"octree": "{obj}", "start": [5, 0, 0]}}]}}"#
+        );
+        std::fs::write(d.join("w/world.json"), world).unwrap();
+        let out = run_capped(d, &["simulate", "w/world.json"], 1024, 30);
+        fails_naming(&out, &["world.json", "--allow-outside"]);
+        let out = run_capped(
+            d,
+            &["simulate", "w/world.json", "--allow-outside"],
+            1024,
+            30,
+        );
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -42,6 +42,11 @@ pub struct Args {
     limits: Limits,
     #[command(flatten)]
     budget: Budget,
+    /// Let the world file name octree files outside its own folder (absolute paths
+    /// or `..`); without it such a path is an error, so that a world file from
+    /// elsewhere cannot make simulate read any file of the machine.
+    #[arg(long)]
+    allow_outside: bool,
 }
 
 #[derive(Serialize)]
@@ -94,7 +99,7 @@ pub fn run(args: Args) -> Result<()> {
         }
     }
     let cap = args.budget.leaf_cap() as u64;
-    let wf = match read_world_limited(&args.world, cap) {
+    let wf = match read_world_limited(&args.world, cap, args.allow_outside) {
         Err(WorldError::TooManyLeaves { path, leaves, .. }) => {
             return Err(args.budget.refuse(&path.display().to_string(), leaves))
         }

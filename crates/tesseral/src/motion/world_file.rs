@@ -156,7 +156,7 @@ const MAX_COORD: f64 = (1u64 << 40) as f64;
 /// # Errors
 /// As [`read_world_limited`].
 pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
-    read_world_limited(path, crate::csg::DEFAULT_MAX_LEAVES as u64)
+    read_world_limited(path, crate::csg::DEFAULT_MAX_LEAVES as u64, false)
 }
 
 /// Reads a world file, with a budget on the leaves of the environment and all the
@@ -164,11 +164,21 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
 /// hold 1,024 copies of it). The total is checked after each body is read, so at
 /// most one body's leaves are read past the budget.
 ///
+/// The octree paths in the file must stay inside its folder (relative, with no
+/// `..`), so that a world file from elsewhere cannot make the reader open any file
+/// of the machine (`/dev/zero`, another user's data); `allow_outside` lifts this.
+/// A symbolic link inside the folder is followed.
+///
 /// # Errors
 /// [`WorldError`] naming the file and the line and column, or the object and field,
 /// at fault; or the octree file that could not be read;
-/// [`WorldError::TooManyLeaves`] when the bodies hold more than `max_leaves`.
-pub fn read_world_limited(path: &Path, max_leaves: u64) -> Result<WorldFile, WorldError> {
+/// [`WorldError::TooManyLeaves`] when the bodies hold more than `max_leaves`;
+/// [`WorldError::Invalid`] for a path outside the folder without `allow_outside`.
+pub fn read_world_limited(
+    path: &Path,
+    max_leaves: u64,
+    allow_outside: bool,
+) -> Result<WorldFile, WorldError> {
     let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io {
         path: path.to_owned(),
         source,
@@ -209,7 +219,23 @@ pub fn read_world_limited(path: &Path, max_leaves: u64) -> Result<WorldFile, Wor
         }
     };
     let dir = path.parent().unwrap_or(Path::new(""));
-    let environment = read_solid(&dir.join(&spec.environment))?;
+    let inside = |field: &str, p: &str| -> Result<PathBuf, WorldError> {
+        let rel = Path::new(p);
+        let escapes = rel.components().any(|c| {
+            !matches!(
+                c,
+                std::path::Component::Normal(_) | std::path::Component::CurDir
+            )
+        });
+        if escapes && !allow_outside {
+            return Err(invalid(format!(
+                "{field} {p:?} leaves the world file's folder (an absolute path or `..`); \
+                 move the file beside the world file, or allow it with --allow-outside"
+            )));
+        }
+        Ok(dir.join(rel))
+    };
+    let environment = read_solid(&inside("environment", &spec.environment)?)?;
     let mut leaves = environment.leaf_count() as u64;
     let over = |leaves: u64| WorldError::TooManyLeaves {
         path: path.to_owned(),
@@ -268,7 +294,7 @@ pub fn read_world_limited(path: &Path, max_leaves: u64) -> Result<WorldFile, Wor
                 Trajectory::Constant { start, velocity }
             }
         };
-        let tree = read_solid(&dir.join(&o.octree))?;
+        let tree = read_solid(&inside(&format!("object {name:?}, octree"), &o.octree)?)?;
         leaves = leaves.saturating_add(tree.leaf_count() as u64);
         if leaves > max_leaves {
             return Err(over(leaves));
