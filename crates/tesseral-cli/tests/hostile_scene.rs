@@ -132,3 +132,45 @@ fn deep_nesting_of_every_kind_is_a_located_error() {
         assert!(err.len() < 1000, "{what}: a report of {} bytes", err.len());
     }
 }
+
+/// 10,000 boxes of eight colours (issue 19, item 8): quadratic before (115 s in the
+/// review for the geometry; the colour layer then wrote 50 million differences).
+/// The cap is a guard against that regression, far above the seconds it takes now,
+/// not a timing measurement.
+#[test]
+fn ten_thousand_boxes_build_without_quadratic_cost() {
+    let mut s = String::from("depth 9\n");
+    let mut x = 0x9e37_79b9_7f4a_7c15_u64;
+    let mut next = || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..10_000 {
+        let at = [next() * 500.0, next() * 500.0, next() * 500.0];
+        let size = [1.0 + 7.0 * next(), 1.0 + 7.0 * next(), 1.0 + 7.0 * next()];
+        writeln!(
+            s,
+            "box(size = [{:.2}, {:.2}, {:.2}]) at [{:.2}, {:.2}, {:.2}]",
+            size[0], size[1], size[2], at[0], at[1], at[2]
+        )
+        .unwrap();
+    }
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("boxes.tss"), &s).unwrap();
+    let out = run_capped(
+        dir.path(),
+        &["build", "boxes.tss", "-o", "boxes.tess", "--json"],
+        4096,
+        90,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["objects"], 10_000);
+    assert_eq!(v["colors"], 8);
+}
