@@ -60,3 +60,77 @@ fn vox_scene_graph_amplification_is_refused_before_expanding() {
     let out = run_capped(dir.path(), &["info", "amp.vox"], 2048, 60);
     fails_naming(&out, &["amp.vox", "voxels"]);
 }
+
+/// Item 9's smaller ones: each a clean error that names what is wrong.
+#[test]
+fn small_hostile_files_fail_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let ply = |last: &str| {
+        format!(
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 {last}\n"
+        )
+    };
+    std::fs::write(d.join("half.ply"), ply("1.5")).unwrap();
+    std::fs::write(d.join("neg.ply"), ply("-2")).unwrap();
+    let mut binvox = b"#binvox 1\ndim 2 2 2\ntranslate 0 0 0\nscale 1e-310\ndata\n".to_vec();
+    binvox.extend_from_slice(&[1, 8]);
+    std::fs::write(d.join("sub.binvox"), binvox).unwrap();
+    std::fs::write(
+        d.join("inf.tss"),
+        "depth 4\nsphere(r = 3) at [1e308 * 10, 1, 2]\n",
+    )
+    .unwrap();
+    std::fs::write(
+        d.join("nan.tss"),
+        "depth 4\nlet b = 1e308 * 10\nsphere(r = 3) at [b - b, 1, 2]\n",
+    )
+    .unwrap();
+    std::fs::write(d.join("long.xyz"), "1 ".repeat(1 << 20)).unwrap();
+    // A ColorOcTree whose root has eight leaf children, each 2^15 voxels wide.
+    let mut ot = b"# Octomap OcTree file\nid ColorOcTree\nsize 9\nres 0.1\ndata\n".to_vec();
+    ot.extend_from_slice(&0f32.to_le_bytes());
+    ot.extend_from_slice(&[1, 2, 3, 0xff]);
+    for _ in 0..8 {
+        ot.extend_from_slice(&1f32.to_le_bytes());
+        ot.extend_from_slice(&[9, 9, 9, 0]);
+    }
+    std::fs::write(d.join("big.ot"), ot).unwrap();
+    let cases: [(&[&str], &[&str]); 7] = [
+        (
+            &["convert", "half.ply", "o.tess"],
+            &["half.ply:13", "1.5", "not a whole number"],
+        ),
+        (
+            &["convert", "neg.ply", "o.tess"],
+            &["neg.ply:13", "-2", "negative"],
+        ),
+        (
+            &["convert", "sub.binvox", "o.tess"],
+            &["sub.binvox", "voxel size", "too small"],
+        ),
+        (
+            &["build", "inf.tss", "-o", "o.tess"],
+            &["inf.tss:2:", "not finite (inf)"],
+        ),
+        (
+            &["build", "nan.tss", "-o", "o.tess"],
+            &["nan.tss:3:", "not finite (NaN)"],
+        ),
+        (
+            &["info", "long.xyz"],
+            &["long.xyz:1", "longer than 4096 bytes"],
+        ),
+        (
+            &["info", "big.ot"],
+            &["big.ot", "coloured voxels", "budget"],
+        ),
+    ];
+    for (args, names) in cases {
+        let out = run_capped(d, args, 1024, 30);
+        fails_naming(&out, names);
+        assert!(!d.join("o.tess").exists(), "{args:?}");
+    }
+}

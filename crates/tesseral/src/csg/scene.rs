@@ -1129,6 +1129,11 @@ impl<'a> Parser<'a> {
                 .iter()
                 .map(|x| match x {
                     Value::Num(f) if f.is_finite() => Ok(*f),
+                    Value::Num(f) => Err(self.err(
+                        span,
+                        format!("`{what}` holds a number that is not finite ({f})"),
+                        Some("check for an overflow such as 1e308 * 10, or inf - inf".into()),
+                    )),
                     _ => Err(self.err(
                         span,
                         format!("`{what}` must hold {n} numbers"),
