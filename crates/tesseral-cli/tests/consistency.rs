@@ -341,6 +341,22 @@ fn tss_scenes_in_info_and_convert() {
     assert_eq!(conv["voxels"], built["voxels"]);
     assert_eq!(conv["voxel_size"], built["voxel_size"]);
     fails(d, &["info", "s.tss", "--max-leaves", "2"], "--max-leaves");
+    fails(
+        d,
+        &["convert", "s.tss", "s3.tess", "--max-leaves", "2"],
+        "--max-leaves",
+    );
+    fails(
+        d,
+        &["convert", "s.tss", "s3.tess", "--memory", "1K"],
+        "--memory",
+    );
+    fails(
+        d,
+        &["build", "s.tss", "-o", "-", "--format", "tess", "--json"],
+        "--json",
+    );
+    assert!(!d.join("s3.tess").exists());
 }
 
 /// "(1 objects)" said "1 object".

@@ -124,6 +124,23 @@ fn plan_never_overwrites_its_environment() {
         "does not write .xyz",
     );
     assert_eq!(fs::read(d.join("wall.xyz")).unwrap(), wall);
+    // Nor does simulate write its frames over the world file.
+    fs::write(
+        d.join("w.json"),
+        r#"{"environment": "wall.xyz", "time_step": 1, "steps": 1, "objects": []}"#,
+    )
+    .unwrap();
+    refused(
+        d,
+        &["simulate", "w.json", "--frames", "w.json"],
+        "world file",
+    );
+    refused(
+        d,
+        &["simulate", "w.json", "--frames", "f", "--max-output", "1K"],
+        "--max-output",
+    );
+    assert!(d.join("w.json").is_file() && !d.join("f").exists());
 }
 
 /// Issue 12, item 4: `render -o x.jpg` and `-o out.tess` wrote PNG bytes.
@@ -332,6 +349,12 @@ fn sigterm_removes_the_temporary() {
     interrupted_convert("-TERM", 143);
 }
 
+/// A closed terminal (SIGHUP) is handled the same way.
+#[test]
+fn sighup_removes_the_temporary() {
+    interrupted_convert("-HUP", 129);
+}
+
 /// Runs a command whose stdout is closed before it writes; it must exit 0 with
 /// nothing on stderr.
 fn quiet_on_broken_pipe(dir: &Path, args: &[&str]) {
@@ -401,6 +424,10 @@ fn a_closed_pipe_ends_quietly() {
         &["build", "good.tss", "-o", "g.tess", "--json"],
         &["translate", "a.xyz", "--by", "1,0,0", "-o", "t.xyz"],
         &["plan", "a.xyz", "a.xyz", "--from", "5,0,0", "--to", "9,0,0"],
+        &["convert", "a.xyz", "-o", "-", "--format", "xyz"],
+        &["render", "a.xyz", "-o", "-", "--size", "64x48"],
+        &["completions", "bash"],
+        &["man"],
     ];
     for args in commands {
         quiet_on_broken_pipe(d, args);

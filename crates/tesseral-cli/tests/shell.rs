@@ -101,6 +101,13 @@ fn dash_is_stdin_and_stdout() {
     fails(d, &["convert", "a.xyz", "-o", "-"], "--format");
     fails(
         d,
+        &[
+            "plan", "a.xyz", "a.xyz", "--from", "5,0,0", "--to", "9,0,0", "-o", "-",
+        ],
+        "standard output",
+    );
+    fails(
+        d,
         &["convert", "a.xyz", "-o", "-", "--format", "jpg"],
         "--format jpg",
     );

@@ -277,3 +277,73 @@ fn item_3_free_space_survives_convert_translate_and_op() {
     assert_eq!(carved.tree.voxel_count(), 0);
     assert_eq!(carved.free.as_ref().unwrap().voxel_count(), free + 120);
 }
+
+#[test]
+fn item_8_garbage_is_not_read_as_an_obj() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mut x = 12345u64;
+    let garbage: Vec<u8> = (0..4096)
+        .map(|_| {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 33) as u8
+        })
+        .collect();
+    std::fs::write(d.join("noise.obj"), &garbage).unwrap();
+    fails(d, &["convert", "noise.obj", "n.tess"], "noise.obj:");
+    // A binary STL renamed .obj.
+    std::fs::write(d.join("cube.stl"), octahedron([0.0; 3], 1.0)).unwrap();
+    ok(d, &["convert", "cube.stl", "c.tess", "--depth", "4"]);
+    ok(d, &["convert", "c.tess", "bin.stl"]);
+    std::fs::copy(d.join("bin.stl"), d.join("bin.obj")).unwrap();
+    fails(d, &["convert", "bin.obj", "b.tess"], "bin.obj:1:");
+    // A text file that is not OBJ, and an OBJ with no faces.
+    std::fs::write(d.join("notes.obj"), "hello world\n").unwrap();
+    fails(
+        d,
+        &["convert", "notes.obj", "x.tess"],
+        "notes.obj:1:1: `hello` is not an OBJ statement",
+    );
+    std::fs::write(d.join("empty.obj"), "# nothing\no thing\n").unwrap();
+    fails(d, &["convert", "empty.obj", "x.tess"], "no triangles");
+    assert!(!d.join("x.tess").exists() && !d.join("n.tess").exists());
+}
+
+#[test]
+fn item_9_a_voxelization_over_budget_is_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    std::fs::write(d.join("oct.stl"), octahedron([0.0; 3], 1.0)).unwrap();
+    // About 2.7e8 crossings and 4.6e8 surface leaves at depth 14: over what 1 GiB
+    // allows, refused at once.
+    fails(
+        d,
+        &[
+            "convert", "oct.stl", "big.tess", "--depth", "14", "--memory", "1G",
+        ],
+        "--memory",
+    );
+    assert!(!d.join("big.tess").exists());
+    // At the default budget, the leaves are estimated from the surface area first:
+    // about 4.6e8 at depth 14, refused at once naming the flags.
+    fails(
+        d,
+        &["convert", "oct.stl", "big.tess", "--depth", "14"],
+        "raise --max-leaves",
+    );
+    // Within the budget it is built.
+    ok(
+        d,
+        &[
+            "convert",
+            "oct.stl",
+            "small.tess",
+            "--depth",
+            "8",
+            "--memory",
+            "1G",
+        ],
+    );
+}

@@ -8,7 +8,6 @@
 //! `readBinary`.
 
 use std::hint::black_box;
-use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
@@ -35,20 +34,20 @@ fn bench_io(c: &mut Criterion) {
         Some(p) => std::fs::read(&p).expect("TESSERAL_BT_FILE must be readable"),
         None => octomap::encode_bt(&Model::new(random_tree(1_000_000, 512, 8))).unwrap(),
     };
-    let model = octomap::decode_bt(&bt_bytes, Path::new("b.bt")).unwrap();
+    let model = octomap::decode_bt(&bt_bytes).unwrap();
     let leaves = model.tree.leaf_count();
     let mut g = c.benchmark_group("io");
     g.sample_size(10);
     g.throughput(Throughput::Elements(leaves as u64));
     g.bench_function(format!("bt_read/{leaves}_leaves"), |b| {
-        b.iter(|| octomap::decode_bt(black_box(&bt_bytes), Path::new("b.bt")).unwrap())
+        b.iter(|| octomap::decode_bt(black_box(&bt_bytes)).unwrap())
     });
     g.bench_function(format!("bt_write/{leaves}_leaves"), |b| {
         b.iter(|| octomap::encode_bt(black_box(&model)).unwrap())
     });
     let tess = native::encode(&model);
     g.bench_function(format!("tess_read/{leaves}_leaves"), |b| {
-        b.iter(|| native::decode(black_box(&tess), Path::new("b.tess")).unwrap())
+        b.iter(|| native::decode(black_box(&tess)).unwrap())
     });
     g.bench_function(format!("tess_write/{leaves}_leaves"), |b| {
         b.iter(|| native::encode(black_box(&model)))
@@ -57,7 +56,7 @@ fn bench_io(c: &mut Criterion) {
     let bv = binvox::encode(&small).unwrap();
     g.throughput(Throughput::Elements(small.tree.voxel_count()));
     g.bench_function("binvox_read/200k_voxels_256", |b| {
-        b.iter(|| binvox::decode(black_box(&bv), Path::new("b.binvox")).unwrap())
+        b.iter(|| binvox::decode(black_box(&bv)).unwrap())
     });
     g.finish();
     eprintln!(
@@ -112,11 +111,12 @@ fn bench_mesh(c: &mut Criterion) {
         let opts = VoxelizeOptions {
             resolution: Resolution::Depth(depth),
             surface_only,
+            ..Default::default()
         };
         let label = if surface_only { "surface" } else { "solid" };
         g.bench_function(
             format!("voxelize_{label}/{n}_triangles_depth_{depth}"),
-            |b| b.iter(|| voxelize(black_box(&sphere), &opts, Path::new("s.stl")).unwrap()),
+            |b| b.iter(|| voxelize(black_box(&sphere), &opts).unwrap()),
         );
     }
     let solid = voxelize(
@@ -124,8 +124,8 @@ fn bench_mesh(c: &mut Criterion) {
         &VoxelizeOptions {
             resolution: Resolution::Depth(8),
             surface_only: false,
+            ..Default::default()
         },
-        Path::new("s"),
     )
     .unwrap();
     let mesh = boundary_mesh(&solid.tree);

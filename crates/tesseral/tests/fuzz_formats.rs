@@ -7,11 +7,11 @@
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::panic::{catch_unwind, AssertUnwindSafe};
-use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Mutex;
 
 use rand::{Rng, SeedableRng};
+use tesseral::io::mesh as meshio;
 use tesseral::io::{binvox, native, octomap, vox, xyz, Frame, Model};
 use tesseral::linear::LinearOctree;
 use tesseral::mesh::{self, Resolution, VoxelizeOptions};
@@ -213,12 +213,7 @@ const CASES: usize = 1500;
 #[test]
 fn fuzz_native() {
     let seeds: Vec<Vec<u8>> = models().iter().map(native::encode).collect();
-    fuzz(
-        "native",
-        |b| native::decode(b, Path::new("f.tess")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("native", |b| native::decode(b).is_ok(), &seeds, CASES);
 }
 
 #[test]
@@ -227,12 +222,7 @@ fn fuzz_binvox() {
         .iter()
         .map(|m| binvox::encode(m).unwrap())
         .collect();
-    fuzz(
-        "binvox",
-        |b| binvox::decode(b, Path::new("f.binvox")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("binvox", |b| binvox::decode(b).is_ok(), &seeds, CASES);
 }
 
 #[test]
@@ -242,12 +232,7 @@ fn fuzz_vox() {
         .filter(|m| !m.tree.is_empty())
         .map(|m| vox::encode(m).unwrap())
         .collect();
-    fuzz(
-        "vox",
-        |b| vox::decode(b, Path::new("f.vox")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("vox", |b| vox::decode(b).is_ok(), &seeds, CASES);
 }
 
 #[test]
@@ -256,12 +241,7 @@ fn fuzz_octomap_bt() {
         .iter()
         .map(|m| octomap::encode_bt(m).unwrap())
         .collect();
-    fuzz(
-        "bt",
-        |b| octomap::decode_bt(b, Path::new("f.bt")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("bt", |b| octomap::decode_bt(b).is_ok(), &seeds, CASES);
 }
 
 #[test]
@@ -275,12 +255,7 @@ fn fuzz_octomap_ot() {
             .into_iter()
             .map(|t| octomap::encode_ot(&Model::new(t)).unwrap()),
     );
-    fuzz(
-        "ot",
-        |b| octomap::decode_ot(b, Path::new("f.ot")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("ot", |b| octomap::decode_ot(b).is_ok(), &seeds, CASES);
 }
 
 #[test]
@@ -293,18 +268,13 @@ fn fuzz_xyz() {
             out
         })
         .collect();
-    fuzz(
-        "xyz",
-        |b| xyz::parse(b, Path::new("f.xyz")).is_ok(),
-        &seeds,
-        CASES,
-    );
+    fuzz("xyz", |b| xyz::parse(b).is_ok(), &seeds, CASES);
 }
 
 /// Parses a mesh and, when it is small, voxelizes it both ways at a small depth:
 /// neither may panic on any input.
 fn parse_mesh(b: &[u8], ext: &str) -> bool {
-    let Ok(m) = mesh::read::parse(b, ext, Path::new("f")) else {
+    let Ok(m) = meshio::parse(b, ext) else {
         return false;
     };
     if m.triangles.len() <= 200 {
@@ -312,8 +282,9 @@ fn parse_mesh(b: &[u8], ext: &str) -> bool {
             let opts = VoxelizeOptions {
                 resolution: Resolution::Depth(4),
                 surface_only,
+                ..Default::default()
             };
-            let _ = mesh::voxelize(&m, &opts, Path::new("f"));
+            let _ = mesh::voxelize(&m, &opts);
         }
     }
     true
@@ -327,9 +298,9 @@ fn mesh_seeds(ext: &str) -> Vec<Vec<u8>> {
             let m = mesh::boundary_mesh(t);
             let mut out = Vec::new();
             match ext {
-                "stl" => mesh::write::write_stl(&mut out, &m),
-                "obj" => mesh::write::write_obj(&mut out, &m),
-                _ => mesh::write::write_ply(&mut out, &m),
+                "stl" => meshio::write_stl(&mut out, &m),
+                "obj" => meshio::write_obj(&mut out, &m),
+                _ => meshio::write_ply(&mut out, &m),
             }
             .unwrap();
             out
@@ -369,15 +340,15 @@ fn fuzz_ply() {
 fn hostile_headers_are_refused_cheaply() {
     let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let cases: Vec<(&str, Parser, Vec<u8>)> = vec![
-        ("binvox dim", |b| binvox::decode(b, Path::new("h")).is_ok(), b"#binvox 1\ndim 2097152 2097152 2097152\ndata\n\x01\xff".to_vec()),
-        ("bt size", |b| octomap::decode_bt(b, Path::new("h")).is_ok(), b"# Octomap OcTree binary file\nid OcTree\nsize 4294967295\nres 0.1\ndata\n\xff\xff".to_vec()),
-        ("ply count", |b| mesh::read::parse(b, "ply", Path::new("h")).is_ok(), b"ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\nproperty double x\nproperty double y\nproperty double z\nend_header\n".to_vec()),
-        ("stl count", |b| mesh::read::parse(b, "stl", Path::new("h")).is_ok(), {
+        ("binvox dim", |b| binvox::decode(b).is_ok(), b"#binvox 1\ndim 2097152 2097152 2097152\ndata\n\x01\xff".to_vec()),
+        ("bt size", |b| octomap::decode_bt(b).is_ok(), b"# Octomap OcTree binary file\nid OcTree\nsize 4294967295\nres 0.1\ndata\n\xff\xff".to_vec()),
+        ("ply count", |b| meshio::parse(b, "ply").is_ok(), b"ply\nformat binary_little_endian 1.0\nelement vertex 4294967295\nproperty double x\nproperty double y\nproperty double z\nend_header\n".to_vec()),
+        ("stl count", |b| meshio::parse(b, "stl").is_ok(), {
             let mut v = vec![0u8; 84];
             v[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
             v
         }),
-        ("vox count", |b| vox::decode(b, Path::new("h")).is_ok(), {
+        ("vox count", |b| vox::decode(b).is_ok(), {
             let mut v = b"VOX \x96\0\0\0MAIN\0\0\0\0\x24\0\0\0SIZE\x0c\0\0\0\0\0\0\0\x02\0\0\0\x02\0\0\0\x02\0\0\0XYZI\x04\0\0\0\0\0\0\0".to_vec();
             v.extend_from_slice(&u32::MAX.to_le_bytes());
             v

@@ -28,6 +28,9 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     octree::guard(&args.output, &[&args.scene], &args.limits)?;
+    if super::output::is_stdio(&args.output) && args.json {
+        anyhow::bail!("--json: standard output already holds the octree (-o -)");
+    }
     let scene = Scene::read(&args.scene)?;
     let start = Instant::now();
     let model = args.budget.build_scene_model(&args.scene)?;

@@ -110,6 +110,10 @@ pub fn run(mut args: Args) -> Result<()> {
         mesh: VoxelizeOptions {
             resolution,
             surface_only: args.surface_only,
+            // A crossing is 8 bytes, held about three times over while it is
+            // sorted and indexed.
+            max_crossings: usize::try_from(args.budget.memory / 24).unwrap_or(usize::MAX),
+            max_leaves: args.budget.leaf_cap(),
         },
     };
     let write = WriteOptions {

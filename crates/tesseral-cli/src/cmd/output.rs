@@ -138,6 +138,25 @@ pub fn parse_size(s: &str) -> Result<Size, String> {
     Ok(Size { width, height })
 }
 
+/// A step rate for people: three significant figures, with k or M.
+pub fn rate_text(per_second: f64) -> String {
+    let (value, unit) = if per_second >= 1e6 {
+        (per_second / 1e6, "M ")
+    } else if per_second >= 1e3 {
+        (per_second / 1e3, "k ")
+    } else {
+        (per_second, "")
+    };
+    let decimals = if value >= 100.0 {
+        0
+    } else if value >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{value:.decimals$} {unit}steps/s")
+}
+
 /// Where an output goes, for the checks: `-` is standard output.
 pub fn is_stdio(path: &Path) -> bool {
     path.as_os_str() == "-"
@@ -271,15 +290,15 @@ pub fn with_progress<T>(estimate: u64, write: impl FnOnce() -> T) -> T {
     result
 }
 
-/// Installs the SIGINT/SIGTERM handler: remove the temporaries of writes in progress
-/// and exit with 128 + the signal (130 for Ctrl-C, 143 for SIGTERM), as a shell
-/// reports a process killed by it. SIGKILL cannot be caught: a `kill -9` may leave a
+/// Installs the SIGINT/SIGTERM/SIGHUP handler: remove the temporaries of writes in
+/// progress and exit with 128 + the signal (130 for Ctrl-C, 143 for SIGTERM, 129 when
+/// the terminal goes away), as a shell reports a process killed by it. SIGKILL cannot be caught: a `kill -9` may leave a
 /// `.NAME.*.tmp` file beside the output.
 pub fn install_signal_handler() {
-    use signal_hook::consts::{SIGINT, SIGTERM};
+    use signal_hook::consts::{SIGHUP, SIGINT, SIGTERM};
     // If the handler cannot be installed, the default action (die at once, possibly
     // leaving a temporary) still stops the program; that is no reason to refuse work.
-    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM]) else {
+    let Ok(mut signals) = signal_hook::iterator::Signals::new([SIGINT, SIGTERM, SIGHUP]) else {
         return;
     };
     std::thread::spawn(move || {
@@ -348,5 +367,14 @@ mod tests {
         assert_eq!(suggest(44 << 30), "44G");
         assert_eq!(suggest((44 << 30) + 1), "45G");
         assert_eq!(suggest(3 << 40), "3T");
+    }
+
+    #[test]
+    fn rates_read_well() {
+        assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
+        assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
+        assert_eq!(rate_text(999.4), "999 steps/s");
+        assert_eq!(rate_text(2.71), "2.71 steps/s");
+        assert_eq!(rate_text(0.0), "0.00 steps/s");
     }
 }

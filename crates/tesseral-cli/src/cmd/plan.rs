@@ -104,6 +104,11 @@ struct NotFound {
 
 pub fn run(args: Args) -> Result<()> {
     if let Some(path) = &args.output {
+        if output::is_stdio(path) {
+            anyhow::bail!(
+                "--output -: standard output holds the path; give the picture a file name"
+            );
+        }
         output::guard("--output", path, &["png"], &[&args.env, &args.obj])?;
     }
     let env = read_solid(&args.env).context("reading the environment")?;

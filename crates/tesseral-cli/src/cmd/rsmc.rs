@@ -238,25 +238,6 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
     Ok(rows)
 }
 
-/// A step rate for people: three significant figures, with k or M.
-fn rate_text(per_second: f64) -> String {
-    let (value, unit) = if per_second >= 1e6 {
-        (per_second / 1e6, "M ")
-    } else if per_second >= 1e3 {
-        (per_second / 1e3, "k ")
-    } else {
-        (per_second, "")
-    };
-    let decimals = if value >= 100.0 {
-        0
-    } else if value >= 10.0 {
-        1
-    } else {
-        2
-    };
-    format!("{value:.decimals$} {unit}steps/s")
-}
-
 /// The size of surface.png: --size, or the older --render-width W (W × 3W/4; 0:
 /// none); `None` draws no picture.
 fn picture_size(args: &Args) -> Option<super::output::Size> {
@@ -405,7 +386,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         .with_key(
             "rate",
             |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
-                let _ = w.write_str(&rate_text(state.per_sec()));
+                let _ = w.write_str(&super::output::rate_text(state.per_sec()));
             },
         ),
     );
@@ -525,18 +506,4 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         )?;
     }
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::rate_text;
-
-    #[test]
-    fn rates_read_well() {
-        assert_eq!(rate_text(1_234_567.891), "1.23 M steps/s");
-        assert_eq!(rate_text(45_678.9), "45.7 k steps/s");
-        assert_eq!(rate_text(999.4), "999 steps/s");
-        assert_eq!(rate_text(1.23456), "1.23 steps/s");
-        assert_eq!(rate_text(0.0), "0.00 steps/s");
-    }
 }

@@ -150,7 +150,7 @@ impl BoxIndex {
                     }
                 }
             } else {
-                stack[top] = stack[top] + 1;
+                stack[top] += 1;
                 stack[top + 1] = node.first;
                 top += 2;
             }

@@ -56,7 +56,7 @@ fn the_index_finds_exactly_the_boxes_a_query_meets() {
 fn part(rng: &mut Rng, depth: u32) -> Solid {
     let at = [0; 3].map(|_| rng.range(0.0, 32.0));
     match rng.next() % 8 {
-        0 | 1 | 2 => Solid::shape(Shape::cuboid([0; 3].map(|_| rng.range(0.5, 6.0))))
+        0..=2 => Solid::shape(Shape::cuboid([0; 3].map(|_| rng.range(0.5, 6.0))))
             .rotate([0; 3].map(|_| rng.range(0.0, 90.0)))
             .at(at),
         3 | 4 => Solid::shape(Shape::sphere(rng.range(0.5, 4.0))).at(at),

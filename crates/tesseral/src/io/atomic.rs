@@ -64,7 +64,26 @@ pub fn remove_pending_temporaries() -> usize {
     removed
 }
 
-/// The temporaries of writes in progress (for tests and diagnostics).
+/// The temporaries of writes in progress (for tests, diagnostics and progress
+/// display: a caller may watch their sizes grow).
+///
+/// # Runtime
+/// O(number of writes in progress).
+///
+/// # Example
+/// ```
+/// use std::io::Write;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.txt");
+/// tesseral::io::write_atomic(&path, |w| {
+///     // While the body runs, its temporary is listed, beside the target.
+///     let pending = tesseral::io::pending_temporaries();
+///     assert!(pending.iter().any(|p| p.parent() == Some(dir.path())));
+///     w.write_all(b"x")
+/// })
+/// .unwrap();
+/// assert!(tesseral::io::pending_temporaries().iter().all(|p| p.parent() != Some(dir.path())));
+/// ```
 #[must_use]
 pub fn pending_temporaries() -> Vec<PathBuf> {
     pending().clone()
@@ -114,10 +133,7 @@ pub fn write_atomic(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> Result<(), FormatError> {
-    write_atomic_inner(path, body).map_err(|source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    })
+    write_atomic_inner(path, body).map_err(|source| FormatError::Io(source).with_path(path))
 }
 
 fn write_atomic_inner(

@@ -33,7 +33,7 @@ pub const MAX_WRITE_DIM: u64 = 2048;
 /// run-length data, [`FormatError::TooLarge`] past [`MAX_DENSE_VOXELS`] filled voxels.
 pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
-    decode(&bytes, path)
+    decode(&bytes).map_err(|e| e.with_path(path))
 }
 
 /// Decodes `.binvox` bytes; `path` names the source in errors.
@@ -43,9 +43,8 @@ pub fn read(path: &Path) -> Result<Model, FormatError> {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
+pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
     let syntax = |line: usize, message: String| FormatError::Syntax {
-        path: path.to_owned(),
         line,
         column: 1,
         message,
@@ -121,20 +120,18 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
         .checked_mul(dy)
         .and_then(|v| v.checked_mul(dz))
         .filter(|&t| t < 1 << 62)
-        .ok_or_else(|| FormatError::too_large(path, format!("grid {dx}×{dz}×{dy} is too large")))?;
+        .ok_or_else(|| FormatError::too_large(format!("grid {dx}×{dz}×{dy} is too large")))?;
     let max_dim = dx.max(dy).max(dz);
     if max_dim > 1 << 21 {
-        return Err(FormatError::too_large(
-            path,
-            format!("grid extent {max_dim} exceeds 2^21"),
-        ));
+        return Err(FormatError::too_large(format!(
+            "grid extent {max_dim} exceeds 2^21"
+        )));
     }
     let voxel_size = scale / max_dim as f64;
     // A subnormal size (or one that underflows to 0) cannot be written back or used
     // to place anything: it would make a `.tess` with voxel size 0.
     if !voxel_size.is_normal() {
         return Err(FormatError::corrupt(
-            path,
             format!("scale {scale:e} over {max_dim} voxels gives a voxel size of {voxel_size:e}, too small to represent"),
         ));
     }
@@ -170,36 +167,29 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     let mut i = 0usize;
     while index < total {
         if i + 1 >= data.len() {
-            return Err(FormatError::corrupt(
-                path,
-                format!(
-                    "data ends after {index} of {total} voxels (byte {})",
-                    pos + i
-                ),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "data ends after {index} of {total} voxels (byte {})",
+                pos + i
+            )));
         }
         let (value, count) = (data[i], u64::from(data[i + 1]));
         if count == 0 || index + count > total {
-            return Err(FormatError::corrupt(
-                path,
-                format!(
-                    "bad run of {count} at byte {} (voxel {index} of {total})",
-                    pos + i
-                ),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "bad run of {count} at byte {} (voxel {index} of {total})",
+                pos + i
+            )));
         }
         if value > 1 {
-            return Err(FormatError::corrupt(
-                path,
-                format!("voxel value {value} at byte {} is not 0 or 1", pos + i),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "voxel value {value} at byte {} is not 0 or 1",
+                pos + i
+            )));
         }
         if value == 1 {
             if codes.len() as u64 + count > MAX_DENSE_VOXELS {
-                return Err(FormatError::too_large(
-                    path,
-                    format!("more than {MAX_DENSE_VOXELS} filled voxels"),
-                ));
+                return Err(FormatError::too_large(format!(
+                    "more than {MAX_DENSE_VOXELS} filled voxels"
+                )));
             }
             for j in index..index + count {
                 let x = j / slab;
@@ -215,7 +205,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     codes.sort_unstable();
     let tree =
         LinearOctree::from_sorted_leaves(depth, shift, codes.into_iter().map(|c| Leaf::new(c, 0)))
-            .map_err(|e| FormatError::octree(path, e))?;
+            .map_err(FormatError::octree)?;
     Ok(Model::new(tree).with_frame(Frame::new(voxel_size, rest)))
 }
 
@@ -235,7 +225,7 @@ fn parse_n<T: std::str::FromStr>(values: &[&str], n: usize) -> Result<Vec<T>, St
 /// [`FormatError::Unsupported`] when the bounding box is wider than
 /// [`MAX_WRITE_DIM`]; [`FormatError::Io`].
 pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
-    let bytes = encode(model).map_err(|m| FormatError::unsupported(path, m))?;
+    let bytes = encode(model).map_err(|m| FormatError::unsupported(m).with_path(path))?;
     super::write_atomic(path, |w| w.write_all(&bytes))
 }
 
@@ -262,7 +252,7 @@ pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(3, [0, 0, 0], [[0, 0, 0], [2, 1, 0]]).unwrap();
 /// let bytes = binvox::encode(&Model::new(tree.clone())).unwrap();
-/// let back = binvox::decode(&bytes, "t.binvox".as_ref()).unwrap();
+/// let back = binvox::decode(&bytes).unwrap();
 /// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
 /// ```
 pub fn encode(model: &Model) -> Result<Vec<u8>, String> {
@@ -344,7 +334,7 @@ mod tests {
         // 2×2×2 grid: ones at indices 1 (y=1) and 2 (z=1) and 4 (x=1).
         let mut bytes = b"#binvox 1\ndim 2 2 2\ntranslate 0 0 0\nscale 2\ndata\n".to_vec();
         bytes.extend_from_slice(&[0, 1, 1, 2, 0, 1, 1, 1, 0, 3]);
-        let m = decode(&bytes, Path::new("t.binvox")).unwrap();
+        let m = decode(&bytes).unwrap();
         let v: HashSet<Voxel> = m.tree.voxels().collect();
         assert_eq!(v, HashSet::from([[0, 1, 0], [0, 0, 1], [1, 0, 0]]));
         assert_eq!(m.frame.voxel_size, 1.0);
@@ -354,13 +344,13 @@ mod tests {
     fn translate_and_scale_survive_a_round_trip() {
         let mut bytes = b"#binvox 1\ndim 4 4 4\ntranslate -0.5 0.25 0.1\nscale 2\ndata\n".to_vec();
         bytes.extend_from_slice(&[0, 5, 1, 3, 0, 56]);
-        let m = decode(&bytes, Path::new("t.binvox")).unwrap();
+        let m = decode(&bytes).unwrap();
         let f = m.frame;
         assert_eq!(f.voxel_size, 0.5);
         // -0.5 is one whole voxel; 0.25 is half a voxel, so it stays in the frame.
         assert_eq!(m.tree.origin()[0], -1);
         assert_eq!(f.translate[1], 0.25);
-        let again = decode(&encode(&m).unwrap(), Path::new("t.binvox")).unwrap();
+        let again = decode(&encode(&m).unwrap()).unwrap();
         assert_eq!(
             again.tree.voxels().collect::<Vec<_>>(),
             m.tree.voxels().collect::<Vec<_>>()
@@ -380,8 +370,7 @@ mod tests {
             let voxels: HashSet<Voxel> = voxels.into_iter().collect();
             let tree = LinearOctree::from_voxels(4, origin, voxels.iter().copied()).unwrap();
             let bytes = encode(&Model::new(tree)).unwrap();
-            let back = decode(&bytes, Path::new("t.binvox"))
-                .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let back = decode(&bytes).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             back.tree.assert_valid();
             assert_eq!(
                 back.tree.voxels().collect::<HashSet<_>>(),
@@ -393,7 +382,6 @@ mod tests {
 
     #[test]
     fn bad_files_give_errors() {
-        let p = Path::new("t.binvox");
         for bad in [
             &b""[..],
             b"#binvox 1\n",
@@ -405,11 +393,7 @@ mod tests {
             b"#binvox 1\ndim 4000000000 4000000000 4000000000\ndata\n\x01\xff",
             b"#binvox 1\ndim 2 2 2\nscale -1\ndata\n\x01\x08",
         ] {
-            assert!(
-                decode(bad, p).is_err(),
-                "{:?}",
-                String::from_utf8_lossy(bad)
-            );
+            assert!(decode(bad).is_err(), "{:?}", String::from_utf8_lossy(bad));
         }
     }
 }

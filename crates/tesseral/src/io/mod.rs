@@ -22,6 +22,7 @@ mod atomic;
 pub mod binvox;
 mod estimate;
 mod leafstream;
+pub mod mesh;
 pub mod native;
 pub mod octomap;
 mod reframe;
@@ -29,130 +30,19 @@ mod sniff;
 pub mod vox;
 pub mod xyz;
 
+mod error;
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
+pub use error::FormatError;
 pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
 pub use sniff::sniff_format;
 
 use std::fs;
-use std::io;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use crate::linear::{LinearOctree, OctreeError};
+use crate::linear::LinearOctree;
 #[cfg(test)]
 use crate::Voxel;
-
-/// What can go wrong reading or writing a file.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum FormatError {
-    /// The operating system refused to read or write the file.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The underlying error.
-        source: io::Error,
-    },
-    /// The file's content is malformed at a given line and column (1-based).
-    #[error("{path}:{line}:{column}: {message}")]
-    Syntax {
-        /// The file.
-        path: PathBuf,
-        /// The line, from 1.
-        line: usize,
-        /// The column, from 1.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// The file is malformed at a byte offset or in a named field.
-    #[error("{path}: {message}")]
-    Corrupt {
-        /// The file.
-        path: PathBuf,
-        /// What is wrong, naming the field or offset.
-        message: String,
-    },
-    /// The extension names no format we know.
-    #[error("{path}: unknown file format (known extensions: {known})")]
-    UnknownFormat {
-        /// The file.
-        path: PathBuf,
-        /// The extensions we know, comma-separated.
-        known: &'static str,
-    },
-    /// The content does not fit an octree (too deep, out of bounds).
-    #[error("{path}: {source}")]
-    Octree {
-        /// The file.
-        path: PathBuf,
-        /// The underlying error.
-        source: OctreeError,
-    },
-    /// The file is well formed but exceeds a limit that protects memory and time
-    /// (grid size, voxel count, element count).
-    #[error("{path}: {message}")]
-    TooLarge {
-        /// The file.
-        path: PathBuf,
-        /// Which limit, and the value found.
-        message: String,
-    },
-    /// The octree cannot be expressed in the target format (too big for its grid,
-    /// too many colours), or the file uses a feature we do not read.
-    #[error("{path}: {message}")]
-    Unsupported {
-        /// The file.
-        path: PathBuf,
-        /// What cannot be expressed or read.
-        message: String,
-    },
-    /// A mesh that should bound a solid has open edges, so inside and outside are not
-    /// defined. Voxelize its surface only, or repair it.
-    #[error("{path}: mesh is not watertight: {open_edges} edge(s) are not shared by an even number of triangles (first near {example:?}); use --surface-only to voxelize the surface")]
-    NotWatertight {
-        /// The file.
-        path: PathBuf,
-        /// How many edges have an odd number of triangles.
-        open_edges: usize,
-        /// The coordinates of one end of one open edge.
-        example: [f64; 3],
-    },
-}
-
-impl FormatError {
-    pub(crate) fn corrupt(path: &Path, message: impl Into<String>) -> Self {
-        Self::Corrupt {
-            path: path.to_owned(),
-            message: message.into(),
-        }
-    }
-    pub(crate) fn too_large(path: &Path, message: impl Into<String>) -> Self {
-        Self::TooLarge {
-            path: path.to_owned(),
-            message: message.into(),
-        }
-    }
-    pub(crate) fn unsupported(path: &Path, message: impl Into<String>) -> Self {
-        Self::Unsupported {
-            path: path.to_owned(),
-            message: message.into(),
-        }
-    }
-    pub(crate) fn io(path: &Path, source: io::Error) -> Self {
-        Self::Io {
-            path: path.to_owned(),
-            source,
-        }
-    }
-    pub(crate) fn octree(path: &Path, source: OctreeError) -> Self {
-        Self::Octree {
-            path: path.to_owned(),
-            source,
-        }
-    }
-}
 
 pub use crate::model::{Frame, Model};
 
@@ -204,12 +94,12 @@ pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<Model, Form
         "binvox" => binvox::read(path),
         "vox" => vox::read(path),
         "bt" | "ot" => octomap::read(path),
-        "stl" | "obj" | "ply" => crate::mesh::read_voxelized(path, &options.mesh),
+        "stl" | "obj" | "ply" => mesh::read_voxelized(path, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
-            path: path.to_owned(),
             known: KNOWN_EXTENSIONS,
         }),
     }
+    .map_err(|e| e.with_path(path))
 }
 
 /// Writes `tree` to `path` atomically, choosing the format by its extension.
@@ -245,12 +135,12 @@ pub fn write_model_with(
         "binvox" => binvox::write_file(path, model),
         "vox" => vox::write_file(path, model),
         "bt" | "ot" => octomap::write_file(path, model),
-        "stl" | "obj" | "ply" | "glb" => crate::mesh::write_meshed(path, model, &options.mesh),
+        "stl" | "obj" | "ply" | "glb" => mesh::write_meshed(path, model, &options.mesh),
         _ => Err(FormatError::UnknownFormat {
-            path: path.to_owned(),
             known: KNOWN_WRITE_EXTENSIONS,
         }),
     }
+    .map_err(|e| e.with_path(path))
 }
 
 /// The lower-case extension of `path`, or "".
@@ -264,14 +154,15 @@ pub fn extension(path: &Path) -> String {
 
 /// Reads a whole file, refusing files larger than `limit` bytes.
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
-    let meta = fs::metadata(path).map_err(|e| FormatError::io(path, e))?;
+    let attach = |e: FormatError| e.with_path(path);
+    let meta = fs::metadata(path).map_err(|e| attach(FormatError::io(e)))?;
     if meta.len() > limit {
-        return Err(FormatError::too_large(
-            path,
-            format!("file is {} bytes; the limit is {limit}", meta.len()),
-        ));
+        return Err(attach(FormatError::too_large(format!(
+            "file is {} bytes; the limit is {limit}",
+            meta.len()
+        ))));
     }
-    fs::read(path).map_err(|e| FormatError::io(path, e))
+    fs::read(path).map_err(|e| attach(FormatError::io(e)))
 }
 
 /// The largest file the whole-file readers load (4 GiB).

@@ -65,7 +65,7 @@ const HEADER_LEN: usize = 56;
 /// [`FormatError::Corrupt`] naming the field for a truncated, corrupted or hostile
 /// file; [`FormatError::Io`] when the file cannot be read.
 pub fn read(path: &Path) -> Result<Model, FormatError> {
-    let file = std::fs::File::open(path).map_err(|e| FormatError::io(path, e))?;
+    let file = std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
     // SAFETY: the map is read-only and dropped before we return. Another process
     // truncating or rewriting the file while we decode could change the bytes under
     // us; `decode` treats the slice as untrusted input (every read is bounds-checked
@@ -73,10 +73,10 @@ pub fn read(path: &Path) -> Result<Model, FormatError> {
     // or format error, or SIGBUS on truncation, which memory-mapped readers accept.
     // `write_atomic` replaces files by rename, so our own writers never do this.
     match unsafe { memmap2::Mmap::map(&file) } {
-        Ok(map) => decode(&map, path),
+        Ok(map) => decode(&map).map_err(|e| e.with_path(path)),
         Err(_) => {
             let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
-            decode(&bytes, path)
+            decode(&bytes).map_err(|e| e.with_path(path))
         }
     }
 }
@@ -87,7 +87,7 @@ pub fn read(path: &Path) -> Result<Model, FormatError> {
 /// As [`read`].
 pub fn read_unmapped(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
-    decode(&bytes, path)
+    decode(&bytes).map_err(|e| e.with_path(path))
 }
 
 /// Encodes a model into `.tess` bytes.
@@ -97,7 +97,7 @@ pub fn read_unmapped(path: &Path) -> Result<Model, FormatError> {
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(4, [-8, 0, 0], [[-8, 0, 0], [3, 2, 1]]).unwrap();
 /// let bytes = native::encode(&Model::new(tree.clone()));
-/// let back = native::decode(&bytes, "mem.tess".as_ref()).unwrap();
+/// let back = native::decode(&bytes).unwrap();
 /// assert_eq!(back.tree, tree);
 /// ```
 #[must_use]
@@ -162,8 +162,8 @@ pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
 ///
 /// # Errors
 /// [`FormatError::Corrupt`] naming the field at fault.
-pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
-    let bad = |m: String| FormatError::corrupt(path, m);
+pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
+    let bad = |m: String| FormatError::corrupt(m);
     if bytes.len() < 8 || bytes[..8] != MAGIC {
         return Err(bad("not a tesseral .tess file (bad magic number)".into()));
     }
@@ -176,10 +176,9 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     }
     let version = u16::from_le_bytes([bytes[8], bytes[9]]);
     if version != VERSION {
-        return Err(FormatError::unsupported(
-            path,
-            format!("format version {version}; this build reads version {VERSION}"),
-        ));
+        return Err(FormatError::unsupported(format!(
+            "format version {version}; this build reads version {VERSION}"
+        )));
     }
     let (body, stored) = bytes.split_at(bytes.len() - 4);
     let stored = u32::from_le_bytes([stored[0], stored[1], stored[2], stored[3]]);
@@ -195,10 +194,9 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     };
     let flags = r.u16().map_err(&bad)?;
     if flags & !KNOWN_FLAGS != 0 {
-        return Err(FormatError::unsupported(
-            path,
-            format!("unknown flags {flags:#06x}"),
-        ));
+        return Err(FormatError::unsupported(format!(
+            "unknown flags {flags:#06x}"
+        )));
     }
     let depth = r.u8().map_err(&bad)?;
     if depth > MAX_DEPTH {
@@ -241,8 +239,8 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
             payload_end - payload.pos
         )));
     }
-    let tree = LinearOctree::from_sorted_leaves(depth, origin, leaves)
-        .map_err(|e| FormatError::octree(path, e))?;
+    let tree =
+        LinearOctree::from_sorted_leaves(depth, origin, leaves).map_err(FormatError::octree)?;
     let mut tail = Reader {
         bytes: body,
         pos: payload_end,
@@ -284,9 +282,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
             let rgba = tail.take(4).map_err(&bad)?;
             pairs.push((tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]));
         }
-        colors = Some(
-            Layer::from_voxels(depth, origin, pairs).map_err(|e| FormatError::octree(path, e))?,
-        );
+        colors = Some(Layer::from_voxels(depth, origin, pairs).map_err(FormatError::octree)?);
     }
     if flags & FLAG_COLOR_LAYER != 0 {
         colors = Some(
@@ -479,8 +475,7 @@ mod tests {
             .unwrap();
             model.assert_valid();
             let bytes = encode(&model);
-            let back =
-                decode(&bytes, Path::new("t.tess")).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let back = decode(&bytes).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             back.assert_valid();
             assert_eq!(back, model, "seed {seed}");
         }
@@ -491,19 +486,13 @@ mod tests {
         let tree = random_tree(7);
         let bytes = encode(&Model::new(tree));
         for len in 0..bytes.len() {
-            assert!(
-                decode(&bytes[..len], Path::new("t.tess")).is_err(),
-                "truncated to {len}"
-            );
+            assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");
         }
         for i in 0..bytes.len() {
             for bit in 0..8 {
                 let mut b = bytes.clone();
                 b[i] ^= 1 << bit;
-                assert!(
-                    decode(&b, Path::new("t.tess")).is_err(),
-                    "flip byte {i} bit {bit}"
-                );
+                assert!(decode(&b).is_err(), "flip byte {i} bit {bit}");
             }
         }
     }
@@ -517,7 +506,7 @@ mod tests {
         let n = bytes.len();
         let crc = crc32fast::hash(&bytes[..n - 4]);
         bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
-        let err = decode(&bytes, Path::new("t.tess")).unwrap_err().to_string();
+        let err = decode(&bytes).unwrap_err().to_string();
         assert!(err.contains("leaf count"), "{err}");
         // Depth beyond the limit.
         let mut bytes = encode(&Model::new(LinearOctree::empty(2, [0; 3]).unwrap()));
@@ -525,7 +514,7 @@ mod tests {
         let crc = crc32fast::hash(&bytes[..bytes.len() - 4]);
         let n = bytes.len();
         bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
-        let err = decode(&bytes, Path::new("t.tess")).unwrap_err().to_string();
+        let err = decode(&bytes).unwrap_err().to_string();
         assert!(err.contains("depth 40"), "{err}");
     }
 

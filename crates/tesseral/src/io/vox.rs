@@ -30,7 +30,7 @@ pub const DEFAULT_COLOR: [u8; 4] = [200, 200, 200, 255];
 /// for a rotated model in a scene.
 pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
-    decode(&bytes, path)
+    decode(&bytes).map_err(|e| e.with_path(path))
 }
 
 struct VoxModel {
@@ -51,8 +51,8 @@ enum Node {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
-    let bad = |m: String| FormatError::corrupt(path, m);
+pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
+    let bad = |m: String| FormatError::corrupt(m);
     if bytes.len() < 8 || &bytes[..4] != b"VOX " {
         return Err(bad("not a MagicaVoxel file (no `VOX ` magic)".into()));
     }
@@ -112,10 +112,9 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
                 }
                 total_voxels += n;
                 if total_voxels > MAX_DENSE_VOXELS {
-                    return Err(FormatError::too_large(
-                        path,
-                        format!("more than {MAX_DENSE_VOXELS} voxels"),
-                    ));
+                    return Err(FormatError::too_large(format!(
+                        "more than {MAX_DENSE_VOXELS} voxels"
+                    )));
                 }
                 let mut voxels = Vec::with_capacity(n as usize);
                 for _ in 0..n {
@@ -150,9 +149,7 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
                     let dict = read_dict(&mut c).map_err(&in_chunk)?;
                     if let Some(rot) = dict.get("_r") {
                         if rot.trim() != "4" {
-                            return Err(FormatError::unsupported(
-                                path,
-                                format!("node {node} rotates its model (_r = {rot}); rotated models are not read"),
+                            return Err(FormatError::unsupported(format!("node {node} rotates its model (_r = {rot}); rotated models are not read"),
                             ));
                         }
                     }
@@ -227,10 +224,9 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
         })
         .map_err(&bad)?;
         if placed_voxels > MAX_DENSE_VOXELS {
-            return Err(FormatError::too_large(
-                path,
-                format!("the scene graph places more than {MAX_DENSE_VOXELS} voxels"),
-            ));
+            return Err(FormatError::too_large(format!(
+                "the scene graph places more than {MAX_DENSE_VOXELS} voxels"
+            )));
         }
         walk_graph(&nodes, &models, &mut |m, offset| {
             place(m, offset);
@@ -269,9 +265,9 @@ pub fn decode(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
     } else {
         LinearOctree::from_voxels_fitted(&voxels)
     }
-    .map_err(|e| FormatError::octree(path, e))?;
-    let colors = Layer::from_voxels(tree.depth(), tree.origin(), placed)
-        .map_err(|e| FormatError::octree(path, e))?;
+    .map_err(FormatError::octree)?;
+    let colors =
+        Layer::from_voxels(tree.depth(), tree.origin(), placed).map_err(FormatError::octree)?;
     Ok(Model {
         colors: Some(colors),
         ..Model::new(tree)
@@ -366,7 +362,7 @@ impl Reader<'_> {
 /// # Errors
 /// [`FormatError::Unsupported`] when the bounding box is wider than 256 voxels.
 pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
-    let bytes = encode(model).map_err(|m| FormatError::unsupported(path, m))?;
+    let bytes = encode(model).map_err(|m| FormatError::unsupported(m).with_path(path))?;
     super::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
 
@@ -379,7 +375,7 @@ pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
 /// use tesseral::io::{vox, Model};
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(2, [0, 0, 0], [[0, 0, 0], [3, 1, 2]]).unwrap();
-/// let back = vox::decode(&vox::encode(&Model::new(tree.clone())).unwrap(), "t.vox".as_ref()).unwrap();
+/// let back = vox::decode(&vox::encode(&Model::new(tree.clone())).unwrap()).unwrap();
 /// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
 /// ```
 pub fn encode(model: &Model) -> Result<Vec<u8>, String> {
@@ -503,8 +499,8 @@ mod tests {
             let layer =
                 Layer::from_voxels(6, [0; 3], colours.iter().map(|(v, c)| (*v, *c))).unwrap();
             let model = Model::new(tree).with_colors(layer).unwrap();
-            let back = decode(&encode(&model).unwrap(), Path::new("t.vox"))
-                .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let back =
+                decode(&encode(&model).unwrap()).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             back.tree.assert_valid();
             assert_eq!(
                 back.tree.voxels().collect::<HashSet<_>>(),
@@ -525,7 +521,7 @@ mod tests {
     #[test]
     fn negative_coordinates_are_shifted_and_too_wide_is_refused() {
         let tree = LinearOctree::from_voxels(4, [-8; 3], [[-8, -8, -8], [7, 7, 7]]).unwrap();
-        let back = decode(&encode(&Model::new(tree)).unwrap(), Path::new("t.vox")).unwrap();
+        let back = decode(&encode(&Model::new(tree)).unwrap()).unwrap();
         assert_eq!(
             back.tree.voxels().collect::<Vec<_>>(),
             vec![[0, 0, 0], [15, 15, 15]]
@@ -539,12 +535,12 @@ mod tests {
         let tree = LinearOctree::from_voxels(2, [0; 3], [[1, 2, 3]]).unwrap();
         let good = encode(&Model::new(tree)).unwrap();
         for len in 0..good.len() {
-            let _ = decode(&good[..len], Path::new("t.vox"));
+            let _ = decode(&good[..len]);
         }
         // A voxel count of 2^32-1 in a tiny XYZI chunk.
         let mut b = good.clone();
         let at = b.windows(4).position(|w| w == b"XYZI").unwrap() + 12;
         b[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
-        assert!(decode(&b, Path::new("t.vox")).is_err());
+        assert!(decode(&b).is_err());
     }
 }

@@ -14,15 +14,10 @@ use crate::Voxel;
 /// # Errors
 /// [`FormatError::Syntax`] with `file:line:column` for a malformed line.
 pub fn read(path: &Path) -> Result<LinearOctree, FormatError> {
-    let file = std::fs::File::open(path).map_err(|source| FormatError::Io {
-        path: path.to_owned(),
-        source,
-    })?;
-    let voxels = parse(io::BufReader::new(file), path)?;
-    LinearOctree::from_voxels_fitted(&voxels).map_err(|source| FormatError::Octree {
-        path: path.to_owned(),
-        source,
-    })
+    let attach = |e: FormatError| e.with_path(path);
+    let file = std::fs::File::open(path).map_err(|e| attach(FormatError::Io(e)))?;
+    let voxels = parse(io::BufReader::new(file)).map_err(attach)?;
+    LinearOctree::from_voxels_fitted(&voxels).map_err(|e| attach(FormatError::Octree(e)))
 }
 
 /// The most voxels an `.xyz` file may list (24 bytes each in memory, 800 MB at the
@@ -31,22 +26,19 @@ pub const MAX_XYZ_VOXELS: usize = 1 << 25;
 /// The longest line, in bytes: a file with no newlines is not buffered whole.
 pub const MAX_XYZ_LINE: usize = 4096;
 
-/// Parses `.xyz` text; `path` names the source in errors.
+/// Parses `.xyz` text.
 ///
 /// # Errors
 /// [`FormatError::Syntax`] for a malformed or overlong line, [`FormatError::Io`] if
 /// reading fails, [`FormatError::TooLarge`] past [`MAX_XYZ_VOXELS`] voxels.
-pub fn parse(mut reader: impl BufRead, path: &Path) -> Result<Vec<Voxel>, FormatError> {
+pub fn parse(mut reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
     let mut voxels = Vec::new();
     let mut buf = Vec::new();
     for index in 0usize.. {
         buf.clear();
         let n = Read::take(&mut reader, MAX_XYZ_LINE as u64 + 1)
             .read_until(b'\n', &mut buf)
-            .map_err(|source| FormatError::Io {
-                path: path.to_owned(),
-                source,
-            })?;
+            .map_err(FormatError::Io)?;
         if n == 0 {
             break;
         }
@@ -54,7 +46,6 @@ pub fn parse(mut reader: impl BufRead, path: &Path) -> Result<Vec<Voxel>, Format
             buf.pop();
         } else if buf.len() > MAX_XYZ_LINE {
             return Err(FormatError::Syntax {
-                path: path.to_owned(),
                 line: index + 1,
                 column: MAX_XYZ_LINE + 1,
                 message: format!("line longer than {MAX_XYZ_LINE} bytes"),
@@ -62,7 +53,6 @@ pub fn parse(mut reader: impl BufRead, path: &Path) -> Result<Vec<Voxel>, Format
         }
         let line = String::from_utf8_lossy(&buf);
         let syntax = |column: usize, message: String| FormatError::Syntax {
-            path: path.to_owned(),
             line: index + 1,
             column,
             message,
@@ -97,13 +87,10 @@ pub fn parse(mut reader: impl BufRead, path: &Path) -> Result<Vec<Voxel>, Format
                 .map_err(|_| syntax(column, format!("`{text}` is not an integer coordinate")))?;
         }
         if voxels.len() == MAX_XYZ_VOXELS {
-            return Err(FormatError::too_large(
-                path,
-                format!(
-                    "more than {MAX_XYZ_VOXELS} voxels (line {}); store large sets as .tess",
-                    index + 1
-                ),
-            ));
+            return Err(FormatError::too_large(format!(
+                "more than {MAX_XYZ_VOXELS} voxels (line {}); store large sets as .tess",
+                index + 1
+            )));
         }
         voxels.push(v);
     }
@@ -133,23 +120,27 @@ mod tests {
     #[test]
     fn parses_comments_blanks_and_negatives() {
         let text = "# header\n\n1 2 3\n  -4\t5 -6   # trailing\n";
-        let v = parse(text.as_bytes(), Path::new("a.xyz")).unwrap();
+        let v = parse(text.as_bytes()).unwrap();
         assert_eq!(v, vec![[1, 2, 3], [-4, 5, -6]]);
     }
 
     #[test]
     fn names_line_and_column_of_the_fault() {
-        let err = parse("1 2 3\n1 2 x\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2 3\n1 2 x\n".as_bytes())
+            .unwrap_err()
+            .with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:2:5: `x` is not an integer coordinate"
         );
-        let err = parse("1 2\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2\n".as_bytes()).unwrap_err().with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:1:4: expected three integers `x y z`, found 2 field(s)"
         );
-        let err = parse("1 2 3 4\n".as_bytes(), Path::new("a.xyz")).unwrap_err();
+        let err = parse("1 2 3 4\n".as_bytes())
+            .unwrap_err()
+            .with_path("a.xyz");
         assert_eq!(
             err.to_string(),
             "a.xyz:1:7: expected three integers `x y z`, found 4 field(s)"

@@ -3,25 +3,17 @@
 //! - **Out** ([`boundary_mesh`], [`smooth_mesh`]): the boundary of a solid as a
 //!   watertight, manifold triangle mesh. Coplanar faces are merged greedily, vertices
 //!   are split where voxels touch only along an edge or at a corner, and T-junctions
-//!   are closed, so every edge is shared by exactly two triangles. Written as STL,
-//!   OBJ, PLY or glTF binary ([`mod@write`]).
-//! - **In** ([`read`], [`voxelize`]): STL (ASCII and binary), OBJ and PLY (ASCII and
-//!   binary) become solid octrees at a chosen depth or voxel size, top-down through a
+//!   are closed, so every edge is shared by exactly two triangles.
+//! - **In** ([`voxelize`]): a triangle mesh becomes a solid octree at a chosen depth
+//!   or voxel size, top-down through a
 //!   [`crate::linear::Classifier`], with exact integer triangle/box overlap tests and
 //!   exact ray parity for inside/outside.
 
 mod boundary;
-pub mod read;
 mod voxelize;
-pub mod write;
-
-use std::path::Path;
 
 pub use boundary::{boundary_mesh, smooth_mesh};
-pub use voxelize::{voxelize, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
-
-use crate::io::FormatError;
-use crate::model::Model;
+pub use voxelize::{voxelize, Resolution, VoxelizeError, VoxelizeOptions, MAX_VOXELIZE_DEPTH};
 
 /// An indexed triangle mesh. Triangles are counter-clockwise seen from outside.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -88,29 +80,5 @@ pub struct MeshOptions {
     pub smooth: bool,
 }
 
-/// Voxelizes the mesh at `path` (by extension: `.stl`, `.obj`, `.ply`).
-///
-/// # Errors
-/// Parser errors naming the file and line; [`FormatError::NotWatertight`] for a
-/// solid voxelization of an open mesh; [`FormatError::TooLarge`] past
-/// [`MAX_VOXELIZE_DEPTH`].
-pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<Model, FormatError> {
-    let mesh = read::read(path)?;
-    voxelize(&mesh, options, path)
-}
-
-/// Meshes `model` (blocky or smooth) and writes it by extension (`.stl`, `.obj`,
-/// `.ply`, `.glb`), in world coordinates when the model has a frame.
-///
-/// # Errors
-/// [`FormatError::Io`]; [`FormatError::UnknownFormat`] for another extension.
-pub fn write_meshed(path: &Path, model: &Model, options: &MeshOptions) -> Result<(), FormatError> {
-    let mut mesh = if options.smooth {
-        smooth_mesh(&model.tree)
-    } else {
-        boundary_mesh(&model.tree)
-    };
-    let f = model.frame;
-    mesh.transform(|p| f.to_world(p));
-    write::write_file(path, &mesh)
-}
+// The mesh file formats (STL, OBJ, PLY, glTF) live with the other formats in
+// `crate::io::mesh`; this module is geometry only and depends on no file code.

@@ -11,7 +11,7 @@
 //!   nothing is counted twice. The crossing height is an exact rational; it becomes
 //!   the index of the first voxel whose centre lies above it (a "flip").
 //! - **Watertightness** first: after welding vertices on the lattice, every edge must
-//!   belong to an even number of triangles, else [`FormatError::NotWatertight`]
+//!   belong to an even number of triangles, else [`VoxelizeError::NotWatertight`]
 //!   (use `surface_only`).
 //! - **Surface cells** by the exact triangle/box separating-axis test of
 //!   Akenine-Möller (2001) on integers, over a uniform grid of triangle bins with a
@@ -22,15 +22,53 @@
 //! near the surface are split, so the cost follows the surface.
 
 use std::collections::HashMap;
-use std::path::Path;
 
 use rayon::prelude::*;
 
 use super::TriMesh;
-use crate::io::FormatError;
 use crate::linear::{CellClass, Classifier, LinearOctree};
 use crate::model::{Frame, Model};
 use crate::Voxel;
+
+/// What can go wrong voxelizing a mesh.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum VoxelizeError {
+    /// The mesh itself is malformed (a triangle names a missing vertex).
+    #[error("{0}")]
+    BadMesh(String),
+    /// The grid would exceed a limit (depth, extent, ray crossings); the message
+    /// names it.
+    #[error("{0}")]
+    TooLarge(String),
+    /// An option cannot be used (a voxel size that is not positive).
+    #[error("{0}")]
+    Unsupported(String),
+    /// A mesh that should bound a solid has open edges, so inside and outside are not
+    /// defined.
+    #[error("mesh is not watertight: {open_edges} edge(s) are not shared by an even number of triangles (first near {example:?}); use --surface-only to voxelize the surface")]
+    NotWatertight {
+        /// How many edges have an odd number of triangles.
+        open_edges: usize,
+        /// The coordinates of one end of one open edge.
+        example: [f64; 3],
+    },
+    /// The octree could not be built.
+    #[error(transparent)]
+    Octree(#[from] crate::linear::OctreeError),
+}
+
+impl VoxelizeError {
+    fn corrupt(m: impl Into<String>) -> Self {
+        Self::BadMesh(m.into())
+    }
+    fn too_large(m: impl Into<String>) -> Self {
+        Self::TooLarge(m.into())
+    }
+    fn unsupported(m: impl Into<String>) -> Self {
+        Self::Unsupported(m.into())
+    }
+}
 
 /// The deepest voxelization we attempt (16384 voxels per axis).
 pub const MAX_VOXELIZE_DEPTH: u8 = 14;
@@ -38,8 +76,8 @@ pub const MAX_VOXELIZE_DEPTH: u8 = 14;
 const FRAC_BITS: u32 = 20;
 const ONE: i64 = 1 << FRAC_BITS;
 const HALF: i64 = ONE / 2;
-/// The most column crossings held in memory (8 bytes each).
-const MAX_CROSSINGS: usize = 1 << 27;
+/// The default budget of column crossings held in memory (8 bytes each, 1 GiB).
+pub const MAX_CROSSINGS: usize = 1 << 27;
 /// The most triangle references held by the bin grid.
 const MAX_BIN_ENTRIES: u64 = 1 << 25;
 
@@ -62,6 +100,13 @@ pub struct VoxelizeOptions {
     /// Keep only voxels whose closed cube meets a triangle (no inside test, so the
     /// mesh need not be watertight).
     pub surface_only: bool,
+    /// The most ray crossings (8 bytes each) a solid voxelization may hold; bounded
+    /// from the triangles before any work.
+    pub max_crossings: usize,
+    /// The most leaves the octree may have, estimated from the surface area before
+    /// any work (a surface leaf per unit of area: the leaves of a voxelized surface
+    /// are about 1–1.4 times its area in voxels).
+    pub max_leaves: usize,
 }
 
 impl Default for VoxelizeOptions {
@@ -69,6 +114,8 @@ impl Default for VoxelizeOptions {
         Self {
             resolution: Resolution::Depth(8),
             surface_only: false,
+            max_crossings: MAX_CROSSINGS,
+            max_leaves: crate::csg::DEFAULT_MAX_LEAVES,
         }
     }
 }
@@ -76,16 +123,15 @@ impl Default for VoxelizeOptions {
 type Tri = [[i64; 3]; 3];
 
 /// Voxelizes `mesh` into a solid (a voxel is black when its centre is inside) or,
-/// with `surface_only`, into the voxels the surface touches. `path` names the source
-/// in errors. The result carries a [`Frame`] mapping voxels back to mesh units.
+/// with `surface_only`, into the voxels the surface touches. The result carries a [`Frame`] mapping voxels back to mesh units.
 ///
 /// # Runtime
 /// O(T + C log C + S) for T triangles, C column crossings (about twice the projected
 /// area in voxels) and S cells near the surface.
 ///
 /// # Errors
-/// [`FormatError::NotWatertight`]; [`FormatError::TooLarge`] for a grid deeper than
-/// [`MAX_VOXELIZE_DEPTH`] or too many crossings; [`FormatError::Corrupt`] for a bad
+/// [`VoxelizeError::NotWatertight`]; [`VoxelizeError::TooLarge`] for a grid deeper than
+/// [`MAX_VOXELIZE_DEPTH`] or too many crossings; [`VoxelizeError::BadMesh`] for a bad
 /// vertex index.
 ///
 /// ```
@@ -93,26 +139,21 @@ type Tri = [[i64; 3]; 3];
 /// // A closed tetrahedron-free box: read one from OBJ text.
 /// let obj = "v 0 0 0\nv 4 0 0\nv 0 4 0\nv 4 4 0\nv 0 0 4\nv 4 0 4\nv 0 4 4\nv 4 4 4\n\
 ///            f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
-/// let mesh = tesseral::mesh::read::parse_obj(obj.as_bytes(), "box.obj".as_ref()).unwrap();
-/// let opts = VoxelizeOptions { resolution: Resolution::VoxelSize(0.5), surface_only: false };
-/// let model = voxelize(&mesh, &opts, "box.obj".as_ref()).unwrap();
+/// let mesh = tesseral::io::mesh::parse_obj(obj.as_bytes()).unwrap();
+/// let opts = VoxelizeOptions { resolution: Resolution::VoxelSize(0.5), ..Default::default() };
+/// let model = voxelize(&mesh, &opts).unwrap();
 /// assert_eq!(model.tree.voxel_count(), 8 * 8 * 8);
 /// ```
-pub fn voxelize(
-    mesh: &TriMesh,
-    options: &VoxelizeOptions,
-    path: &Path,
-) -> Result<Model, FormatError> {
+pub fn voxelize(mesh: &TriMesh, options: &VoxelizeOptions) -> Result<Model, VoxelizeError> {
     let n = mesh.positions.len();
     if let Some(t) = mesh
         .triangles
         .iter()
         .position(|t| t.iter().any(|&i| i as usize >= n))
     {
-        return Err(FormatError::corrupt(
-            path,
-            format!("triangle {t} names a missing vertex"),
-        ));
+        return Err(VoxelizeError::corrupt(format!(
+            "triangle {t} names a missing vertex"
+        )));
     }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
@@ -131,14 +172,13 @@ pub fn voxelize(
     let (depth, origin, h, translate) = match options.resolution {
         Resolution::Depth(d) => {
             if d > MAX_VOXELIZE_DEPTH {
-                return Err(FormatError::too_large(
-                    path,
-                    format!("depth {d} exceeds the voxelization limit {MAX_VOXELIZE_DEPTH}"),
-                ));
+                return Err(VoxelizeError::too_large(format!(
+                    "depth {d} exceeds the voxelization limit {MAX_VOXELIZE_DEPTH}"
+                )));
             }
             let ext = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
             if !ext.is_finite() {
-                return Err(FormatError::too_large(path, "the mesh's extent overflows"));
+                return Err(VoxelizeError::too_large("the mesh's extent overflows"));
             }
             let h = if ext > 0.0 {
                 ext / f64::from(1u32 << d)
@@ -149,33 +189,28 @@ pub fn voxelize(
         }
         Resolution::VoxelSize(h) => {
             if !(h.is_finite() && h > 0.0) {
-                return Err(FormatError::unsupported(
-                    path,
-                    format!("voxel size {h} must be positive"),
-                ));
+                return Err(VoxelizeError::unsupported(format!(
+                    "voxel size {h} must be positive"
+                )));
             }
             let mut origin = [0i64; 3];
             let mut extent = 1i64;
             for a in 0..3 {
                 let (l, u) = ((lo[a] / h).floor(), (hi[a] / h).floor());
                 if !(l.abs() < 1e15 && u.abs() < 1e15) {
-                    return Err(FormatError::too_large(
-                        path,
-                        format!("voxel size {h} gives a grid too large"),
-                    ));
+                    return Err(VoxelizeError::too_large(format!(
+                        "voxel size {h} gives a grid too large"
+                    )));
                 }
                 origin[a] = l as i64;
                 extent = extent.max(u as i64 - l as i64 + 1);
             }
             let d = (extent as u64).next_power_of_two().trailing_zeros();
             if d > u32::from(MAX_VOXELIZE_DEPTH) {
-                return Err(FormatError::too_large(
-                    path,
-                    format!(
-                        "voxel size {h} needs {extent} voxels per axis, beyond the limit of {}",
-                        1u32 << MAX_VOXELIZE_DEPTH
-                    ),
-                ));
+                return Err(VoxelizeError::too_large(format!(
+                    "voxel size {h} needs {extent} voxels per axis, beyond the limit of {}",
+                    1u32 << MAX_VOXELIZE_DEPTH
+                )));
             }
             (d as u8, origin, h, [0.0; 3])
         }
@@ -194,15 +229,33 @@ pub fn voxelize(
         .map(|t| t.map(|i| q[i as usize]))
         .collect();
     if !options.surface_only {
-        check_watertight(&tris, path, |p| {
+        check_watertight(&tris, |p| {
             [0, 1, 2].map(|a| translate[a] + h * (origin[a] as f64 + p[a] as f64 / ONE as f64))
         })?;
+    }
+    let area = surface_area(&tris);
+    if area > options.max_leaves as f64 {
+        return Err(VoxelizeError::TooLarge(format!(
+            "the surface at depth {depth} is about {area:.0} voxels in area, so the octree would have about that many leaves, more than the budget of {} (raise --max-leaves or --memory, or lower --depth)",
+            options.max_leaves
+        )));
+    }
+    if !options.surface_only {
+        // The budget is checked before any work, from the triangles alone.
+        let bound = crossing_bound(&tris);
+        if bound > options.max_crossings as u64 {
+            return Err(VoxelizeError::TooLarge(format!(
+                "a solid voxelization at depth {depth} needs up to {bound} ray crossings ({} MiB at 8 bytes each), more than the budget of {} (raise --memory, lower --depth, or use --surface-only)",
+                bound.saturating_mul(8) >> 20,
+                options.max_crossings
+            )));
+        }
     }
     let bins = Bins::new(&tris, depth);
     let columns = if options.surface_only {
         Columns::default()
     } else {
-        Columns::new(&tris, depth).map_err(|m| FormatError::too_large(path, m))?
+        Columns::new(&tris, depth, options.max_crossings).map_err(VoxelizeError::too_large)?
     };
     let classifier = MeshClassifier {
         tris,
@@ -212,16 +265,15 @@ pub fn voxelize(
         side,
         surface_only: options.surface_only,
     };
-    let tree = LinearOctree::from_classifier(depth, origin, &classifier)
-        .map_err(|e| FormatError::octree(path, e))?;
+    let tree =
+        LinearOctree::from_classifier(depth, origin, &classifier).map_err(VoxelizeError::Octree)?;
     Ok(Model::new(tree).with_frame(Frame::new(h, translate)))
 }
 
 fn check_watertight(
     tris: &[Tri],
-    path: &Path,
     world: impl Fn([i64; 3]) -> [f64; 3],
-) -> Result<(), FormatError> {
+) -> Result<(), VoxelizeError> {
     let mut ids: HashMap<[i64; 3], u32> = HashMap::with_capacity(tris.len());
     let mut odd: HashMap<(u32, u32), bool> = HashMap::with_capacity(tris.len() * 3 / 2);
     let mut points: Vec<[i64; 3]> = Vec::new();
@@ -244,8 +296,7 @@ fn check_watertight(
     }
     let open: Vec<(u32, u32)> = odd.into_iter().filter(|e| e.1).map(|e| e.0).collect();
     if let Some(&(a, _)) = open.iter().min() {
-        return Err(FormatError::NotWatertight {
-            path: path.to_owned(),
+        return Err(VoxelizeError::NotWatertight {
             open_edges: open.len(),
             example: world(points[a as usize]),
         });
@@ -286,7 +337,7 @@ struct Columns {
 const DENSE_COLUMNS: i64 = 1 << 24;
 
 impl Columns {
-    fn new(tris: &[Tri], depth: u8) -> Result<Self, String> {
+    fn new(tris: &[Tri], depth: u8, max_crossings: usize) -> Result<Self, String> {
         let side = 1i64 << depth;
         let parts: Vec<Vec<u64>> = tris
             .par_chunks(4096)
@@ -294,7 +345,7 @@ impl Columns {
                 let mut out = Vec::new();
                 for t in chunk {
                     rasterize(t, side, &mut out);
-                    if out.len() > MAX_CROSSINGS {
+                    if out.len() > max_crossings {
                         break;
                     }
                 }
@@ -302,9 +353,9 @@ impl Columns {
             })
             .collect();
         let total: usize = parts.iter().map(Vec::len).sum();
-        if total > MAX_CROSSINGS {
+        if total > max_crossings {
             return Err(format!(
-                "more than {MAX_CROSSINGS} ray crossings at depth {depth}"
+                "more than {max_crossings} ray crossings at depth {depth}"
             ));
         }
         let mut entries: Vec<u64> = Vec::with_capacity(total);
@@ -381,6 +432,54 @@ impl Columns {
 
 /// Appends `(column << 32) | flip` for every column centre that `t`'s xy-projection
 /// covers.
+/// An upper bound on the ray crossings of a solid voxelization: per triangle, the
+/// column centres its projection can hold, at most those of its bounding box and at
+/// most `A + P/2 + 1` (Nosarzewska's bound on the lattice points of a convex region
+/// of area A and perimeter P). O(triangles).
+#[must_use]
+fn crossing_bound(tris: &[Tri]) -> u64 {
+    let one = ONE as f64;
+    tris.iter()
+        .map(|t| {
+            let p = t.map(|v| [v[0] as f64 / one, v[1] as f64 / one]);
+            let area = ((p[1][0] - p[0][0]) * (p[2][1] - p[0][1])
+                - (p[2][0] - p[0][0]) * (p[1][1] - p[0][1]))
+                .abs()
+                / 2.0;
+            if area == 0.0 {
+                return 0;
+            }
+            let len = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).hypot(a[1] - b[1]);
+            let perimeter = len(p[0], p[1]) + len(p[1], p[2]) + len(p[2], p[0]);
+            let span = |a: usize| {
+                let lo = p.iter().map(|q| q[a]).fold(f64::INFINITY, f64::min);
+                let hi = p.iter().map(|q| q[a]).fold(f64::NEG_INFINITY, f64::max);
+                (hi - lo).floor() + 2.0
+            };
+            let convex = area + perimeter / 2.0 + 1.0;
+            (span(0) * span(1)).min(convex).ceil() as u64
+        })
+        .sum()
+}
+
+/// The total area of the triangles in voxel units. O(triangles).
+fn surface_area(tris: &[Tri]) -> f64 {
+    let one = ONE as f64;
+    tris.iter()
+        .map(|t| {
+            let p = t.map(|v| v.map(|c| c as f64 / one));
+            let u = [0, 1, 2].map(|a| p[1][a] - p[0][a]);
+            let w = [0, 1, 2].map(|a| p[2][a] - p[0][a]);
+            let c = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt() / 2.0
+        })
+        .sum()
+}
+
 fn rasterize(t: &Tri, side: i64, out: &mut Vec<u64>) {
     let [a, mut b, mut c] = *t;
     let (w, _) = edge_sign(a, b, c[0], c[1]);
@@ -747,8 +846,9 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(h),
                 surface_only: false,
+                ..Default::default()
             };
-            let m = voxelize(&box_mesh(lo, hi), &opts, Path::new("b.stl")).unwrap();
+            let m = voxelize(&box_mesh(lo, hi), &opts).unwrap();
             m.tree.assert_valid();
             assert_eq!(
                 m.tree.voxel_count(),
@@ -766,8 +866,9 @@ mod tests {
         let opts = VoxelizeOptions {
             resolution: Resolution::VoxelSize(1.0),
             surface_only: false,
+            ..Default::default()
         };
-        let whole = voxelize(&box_mesh([0.5; 3], [4.5; 3]), &opts, Path::new("w")).unwrap();
+        let whole = voxelize(&box_mesh([0.5; 3], [4.5; 3]), &opts).unwrap();
         assert_eq!(whole.tree.voxel_count(), 64);
         assert!(whole.tree.contains([0, 0, 4]) && !whole.tree.contains([0, 0, 0]));
         // Two boxes meeting in the plane x = 2.5, which holds the centres of column
@@ -778,7 +879,7 @@ mod tests {
         a.positions.extend(b.positions);
         a.triangles
             .extend(b.triangles.iter().map(|t| t.map(|i| i + off)));
-        let halves = voxelize(&a, &opts, Path::new("h")).unwrap();
+        let halves = voxelize(&a, &opts).unwrap();
         assert_eq!(halves.tree, whole.tree);
     }
 
@@ -790,21 +891,23 @@ mod tests {
                        v 0 0 3\nv 6 0 3\nv 6 2 3\nv 2 2 3\nv 2 6 3\nv 0 6 3\n\
                        f 1 6 5 4 3 2\nf 7 8 9 10 11 12\n\
                        f 1 2 8 7\nf 2 3 9 8\nf 3 4 10 9\nf 4 5 11 10\nf 5 6 12 11\nf 6 1 7 12\n";
-            super::super::read::parse_obj(obj.as_bytes(), Path::new("l.obj")).unwrap()
+            crate::io::mesh::parse_obj(obj.as_bytes()).unwrap()
         };
         assert_eq!(m.edge_defects(), 0);
         let opts = VoxelizeOptions {
             resolution: Resolution::VoxelSize(0.25),
             surface_only: false,
+            ..Default::default()
         };
-        let v = voxelize(&m, &opts, Path::new("l.obj")).unwrap();
+        let v = voxelize(&m, &opts).unwrap();
         // L-shaped prism: area 6*2 + 2*4 = 20, height 3 → 60 units → 60 * 64 voxels.
         assert_eq!(v.tree.voxel_count(), 60 * 64);
         let shell = VoxelizeOptions {
             resolution: Resolution::VoxelSize(0.25),
             surface_only: true,
+            ..Default::default()
         };
-        let s = voxelize(&m, &shell, Path::new("l.obj")).unwrap();
+        let s = voxelize(&m, &shell).unwrap();
         s.tree.assert_valid();
         // Every surface voxel touches the solid's boundary: it is a solid voxel or a
         // neighbour of one.
@@ -819,13 +922,48 @@ mod tests {
     }
 
     #[test]
+    fn the_crossing_bound_holds_and_the_budget_is_checked_first() {
+        let side = 1i64 << 8;
+        let mut x = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |m: i64| {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            (x % m as u64) as i64
+        };
+        for seed in 0..300 {
+            let t: Tri =
+                std::array::from_fn(|_| [next(side * ONE), next(side * ONE), next(side * ONE)]);
+            let mut out = Vec::new();
+            rasterize(&t, side, &mut out);
+            let bound = crossing_bound(&[t]);
+            assert!(
+                out.len() as u64 <= bound,
+                "seed {seed}: {} > {bound}",
+                out.len()
+            );
+        }
+        // A budget below the bound is refused before any work, naming the flag.
+        let opts = VoxelizeOptions {
+            resolution: Resolution::Depth(6),
+            max_crossings: 100,
+            ..Default::default()
+        };
+        let e = voxelize(&box_mesh([0.0; 3], [1.0; 3]), &opts).unwrap_err();
+        assert!(
+            matches!(e, VoxelizeError::TooLarge(_)) && e.to_string().contains("--memory"),
+            "{e}"
+        );
+    }
+
+    #[test]
     fn open_meshes_are_refused_unless_surface_only() {
         let mut m = box_mesh([0.0; 3], [1.0; 3]);
         m.triangles.pop();
         let opts = VoxelizeOptions::default();
-        let err = voxelize(&m, &opts, Path::new("open.stl")).unwrap_err();
+        let err = voxelize(&m, &opts).unwrap_err();
         assert!(
-            matches!(err, FormatError::NotWatertight { open_edges: 3, .. }),
+            matches!(err, VoxelizeError::NotWatertight { open_edges: 3, .. }),
             "{err}"
         );
         let ok = voxelize(
@@ -834,7 +972,6 @@ mod tests {
                 surface_only: true,
                 ..opts
             },
-            Path::new("open.stl"),
         )
         .unwrap();
         assert!(ok.tree.voxel_count() > 0);
@@ -901,8 +1038,9 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(1.0),
                 surface_only: true,
+                ..Default::default()
             };
-            let got = voxelize(&mesh, &opts, Path::new("s")).unwrap();
+            let got = voxelize(&mesh, &opts).unwrap();
             got.tree.assert_valid();
             let o = got.tree.origin();
             let side = got.tree.side() as i64;
@@ -972,8 +1110,9 @@ mod tests {
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(h),
                 surface_only: false,
+                ..Default::default()
             };
-            let got = voxelize(&mesh, &opts, Path::new("s")).unwrap();
+            let got = voxelize(&mesh, &opts).unwrap();
             got.tree.assert_valid();
             // Brute force in f64 (no centre lies exactly on the jittered surface).
             let o = got.tree.origin();

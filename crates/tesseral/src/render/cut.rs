@@ -12,6 +12,16 @@ impl Clip {
     /// The first voxel coordinate at or above the plane: voxels below it are kept
     /// (or, with `keep_above`, those at or above it). A voxel `c` is removed when
     /// `c ≥ at`, that is `c ≥ ⌈at⌉`.
+    ///
+    /// # Runtime
+    /// O(1).
+    ///
+    /// # Example
+    /// ```
+    /// use tesseral::render::Clip;
+    /// let c = Clip { axis: 0, at: 2.5, keep_above: false };
+    /// assert_eq!(c.boundary(), 3);
+    /// ```
     #[must_use]
     pub fn boundary(&self) -> i64 {
         // Saturating: a plane far outside any tree keeps all or nothing.
@@ -24,6 +34,16 @@ impl Clip {
     }
 
     /// Whether the clip keeps voxel `v`.
+    ///
+    /// # Runtime
+    /// O(1).
+    ///
+    /// # Example
+    /// ```
+    /// use tesseral::render::Clip;
+    /// let c = Clip { axis: 2, at: 4.0, keep_above: false };
+    /// assert!(c.keeps([9, 9, 3]) && !c.keeps([0, 0, 4]));
+    /// ```
     #[must_use]
     pub fn keeps(&self, v: Voxel) -> bool {
         (v[self.axis] >= self.boundary()) == self.keep_above

@@ -53,9 +53,9 @@ const OT_HEADER: &str = "# Octomap OcTree file";
 pub fn read(path: &Path) -> Result<Model, FormatError> {
     let bytes = super::read_limited(path, super::MAX_FILE_BYTES)?;
     if super::extension(path) == "ot" {
-        decode_ot(&bytes, path)
+        decode_ot(&bytes).map_err(|e| e.with_path(path))
     } else {
-        decode_bt(&bytes, path)
+        decode_bt(&bytes).map_err(|e| e.with_path(path))
     }
 }
 
@@ -68,8 +68,8 @@ struct Header {
 
 /// Parses the header the way OctoMap's `readHeader` does: whitespace-separated
 /// tokens, `#` comments to the end of the line, `data` ends it.
-fn parse_header(bytes: &[u8], first: &str, path: &Path) -> Result<Header, FormatError> {
-    let bad = |m: String| FormatError::corrupt(path, m);
+fn parse_header(bytes: &[u8], first: &str) -> Result<Header, FormatError> {
+    let bad = |m: String| FormatError::corrupt(m);
     let nl = bytes
         .iter()
         .position(|&b| b == b'\n')
@@ -150,26 +150,25 @@ fn octomap_space() -> LinearOctree {
 ///
 /// # Errors
 /// As [`read`].
-pub fn decode_bt(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
-    let header = parse_header(bytes, BT_HEADER, path)?;
+pub fn decode_bt(bytes: &[u8]) -> Result<Model, FormatError> {
+    let header = parse_header(bytes, BT_HEADER)?;
     let frame = Frame::new(header.res, [0.0; 3]);
     if header.size == 0 {
         return Ok(Model::new(octomap_space()).with_frame(frame));
     }
     let data = &bytes[header.data_start..];
-    let (leaves, free, nodes, used) =
-        decode_bt_stream(data).map_err(|m| FormatError::corrupt(path, m))?;
+    let (leaves, free, nodes, used) = decode_bt_stream(data).map_err(FormatError::corrupt)?;
     if nodes != header.size {
-        return Err(FormatError::corrupt(
-            path,
-            format!("header says {} nodes, the data holds {nodes}", header.size),
-        ));
+        return Err(FormatError::corrupt(format!(
+            "header says {} nodes, the data holds {nodes}",
+            header.size
+        )));
     }
     let _ = used;
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
-        .map_err(|e| FormatError::octree(path, e))?;
+        .map_err(FormatError::octree)?;
     let free = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], free)
-        .map_err(|e| FormatError::octree(path, e))?;
+        .map_err(FormatError::octree)?;
     Ok(Model {
         free: Some(free),
         ..Model::new(tree).with_frame(frame)
@@ -239,17 +238,16 @@ fn decode_bt_stream(data: &[u8]) -> Result<BtLeaves, String> {
 ///
 /// # Errors
 /// As [`read`]; [`FormatError::Unsupported`] for another tree type.
-pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
-    let header = parse_header(bytes, OT_HEADER, path)?;
+pub fn decode_ot(bytes: &[u8]) -> Result<Model, FormatError> {
+    let header = parse_header(bytes, OT_HEADER)?;
     let extra = match header.id.as_str() {
         "OcTree" => 0,
         "ColorOcTree" => 3,
         "OcTreeStamped" => 4,
         other => {
-            return Err(FormatError::unsupported(
-                path,
-                format!("tree type `{other}` (we read OcTree, ColorOcTree, OcTreeStamped)"),
-            ))
+            return Err(FormatError::unsupported(format!(
+                "tree type `{other}` (we read OcTree, ColorOcTree, OcTreeStamped)"
+            )))
         }
     };
     let color = extra == 3;
@@ -265,7 +263,7 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
         });
     }
     let data = &bytes[header.data_start..];
-    let bad = |m: String| FormatError::corrupt(path, m);
+    let bad = |m: String| FormatError::corrupt(m);
     let node_len = 4 + extra;
     let mut pos = 0usize;
     let mut nodes = 0u64;
@@ -314,7 +312,6 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
                 coloured_voxels += leaf.voxel_count();
                 if coloured_voxels > MAX_COLORED_VOXELS {
                     return Err(FormatError::too_large(
-                            path,
                             format!("more than {MAX_COLORED_VOXELS} coloured voxels, the budget of a colour layer"),
                         ));
                 }
@@ -349,8 +346,8 @@ pub fn decode_ot(bytes: &[u8], path: &Path) -> Result<Model, FormatError> {
         )));
     }
     let tree = LinearOctree::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaves)
-        .map_err(|e| FormatError::octree(path, e))?;
-    let oct = |e| FormatError::octree(path, e);
+        .map_err(FormatError::octree)?;
+    let oct = FormatError::octree;
     let colors = if color {
         Some(Layer::from_sorted_leaves(OCTOMAP_DEPTH, [KEY_ORIGIN; 3], leaf_colors).map_err(oct)?)
     } else {
@@ -453,8 +450,8 @@ mod tests {
     fn bt_and_ot_round_trip_random_trees() {
         for seed in 0..80 {
             let m = random_model(seed);
-            let bt = decode_bt(&encode_bt(&m).unwrap(), Path::new("t.bt"))
-                .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let bt =
+                decode_bt(&encode_bt(&m).unwrap()).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             bt.tree.assert_valid();
             assert_eq!(set(&bt.tree), set(&m.tree), "seed {seed}");
             assert_eq!(bt.frame.voxel_size, 0.05);
@@ -464,8 +461,8 @@ mod tests {
                 "seed {seed}"
             );
             bt.assert_valid();
-            let ot = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot"))
-                .unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+            let ot =
+                decode_ot(&encode_ot(&m).unwrap()).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
             ot.assert_valid();
             assert_eq!(set(&ot.tree), set(&m.tree), "seed {seed}");
             assert_eq!(
@@ -495,7 +492,7 @@ mod tests {
             colors: Some(colors.clone()),
             ..m
         };
-        let back = decode_ot(&encode_ot(&m).unwrap(), Path::new("t.ot")).unwrap();
+        let back = decode_ot(&encode_ot(&m).unwrap()).unwrap();
         back.assert_valid();
         let got: Vec<_> = back
             .colors
@@ -518,19 +515,19 @@ mod tests {
         // block of size 2^14 at keys (16384, 16384, 16384), i.e. voxel -16384.
         let mut b = b"# Octomap OcTree binary file\nid OcTree\nsize 3\nres 0.1\ndata\n".to_vec();
         b.extend_from_slice(&[0b0000_0011, 0, 0, 0b1000_0000]);
-        let m = decode_bt(&b, Path::new("t.bt")).unwrap();
+        let m = decode_bt(&b).unwrap();
         assert_eq!(m.tree.leaf_count(), 1);
         let blk = m.tree.blocks().next().unwrap();
         assert_eq!((blk.min, blk.size_log2), ([-16384; 3], 14));
         // Wrong node count, truncation, too deep.
         let mut w = b.clone();
         w[b.len() - 9] = b'4';
-        assert!(decode_bt(&w, Path::new("t.bt")).is_err());
-        assert!(decode_bt(&b[..b.len() - 1], Path::new("t.bt")).is_err());
+        assert!(decode_bt(&w).is_err());
+        assert!(decode_bt(&b[..b.len() - 1]).is_err());
         let mut deep =
             b"# Octomap OcTree binary file\nid OcTree\nsize 99\nres 0.1\ndata\n".to_vec();
         deep.extend(std::iter::repeat_n([3u8, 0], 20).flatten());
-        assert!(decode_bt(&deep, Path::new("t.bt")).is_err());
+        assert!(decode_bt(&deep).is_err());
     }
 
     #[test]

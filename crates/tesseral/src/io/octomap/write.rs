@@ -137,7 +137,7 @@ pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
     } else {
         encode_bt(model)
     }
-    .map_err(|m| FormatError::unsupported(path, m))?;
+    .map_err(|m| FormatError::unsupported(m).with_path(path))?;
     crate::io::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
 
@@ -177,7 +177,7 @@ fn covers(pieces: &[Piece], k: u8) -> Option<Piece> {
 /// use tesseral::linear::LinearOctree;
 /// let tree = LinearOctree::from_voxels(2, [-2; 3], [[-2, -2, -2], [1, 0, 1]]).unwrap();
 /// let bytes = octomap::encode_bt(&Model::new(tree.clone())).unwrap();
-/// let back = octomap::decode_bt(&bytes, "t.bt".as_ref()).unwrap();
+/// let back = octomap::decode_bt(&bytes).unwrap();
 /// assert_eq!(back.tree.voxels().collect::<Vec<_>>(), tree.voxels().collect::<Vec<_>>());
 /// ```
 pub fn encode_bt(model: &Model) -> Result<Vec<u8>, String> {

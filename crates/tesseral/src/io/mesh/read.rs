@@ -6,8 +6,8 @@
 
 use std::path::Path;
 
-use super::TriMesh;
 use crate::io::{extension, FormatError};
+use crate::mesh::TriMesh;
 
 /// The most vertices or triangles a mesh file may hold.
 pub const MAX_MESH_ELEMENTS: usize = 1 << 26;
@@ -19,28 +19,26 @@ pub const MAX_MESH_ELEMENTS: usize = 1 << 26;
 /// [`FormatError::TooLarge`] past [`MAX_MESH_ELEMENTS`].
 pub fn read(path: &Path) -> Result<TriMesh, FormatError> {
     let bytes = crate::io::read_limited(path, crate::io::MAX_FILE_BYTES)?;
-    parse(&bytes, &extension(path), path)
+    parse(&bytes, &extension(path)).map_err(|e| e.with_path(path))
 }
 
-/// Parses mesh bytes in the format named by `ext`; `path` names the source in errors.
+/// Parses mesh bytes in the format named by `ext`.
 ///
 /// # Errors
 /// As [`read`].
-pub fn parse(bytes: &[u8], ext: &str, path: &Path) -> Result<TriMesh, FormatError> {
+pub fn parse(bytes: &[u8], ext: &str) -> Result<TriMesh, FormatError> {
     match ext {
-        "stl" => parse_stl(bytes, path),
-        "obj" => parse_obj(bytes, path),
-        "ply" => parse_ply(bytes, path),
+        "stl" => parse_stl(bytes),
+        "obj" => parse_obj(bytes),
+        "ply" => parse_ply(bytes),
         _ => Err(FormatError::UnknownFormat {
-            path: path.to_owned(),
             known: "stl, obj, ply",
         }),
     }
 }
 
-fn syntax(path: &Path, line: usize, column: usize, message: impl Into<String>) -> FormatError {
+fn syntax(line: usize, column: usize, message: impl Into<String>) -> FormatError {
     FormatError::Syntax {
-        path: path.to_owned(),
         line,
         column,
         message: message.into(),
@@ -54,22 +52,16 @@ fn words(line: &str) -> impl Iterator<Item = (usize, &str)> {
         .map(move |w| (w.as_ptr() as usize - base + 1, w))
 }
 
-fn parse_coord(path: &Path, line: usize, col: usize, w: &str) -> Result<f64, FormatError> {
+fn parse_coord(line: usize, col: usize, w: &str) -> Result<f64, FormatError> {
     match w.parse::<f64>() {
         Ok(x) if x.is_finite() => Ok(x),
-        _ => Err(syntax(
-            path,
-            line,
-            col,
-            format!("`{w}` is not a finite number"),
-        )),
+        _ => Err(syntax(line, col, format!("`{w}` is not a finite number"))),
     }
 }
 
 /// The three coordinates after `key` on line number `line_no` (text `line`).
 fn parse_point<'a>(
     ws: &mut impl Iterator<Item = (usize, &'a str)>,
-    path: &Path,
     line_no: usize,
     line: &str,
     key: &str,
@@ -78,13 +70,12 @@ fn parse_point<'a>(
     for x in &mut p {
         let (c, w) = ws.next().ok_or_else(|| {
             syntax(
-                path,
                 line_no,
                 line.len() + 1,
                 format!("`{key}` needs three numbers"),
             )
         })?;
-        *x = parse_coord(path, line_no, c, w)?;
+        *x = parse_coord(line_no, c, w)?;
     }
     Ok(p)
 }
@@ -93,31 +84,28 @@ fn parse_point<'a>(
 ///
 /// # Errors
 /// As [`read`].
-pub fn parse_stl(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
+pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         let binary_len = 84 + 50 * n as u64;
         let looks_ascii = bytes.trim_ascii_start().starts_with(b"solid")
             && bytes.iter().take(1024).all(|b| b.is_ascii());
         if bytes.len() as u64 == binary_len || (!looks_ascii && bytes.len() as u64 > binary_len) {
-            return parse_stl_binary(bytes, n, path);
+            return parse_stl_binary(bytes, n);
         }
         if !looks_ascii {
-            return Err(FormatError::corrupt(
-                path,
-                format!(
-                    "binary STL header says {n} triangles ({binary_len} bytes), the file has {} bytes",
-                    bytes.len()
-                ),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "binary STL header says {n} triangles ({binary_len} bytes), the file has {} bytes",
+                bytes.len()
+            )));
         }
     }
-    parse_stl_ascii(bytes, path)
+    parse_stl_ascii(bytes)
 }
 
-fn parse_stl_binary(bytes: &[u8], n: usize, path: &Path) -> Result<TriMesh, FormatError> {
+fn parse_stl_binary(bytes: &[u8], n: usize) -> Result<TriMesh, FormatError> {
     if n > MAX_MESH_ELEMENTS {
-        return Err(FormatError::too_large(path, format!("{n} triangles")));
+        return Err(FormatError::too_large(format!("{n} triangles")));
     }
     let mut m = TriMesh {
         positions: Vec::with_capacity(3 * n),
@@ -131,13 +119,10 @@ fn parse_stl_binary(bytes: &[u8], n: usize, path: &Path) -> Result<TriMesh, Form
                 let o = 12 + 12 * v + 4 * a;
                 let f = f32::from_le_bytes([rec[o], rec[o + 1], rec[o + 2], rec[o + 3]]);
                 if !f.is_finite() {
-                    return Err(FormatError::corrupt(
-                        path,
-                        format!(
-                            "triangle {t}: coordinate at byte {} is not finite",
-                            84 + 50 * t + o
-                        ),
-                    ));
+                    return Err(FormatError::corrupt(format!(
+                        "triangle {t}: coordinate at byte {} is not finite",
+                        84 + 50 * t + o
+                    )));
                 }
                 *x = f64::from(f);
             }
@@ -149,12 +134,12 @@ fn parse_stl_binary(bytes: &[u8], n: usize, path: &Path) -> Result<TriMesh, Form
     Ok(m)
 }
 
-fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
+fn parse_stl_ascii(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
-        FormatError::corrupt(
-            path,
-            format!("ASCII STL is not UTF-8 at byte {}", e.valid_up_to()),
-        )
+        FormatError::corrupt(format!(
+            "ASCII STL is not UTF-8 at byte {}",
+            e.valid_up_to()
+        ))
     })?;
     let mut m = TriMesh::default();
     let mut saw_solid = false;
@@ -175,16 +160,15 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
             }
             "endsolid" => ended = true,
             "vertex" => {
-                let p = parse_point(&mut ws, path, i + 1, line, "vertex")?;
+                let p = parse_point(&mut ws, i + 1, line, "vertex")?;
                 if m.positions.len() >= 3 * MAX_MESH_ELEMENTS {
-                    return Err(FormatError::too_large(path, "too many vertices"));
+                    return Err(FormatError::too_large("too many vertices"));
                 }
                 m.positions.push(p);
             }
             "facet" | "outer" | "endloop" | "endfacet" => {}
             other => {
                 return Err(syntax(
-                    path,
                     i + 1,
                     col,
                     format!("unexpected `{other}` in ASCII STL"),
@@ -193,11 +177,10 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         }
     }
     if !saw_solid {
-        return Err(syntax(path, 1, 1, "not an STL file (no `solid`)"));
+        return Err(syntax(1, 1, "not an STL file (no `solid`)"));
     }
     if !ended {
         return Err(syntax(
-            path,
             last_line,
             1,
             "ASCII STL ends without `endsolid` (the file is cut short)",
@@ -205,7 +188,6 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
     }
     if m.positions.len() % 3 != 0 {
         return Err(syntax(
-            path,
             last_line,
             1,
             format!(
@@ -220,13 +202,74 @@ fn parse_stl_ascii(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
     Ok(m)
 }
 
+/// The statements of the OBJ format (Wavefront's specification) that we read past:
+/// texture and normal vertices, groups, materials, smoothing, and free-form geometry.
+const OBJ_IGNORED: &[&str] = &[
+    "vt",
+    "vn",
+    "vp",
+    "l",
+    "p",
+    "o",
+    "g",
+    "s",
+    "mg",
+    "usemtl",
+    "mtllib",
+    "maplib",
+    "usemap",
+    "lod",
+    "shadow_obj",
+    "trace_obj",
+    "ctech",
+    "stech",
+    "bevel",
+    "c_interp",
+    "d_interp",
+    "cstype",
+    "deg",
+    "bmat",
+    "step",
+    "curv",
+    "curv2",
+    "surf",
+    "parm",
+    "trim",
+    "hole",
+    "scrv",
+    "sp",
+    "end",
+    "con",
+    "call",
+    "csh",
+];
+
+/// The 1-based line and column of byte `offset` in `bytes`.
+fn line_col(bytes: &[u8], offset: usize) -> (usize, usize) {
+    let before = &bytes[..offset.min(bytes.len())];
+    let line = before.iter().filter(|&&b| b == b'\n').count() + 1;
+    let col = offset
+        - before
+            .iter()
+            .rposition(|&b| b == b'\n')
+            .map_or(0, |p| p + 1)
+        + 1;
+    (line, col)
+}
+
 /// Parses Wavefront OBJ: `v` and `f` lines (`f` references may be `i`, `i/t`,
-/// `i/t/n`, `i//n`, negative for relative); everything else is ignored.
+/// `i/t/n`, `i//n`, negative for relative). The other statements of the format are
+/// read past; anything else (binary data, an unknown keyword) is an error naming
+/// its line and column, so that a file that is not OBJ is never read as an empty
+/// mesh.
 ///
 /// # Errors
 /// As [`read`].
-pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
-    let text = String::from_utf8_lossy(bytes);
+pub fn parse_obj(bytes: &[u8]) -> Result<TriMesh, FormatError> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        let (line, column) = line_col(bytes, e.valid_up_to());
+        syntax(line, column, "not text (an OBJ file is UTF-8 text)")
+    })?;
     let mut m = TriMesh::default();
     let mut poly: Vec<u32> = Vec::new();
     for (i, line) in text.lines().enumerate() {
@@ -235,9 +278,9 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         let Some((_, key)) = ws.next() else { continue };
         match key {
             "v" => {
-                let p = parse_point(&mut ws, path, i + 1, line, "v")?;
+                let p = parse_point(&mut ws, i + 1, line, "v")?;
                 if m.positions.len() >= MAX_MESH_ELEMENTS {
-                    return Err(FormatError::too_large(path, "too many vertices"));
+                    return Err(FormatError::too_large("too many vertices"));
                 }
                 m.positions.push(p);
             }
@@ -246,13 +289,12 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                 for (c, w) in ws {
                     let idx = w.split('/').next().unwrap_or("");
                     let n: i64 = idx.parse().map_err(|_| {
-                        syntax(path, i + 1, c, format!("`{w}` is not a vertex reference"))
+                        syntax(i + 1, c, format!("`{w}` is not a vertex reference"))
                     })?;
                     let count = m.positions.len() as i64;
                     let k = if n > 0 { n - 1 } else { count + n };
                     if n == 0 || k < 0 || k >= count {
                         return Err(syntax(
-                            path,
                             i + 1,
                             c,
                             format!("vertex {n} does not exist ({count} so far)"),
@@ -261,21 +303,25 @@ pub fn parse_obj(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                     poly.push(k as u32);
                 }
                 if poly.len() < 3 {
-                    return Err(syntax(
-                        path,
-                        i + 1,
-                        1,
-                        "a face needs at least three vertices",
-                    ));
+                    return Err(syntax(i + 1, 1, "a face needs at least three vertices"));
                 }
                 if m.triangles.len() + poly.len() > MAX_MESH_ELEMENTS {
-                    return Err(FormatError::too_large(path, "too many triangles"));
+                    return Err(FormatError::too_large("too many triangles"));
                 }
                 for j in 1..poly.len() - 1 {
                     m.triangles.push([poly[0], poly[j], poly[j + 1]]);
                 }
             }
-            _ => {}
+            _ if OBJ_IGNORED.contains(&key) => {}
+            other => {
+                let col = line.find(other).map_or(1, |c| c + 1);
+                let shown: String = other.chars().take(20).collect();
+                return Err(syntax(
+                    i + 1,
+                    col,
+                    format!("`{}` is not an OBJ statement", shown.escape_default()),
+                ));
+            }
         }
     }
     Ok(m)
@@ -348,7 +394,7 @@ struct PlyBody<'a> {
 }
 
 impl PlyBody<'_> {
-    fn value(&mut self, ty: Scalar, path: &Path) -> Result<f64, FormatError> {
+    fn value(&mut self, ty: Scalar) -> Result<f64, FormatError> {
         if self.format == PlyFormat::Ascii {
             while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
                 if self.bytes[self.pos] == b'\n' {
@@ -361,20 +407,20 @@ impl PlyBody<'_> {
                 self.pos += 1;
             }
             if start == self.pos {
-                return Err(syntax(path, self.line, 1, "file ends inside an element"));
+                return Err(syntax(self.line, 1, "file ends inside an element"));
             }
             let w = String::from_utf8_lossy(&self.bytes[start..self.pos]);
             return match w.parse::<f64>() {
                 Ok(x) if x.is_finite() => Ok(x),
-                _ => Err(syntax(path, self.line, 1, format!("`{w}` is not a number"))),
+                _ => Err(syntax(self.line, 1, format!("`{w}` is not a number"))),
             };
         }
         let n = ty.size();
         if self.pos + n > self.bytes.len() {
-            return Err(FormatError::corrupt(
-                path,
-                format!("file ends at byte {} inside an element", self.pos),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "file ends at byte {} inside an element",
+                self.pos
+            )));
         }
         let mut b = [0u8; 8];
         b[..n].copy_from_slice(&self.bytes[self.pos..self.pos + n]);
@@ -393,10 +439,10 @@ impl PlyBody<'_> {
             Scalar::F64 => f64::from_le_bytes(b),
         };
         if !v.is_finite() {
-            return Err(FormatError::corrupt(
-                path,
-                format!("value at byte {} is not finite", self.pos - n),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "value at byte {} is not finite",
+                self.pos - n
+            )));
         }
         Ok(v)
     }
@@ -408,11 +454,11 @@ impl PlyBody<'_> {
 ///
 /// # Errors
 /// As [`read`].
-pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
+pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     let end = bytes
         .windows(11)
         .position(|w| w == b"end_header\n" || w == b"end_header\r")
-        .ok_or_else(|| syntax(path, 1, 1, "no `end_header` line"))?;
+        .ok_or_else(|| syntax(1, 1, "no `end_header` line"))?;
     let header = String::from_utf8_lossy(&bytes[..end]);
     let mut body_start = end + 11;
     if bytes.get(end + 10) == Some(&b'\r') && bytes.get(body_start) == Some(&b'\n') {
@@ -427,7 +473,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         let Some(&(col, key)) = ws.first() else {
             continue;
         };
-        let err = |m: &str| syntax(path, i + 1, col, m.to_string());
+        let err = |m: &str| syntax(i + 1, col, m.to_string());
         match key {
             "ply" if i == 0 => {}
             _ if i == 0 => return Err(err("not a PLY file (first line must be `ply`)")),
@@ -447,7 +493,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                 let count: u64 = count
                     .1
                     .parse()
-                    .map_err(|_| syntax(path, i + 1, count.0, "element count is not a number"))?;
+                    .map_err(|_| syntax(i + 1, count.0, "element count is not a number"))?;
                 elements.push(Element {
                     name: name.1.to_string(),
                     count,
@@ -466,10 +512,10 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                         name: name.1.to_string(),
                         list: Some(
                             Scalar::parse(ct.1)
-                                .ok_or_else(|| syntax(path, i + 1, ct.0, "unknown type"))?,
+                                .ok_or_else(|| syntax(i + 1, ct.0, "unknown type"))?,
                         ),
                         ty: Scalar::parse(ty.1)
-                            .ok_or_else(|| syntax(path, i + 1, ty.0, "unknown type"))?,
+                            .ok_or_else(|| syntax(i + 1, ty.0, "unknown type"))?,
                     }
                 } else {
                     let (Some(ty), Some(name)) = (ws.get(1), ws.get(2)) else {
@@ -479,7 +525,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                         name: name.1.to_string(),
                         list: None,
                         ty: Scalar::parse(ty.1)
-                            .ok_or_else(|| syntax(path, i + 1, ty.0, "unknown type"))?,
+                            .ok_or_else(|| syntax(i + 1, ty.0, "unknown type"))?,
                     }
                 };
                 el.props.push(prop);
@@ -487,7 +533,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
             _ => return Err(err(&format!("unexpected `{key}` in the PLY header"))),
         }
     }
-    let format = format.ok_or_else(|| syntax(path, 2, 1, "no `format` line"))?;
+    let format = format.ok_or_else(|| syntax(2, 1, "no `format` line"))?;
     let remaining = (bytes.len() - body_start.min(bytes.len())) as u64;
     let mut body = PlyBody {
         bytes,
@@ -508,19 +554,16 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                 .sum()
         };
         if el.count > 0 && min > 0 && el.count > remaining / min {
-            return Err(FormatError::corrupt(
-                path,
-                format!(
-                    "header declares {} `{}` elements; the file is too short for them",
-                    el.count, el.name
-                ),
-            ));
+            return Err(FormatError::corrupt(format!(
+                "header declares {} `{}` elements; the file is too short for them",
+                el.count, el.name
+            )));
         }
         if el.count > MAX_MESH_ELEMENTS as u64 {
-            return Err(FormatError::too_large(
-                path,
-                format!("{} `{}` elements", el.count, el.name),
-            ));
+            return Err(FormatError::too_large(format!(
+                "{} `{}` elements",
+                el.count, el.name
+            )));
         }
         let xyz: Vec<Option<usize>> = ["x", "y", "z"]
             .iter()
@@ -535,16 +578,11 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
         });
         let is_vertex = el.name == "vertex";
         if is_vertex && xyz.iter().any(Option::is_none) {
-            return Err(syntax(path, 1, 1, "`vertex` element lacks x, y or z"));
+            return Err(syntax(1, 1, "`vertex` element lacks x, y or z"));
         }
         let is_face = el.name == "face";
         if is_face && faces.is_none() {
-            return Err(syntax(
-                path,
-                1,
-                1,
-                "`face` element lacks a vertex_indices list",
-            ));
+            return Err(syntax(1, 1, "`face` element lacks a vertex_indices list"));
         }
         let mut poly: Vec<u32> = Vec::new();
         for index in 0..el.count {
@@ -552,7 +590,7 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
             for (pi, prop) in el.props.iter().enumerate() {
                 match prop.list {
                     None => {
-                        let v = body.value(prop.ty, path)?;
+                        let v = body.value(prop.ty)?;
                         if is_vertex {
                             for a in 0..3 {
                                 if xyz[a] == Some(pi) {
@@ -562,17 +600,16 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                         }
                     }
                     Some(ct) => {
-                        let n = body.value(ct, path)?;
+                        let n = body.value(ct)?;
                         if !(0.0..=1e9).contains(&n) || n.fract() != 0.0 {
-                            return Err(FormatError::corrupt(
-                                path,
-                                format!("element {index}: bad list length {n}"),
-                            ));
+                            return Err(FormatError::corrupt(format!(
+                                "element {index}: bad list length {n}"
+                            )));
                         }
                         let take = is_face && faces == Some(pi);
                         poly.clear();
                         for _ in 0..n as u64 {
-                            let v = body.value(prop.ty, path)?;
+                            let v = body.value(prop.ty)?;
                             if take {
                                 // A vertex index is a whole number from 0: `1.5` or `-2`
                                 // is an error that says so, not a face to guess at.
@@ -586,12 +623,9 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                                 if let Some(why) = why {
                                     let msg = format!("face {index}: vertex index {v} {why}");
                                     return Err(if body.format == PlyFormat::Ascii {
-                                        syntax(path, body.line, 1, msg)
+                                        syntax(body.line, 1, msg)
                                     } else {
-                                        FormatError::corrupt(
-                                            path,
-                                            format!("{msg} (byte {})", body.pos),
-                                        )
+                                        FormatError::corrupt(format!("{msg} (byte {})", body.pos))
                                     });
                                 }
                                 poly.push(if v < u32::MAX as f64 {
@@ -603,16 +637,15 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
                         }
                         if take {
                             if poly.len() < 3 {
-                                return Err(FormatError::corrupt(
-                                    path,
-                                    format!("face {index} has fewer than three vertices"),
-                                ));
+                                return Err(FormatError::corrupt(format!(
+                                    "face {index} has fewer than three vertices"
+                                )));
                             }
                             for j in 1..poly.len() - 1 {
                                 m.triangles.push([poly[0], poly[j], poly[j + 1]]);
                             }
                             if m.triangles.len() > MAX_MESH_ELEMENTS {
-                                return Err(FormatError::too_large(path, "too many triangles"));
+                                return Err(FormatError::too_large("too many triangles"));
                             }
                         }
                     }
@@ -625,10 +658,9 @@ pub fn parse_ply(bytes: &[u8], path: &Path) -> Result<TriMesh, FormatError> {
     }
     let n = m.positions.len() as u32;
     if let Some(t) = m.triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {
-        return Err(FormatError::corrupt(
-            path,
-            format!("face {t} names a vertex beyond the {n} there are"),
-        ));
+        return Err(FormatError::corrupt(format!(
+            "face {t} names a vertex beyond the {n} there are"
+        )));
     }
     Ok(m)
 }
@@ -652,8 +684,47 @@ mod tests {
     }
 
     #[test]
+    fn garbage_and_binary_stl_are_not_obj() {
+        // Seeded random bytes: never an empty mesh, always an error with a place.
+        let mut x = 0x9e37_79b9_7f4a_7c15u64;
+        for seed in 0..200 {
+            let bytes: Vec<u8> = (0..64 + seed)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    x as u8
+                })
+                .collect();
+            if let Ok(m) = parse_obj(&bytes) {
+                // Only text made of OBJ statements may parse.
+                assert!(std::str::from_utf8(&bytes).is_ok(), "seed {seed}: {m:?}");
+            }
+        }
+        let mut stl = vec![0u8; 84];
+        stl[..10].copy_from_slice(b"binary stl");
+        stl[80] = 1;
+        stl.extend(std::iter::repeat_n(0x41u8, 50));
+        let e = parse_obj(&stl).unwrap_err().with_path("m.obj").to_string();
+        assert!(e.starts_with("m.obj:1:1:"), "{e}");
+        let e = parse_obj(b"v 0 0 0\nhello world\n")
+            .unwrap_err()
+            .to_string();
+        assert_eq!(e, "2:1: `hello` is not an OBJ statement");
+        // The statements of the format that we do not use are read past.
+        let ok = "mtllib a.mtl\no cube\ng side\nusemtl red\ns off\nvt 0 0\nvn 0 0 1\n";
+        assert_eq!(
+            parse_obj(format!("{ok}{}", cube_obj()).as_bytes())
+                .unwrap()
+                .triangles
+                .len(),
+            12
+        );
+    }
+
+    #[test]
     fn obj_quads_become_a_closed_cube() {
-        let m = parse_obj(cube_obj().as_bytes(), Path::new("c.obj")).unwrap();
+        let m = parse_obj(cube_obj().as_bytes()).unwrap();
         assert_eq!((m.positions.len(), m.triangles.len()), (8, 12));
         assert_eq!(m.edge_defects(), 0);
         assert!((m.volume() - 1.0).abs() < 1e-12);
@@ -661,7 +732,7 @@ mod tests {
 
     #[test]
     fn written_meshes_parse_back() {
-        let m = parse_obj(cube_obj().as_bytes(), Path::new("c.obj")).unwrap();
+        let m = parse_obj(cube_obj().as_bytes()).unwrap();
         for (ext, f) in [
             (
                 "stl",
@@ -673,7 +744,7 @@ mod tests {
         ] {
             let mut bytes = Vec::new();
             f(&mut bytes, &m).unwrap();
-            let back = parse(&bytes, ext, Path::new("x")).unwrap();
+            let back = parse(&bytes, ext).unwrap();
             assert_eq!(back.triangles.len(), 12, "{ext}");
             assert!((back.volume() - 1.0).abs() < 1e-6, "{ext}");
         }
@@ -682,10 +753,10 @@ mod tests {
     #[test]
     fn ascii_stl_and_ply_parse() {
         let stl = "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
-        let m = parse_stl(stl.as_bytes(), Path::new("t.stl")).unwrap();
+        let m = parse_stl(stl.as_bytes()).unwrap();
         assert_eq!(m.triangles.len(), 1);
         let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
-        let m = parse_ply(ply.as_bytes(), Path::new("t.ply")).unwrap();
+        let m = parse_ply(ply.as_bytes()).unwrap();
         assert_eq!((m.positions.len(), m.triangles.len()), (3, 1));
     }
 
@@ -696,36 +767,44 @@ mod tests {
             "solid x\n",
             "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n",
         ] {
-            let e = parse_stl(text.as_bytes(), Path::new("c.stl")).unwrap_err();
+            let e = parse_stl(text.as_bytes()).unwrap_err();
             assert!(e.to_string().contains("without `endsolid`"), "{e}");
         }
         // An empty but closed solid is a valid, empty mesh.
-        let m = parse_stl(b"solid x\nendsolid x\n", Path::new("e.stl")).unwrap();
+        let m = parse_stl(b"solid x\nendsolid x\n").unwrap();
         assert!(m.triangles.is_empty());
     }
 
     #[test]
     fn a_short_point_names_its_keyword() {
-        let e = parse_obj(b"v 1 2\n", Path::new("a.obj")).unwrap_err();
+        let e = parse_obj(b"v 1 2\n").unwrap_err().with_path("a.obj");
         assert_eq!(e.to_string(), "a.obj:1:6: `v` needs three numbers");
-        let e = parse_stl(b"solid x\nvertex 1 2\n", Path::new("a.stl")).unwrap_err();
+        let e = parse_stl(b"solid x\nvertex 1 2\n")
+            .unwrap_err()
+            .with_path("a.stl");
         assert_eq!(e.to_string(), "a.stl:2:11: `vertex` needs three numbers");
     }
 
     #[test]
     fn errors_name_line_and_column() {
-        let e = parse_obj(b"v 0 0 0\nv 1 x 0\n", Path::new("a.obj")).unwrap_err();
+        let e = parse_obj(b"v 0 0 0\nv 1 x 0\n")
+            .unwrap_err()
+            .with_path("a.obj");
         assert_eq!(e.to_string(), "a.obj:2:5: `x` is not a finite number");
-        let e = parse_obj(b"v 0 0 0\nf 1 2 3\n", Path::new("a.obj")).unwrap_err();
+        let e = parse_obj(b"v 0 0 0\nf 1 2 3\n")
+            .unwrap_err()
+            .with_path("a.obj");
         assert!(e.to_string().starts_with("a.obj:2:5:"), "{e}");
-        let e = parse_stl(b"solid x\nvertex 1 2\n", Path::new("a.stl")).unwrap_err();
+        let e = parse_stl(b"solid x\nvertex 1 2\n")
+            .unwrap_err()
+            .with_path("a.stl");
         assert!(e.to_string().starts_with("a.stl:2:"), "{e}");
         // A hostile PLY header.
         let ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4000000000\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
-        assert!(parse_ply(ply, Path::new("a.ply")).is_err());
+        assert!(parse_ply(ply).is_err());
         // A binary STL claiming more triangles than it holds.
         let mut stl = vec![0u8; 84 + 50];
         stl[80..84].copy_from_slice(&1000u32.to_le_bytes());
-        assert!(parse_stl(&stl, Path::new("a.stl")).is_err());
+        assert!(parse_stl(&stl).is_err());
     }
 }

@@ -5,8 +5,8 @@
 use std::io::{self, Write};
 use std::path::Path;
 
-use super::TriMesh;
 use crate::io::{extension, write_atomic, FormatError};
+use crate::mesh::TriMesh;
 
 /// The mesh extensions we write.
 pub const MESH_EXTENSIONS: &str = "stl, obj, ply, glb";
@@ -24,9 +24,9 @@ pub fn write_file(path: &Path, mesh: &TriMesh) -> Result<(), FormatError> {
         "glb" => write_glb,
         _ => {
             return Err(FormatError::UnknownFormat {
-                path: path.to_owned(),
                 known: MESH_EXTENSIONS,
-            })
+            }
+            .with_path(path))
         }
     };
     write_atomic(path, |w| f(w, mesh))
