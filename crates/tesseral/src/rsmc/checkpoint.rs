@@ -45,7 +45,7 @@ impl Checkpoint {
     /// [`RsmcError::BadCheckpoint`] naming the first bad field.
     ///
     /// ```
-    /// use tesseral::rsmc::{Chain, DenseLattice, Params};
+    /// use tesseral::rsmc::{Chain, DenseLattice, Lattice, Params};
     /// let mut chain = Chain::new(DenseLattice::empty(), Params::default(), 7, &[[0, 0, 0]]).unwrap();
     /// chain.run(100);
     /// let mut cp = chain.checkpoint();
