@@ -347,3 +347,52 @@ fn item_9_a_voxelization_over_budget_is_refused_before_the_work() {
         ],
     );
 }
+
+#[test]
+fn item_2_coloured_meshes_carry_their_colours() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = "depth 5\nbounds [0, 0, 0] [32, 32, 32]\nbox(size = [8, 8, 8]) at [8, 8, 8] colour \"red\"\nbox(size = [8, 8, 8]) at [20, 20, 20] colour \"blue\"\n";
+    std::fs::write(d.join("s.tss"), scene).unwrap();
+    ok(d, &["build", "s.tss", "-o", "s.ply"]);
+    let bytes = std::fs::read(d.join("s.ply")).unwrap();
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    assert!(header.contains("property uchar red"), "{header}");
+    // Faces: count byte, three i32, then RGB; both colours appear.
+    let nv: usize = header
+        .lines()
+        .find_map(|l| l.strip_prefix("element vertex "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let nf: usize = header
+        .lines()
+        .find_map(|l| l.strip_prefix("element face "))
+        .unwrap()
+        .parse()
+        .unwrap();
+    let faces = &bytes[end + 12 * nv..];
+    assert_eq!(faces.len(), 16 * nf);
+    let rgb: std::collections::HashSet<[u8; 3]> =
+        faces.chunks(16).map(|f| [f[13], f[14], f[15]]).collect();
+    assert_eq!(
+        rgb,
+        [[200, 60, 50], [60, 100, 200]].into_iter().collect(),
+        "{rgb:?}"
+    );
+    // It reads back as a mesh (the colour properties are read past).
+    ok(d, &["convert", "s.ply", "back.tess", "--depth", "4"]);
+    ok(d, &["build", "s.tss", "-o", "s.glb"]);
+    let glb = std::fs::read(d.join("s.glb")).unwrap();
+    let n = u32::from_le_bytes([glb[12], glb[13], glb[14], glb[15]]) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&glb[20..20 + n]).unwrap();
+    assert_eq!(
+        json["meshes"][0]["primitives"][0]["attributes"]["COLOR_0"],
+        1
+    );
+}

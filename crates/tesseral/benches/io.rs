@@ -99,6 +99,7 @@ fn bumpy_sphere(lat: usize, lon: usize) -> TriMesh {
     TriMesh {
         positions,
         triangles,
+        colors: Vec::new(),
     }
 }
 

@@ -524,6 +524,7 @@ fn build(tree: &LinearOctree, merge: bool) -> Built {
         TriMesh {
             positions,
             triangles,
+            colors: Vec::new(),
         },
         verts.keys,
         verts.groups,

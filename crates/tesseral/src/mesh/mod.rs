@@ -22,6 +22,8 @@ pub struct TriMesh {
     pub positions: Vec<[f64; 3]>,
     /// Triangles as three indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
+    /// A colour per triangle, or empty when the mesh has none.
+    pub colors: Vec<[u8; 3]>,
 }
 
 impl TriMesh {

@@ -813,6 +813,7 @@ mod tests {
         TriMesh {
             positions,
             triangles,
+            colors: Vec::new(),
         }
     }
 
@@ -1034,6 +1035,7 @@ mod tests {
             let mesh = TriMesh {
                 positions,
                 triangles,
+                colors: Vec::new(),
             };
             let opts = VoxelizeOptions {
                 resolution: Resolution::VoxelSize(1.0),
@@ -1105,6 +1107,7 @@ mod tests {
             let mesh = TriMesh {
                 positions,
                 triangles,
+                colors: Vec::new(),
             };
             let h = 0.25;
             let opts = VoxelizeOptions {

@@ -52,7 +52,9 @@ pub fn read_voxelized(path: &Path, options: &VoxelizeOptions) -> Result<Model, F
 }
 
 /// Meshes `model` (blocky or smooth) and writes it by extension (`.stl`, `.obj`,
-/// `.ply`, `.glb`), in world units (the model's frame applied).
+/// `.ply`, `.glb`), in world units (the model's frame applied). PLY (face colours)
+/// and glTF (`COLOR_0`) carry the model's colours; STL and OBJ have no standard
+/// place for them.
 ///
 /// # Errors
 /// [`FormatError::Io`]; [`FormatError::UnknownFormat`] for another extension.
@@ -62,7 +64,39 @@ pub fn write_meshed(path: &Path, model: &Model, options: &MeshOptions) -> Result
     } else {
         boundary_mesh(&model.tree)
     };
+    if let Some(colors) = &model.colors {
+        mesh.colors = face_colors(&mesh, colors);
+    }
     let f = model.frame;
     mesh.transform(|p| f.to_world(p));
     write_file(path, &mesh)
+}
+
+/// The colour of each triangle: that of the voxel half a voxel inside the surface at
+/// its centroid (voxel units), or the default colour where the voxel has none.
+fn face_colors(
+    mesh: &crate::mesh::TriMesh,
+    colors: &crate::model::Layer<crate::model::Rgba>,
+) -> Vec<[u8; 3]> {
+    let default = super::vox::DEFAULT_COLOR;
+    mesh.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+            let u = [0, 1, 2].map(|k| b[k] - a[k]);
+            let v = [0, 1, 2].map(|k| c[k] - a[k]);
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+                .sqrt()
+                .max(f64::MIN_POSITIVE);
+            // Triangles wind counter-clockwise seen from outside: n points out.
+            let p = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0 - 0.5 * n[k] / len);
+            let col = colors.get(p.map(|x| x.floor() as i64)).unwrap_or(default);
+            [col[0], col[1], col[2]]
+        })
+        .collect()
 }

@@ -110,6 +110,7 @@ fn parse_stl_binary(bytes: &[u8], n: usize) -> Result<TriMesh, FormatError> {
     let mut m = TriMesh {
         positions: Vec::with_capacity(3 * n),
         triangles: Vec::with_capacity(n),
+        colors: Vec::new(),
     };
     for t in 0..n {
         let rec = &bytes[84 + 50 * t..84 + 50 * t + 50];

@@ -94,14 +94,21 @@ pub fn write_obj(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
     Ok(())
 }
 
-/// Binary little-endian PLY with float vertices and `uchar`/`int` face lists.
+/// Binary little-endian PLY with float vertices and `uchar`/`int` face lists, and
+/// `uchar` red, green, blue per face when the mesh has colours.
 ///
 /// # Errors
 /// I/O errors of `w`.
 pub fn write_ply(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    let coloured = m.colors.len() == m.triangles.len() && !m.colors.is_empty();
+    let face_colour = if coloured {
+        "property uchar red\nproperty uchar green\nproperty uchar blue\n"
+    } else {
+        ""
+    };
     write!(
         w,
-        "ply\nformat binary_little_endian 1.0\ncomment written by tesseral\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        "ply\nformat binary_little_endian 1.0\ncomment written by tesseral\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {}\nproperty list uchar int vertex_indices\n{face_colour}end_header\n",
         m.positions.len(),
         m.triangles.len()
     )?;
@@ -111,21 +118,29 @@ pub fn write_ply(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
             buf.extend_from_slice(&(*x as f32).to_le_bytes());
         }
     }
-    for t in &m.triangles {
+    for (k, t) in m.triangles.iter().enumerate() {
         buf.push(3);
         for &i in t {
             buf.extend_from_slice(&(i as i32).to_le_bytes());
+        }
+        if coloured {
+            buf.extend_from_slice(&m.colors[k]);
         }
     }
     w.write_all(&buf)
 }
 
 /// glTF 2.0 binary: one mesh, one triangle primitive with `POSITION` (float VEC3,
-/// with its bounds) and `u32` indices.
+/// with its bounds) and `u32` indices. A coloured mesh is written with its
+/// vertices repeated per triangle and a `COLOR_0` attribute, so each face keeps its
+/// own colour.
 ///
 /// # Errors
 /// I/O errors of `w`.
 pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    if !m.colors.is_empty() && m.colors.len() == m.triangles.len() {
+        return write_glb_coloured(w, m);
+    }
     if m.triangles.is_empty() {
         // glTF accessors and buffers may not be empty: an empty scene instead.
         let json = br#"{"asset":{"version":"2.0","generator":"tesseral"},"scene":0,"scenes":[{"nodes":[]}]}"#;
@@ -177,6 +192,63 @@ pub fn write_glb(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
             {"bufferView": 0, "componentType": 5126, "count": m.positions.len(), "type": "VEC3",
              "min": lo, "max": hi},
             {"bufferView": 1, "componentType": 5125, "count": 3 * m.triangles.len(), "type": "SCALAR"}
+        ]
+    });
+    let mut json = serde_json::to_vec(&json).map_err(io::Error::other)?;
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    w.write_all(b"glTF")?;
+    w.write_all(&2u32.to_le_bytes())?;
+    w.write_all(&(total as u32).to_le_bytes())?;
+    w.write_all(&(json.len() as u32).to_le_bytes())?;
+    w.write_all(b"JSON")?;
+    w.write_all(&json)?;
+    w.write_all(&(bin.len() as u32).to_le_bytes())?;
+    w.write_all(b"BIN\0")?;
+    w.write_all(&bin)
+}
+
+/// A coloured glTF: three vertices per triangle, `COLOR_0` as normalized RGBA bytes.
+fn write_glb_coloured(w: &mut dyn Write, m: &TriMesh) -> io::Result<()> {
+    let n = 3 * m.triangles.len();
+    let mut bin = Vec::with_capacity(16 * n);
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    for t in &m.triangles {
+        for &i in t {
+            let p = m.positions[i as usize];
+            for a in 0..3 {
+                let x = p[a] as f32;
+                lo[a] = lo[a].min(x);
+                hi[a] = hi[a].max(x);
+                bin.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+    }
+    let pos_len = bin.len();
+    for c in &m.colors {
+        for _ in 0..3 {
+            bin.extend_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+    }
+    let col_len = bin.len() - pos_len;
+    let json = serde_json::json!({
+        "asset": {"version": "2.0", "generator": "tesseral"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "COLOR_0": 1}, "mode": 4}]}],
+        "buffers": [{"byteLength": bin.len()}],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": pos_len, "target": 34962},
+            {"buffer": 0, "byteOffset": pos_len, "byteLength": col_len, "target": 34962}
+        ],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": n, "type": "VEC3",
+             "min": lo, "max": hi},
+            {"bufferView": 1, "componentType": 5121, "normalized": true, "count": n, "type": "VEC4"}
         ]
     });
     let mut json = serde_json::to_vec(&json).map_err(io::Error::other)?;

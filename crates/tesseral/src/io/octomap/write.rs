@@ -96,7 +96,8 @@ fn split<T: Copy>(leaf: Leaf, index: &[(Leaf, T)], out: &mut impl FnMut(Leaf, Op
 fn pieces(km: &KeyModel) -> Vec<Piece> {
     let colors = km.colors.as_ref().map(Layer::leaves).unwrap_or_default();
     let odds = km.log_odds.as_ref().map(Layer::leaves).unwrap_or_default();
-    let default_rgb = super::super::vox::DEFAULT_COLOR;
+    // OctoMap's "no colour set" is white; its inner nodes average only set colours.
+    let default_rgb = [255, 255, 255, 255];
     let mut out = Vec::new();
     let parts = [(&km.occupied, true)]
         .into_iter()
@@ -223,7 +224,8 @@ fn write_bt_node(pieces: &[Piece], code: u64, k: u8, out: &mut Vec<u8>, nodes: &
 /// Encodes `model` as `.ot` bytes: an `OcTree`, or a `ColorOcTree` when the model has
 /// colours. Leaves carry the model's log-odds (or OctoMap's clamping thresholds when
 /// it has none); inner nodes the maximum of their children's, as OctoMap's
-/// `updateInnerOccupancy`, and the mean of their colours, as `updateColorChildren`.
+/// `updateInnerOccupancy`, and the mean of their set colours, as
+/// `getAverageChildColor` (white is OctoMap's "unset", used for free leaves).
 ///
 /// # Errors
 /// As [`encode_bt`].
@@ -267,6 +269,7 @@ fn write_ot_node(
         let mut max = f32::NEG_INFINITY;
         let mut sum = [0u32; 3];
         let mut n = 0u32;
+        const UNSET: [u8; 3] = [255, 255, 255];
         for (i, (c, mine)) in children(pieces, code, k).into_iter().enumerate() {
             if mine.is_empty() {
                 continue;
@@ -274,13 +277,22 @@ fn write_ot_node(
             mask |= 1 << i;
             let (v, rgb) = write_ot_node(mine, c, k - 1, colour, out, nodes);
             max = max.max(v);
-            for j in 0..3 {
-                sum[j] += u32::from(rgb[j]);
+            if rgb != UNSET {
+                for j in 0..3 {
+                    sum[j] += u32::from(rgb[j]);
+                }
+                n += 1;
             }
-            n += 1;
         }
         out[at + 4 + extra] = mask;
-        (max, sum.map(|s| (s / n.max(1)) as u8))
+        // As OctoMap's `getAverageChildColor`: the mean of the children whose colour
+        // is set, or unset (white) when none is.
+        let rgb = if n == 0 {
+            UNSET
+        } else {
+            sum.map(|s| (s / n) as u8)
+        };
+        (max, rgb)
     };
     out[at..at + 4].copy_from_slice(&value.to_le_bytes());
     if colour {
