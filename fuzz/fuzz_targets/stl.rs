@@ -1,15 +1,14 @@
 #![no_main]
 //! Fuzzes the stl parser and, for small meshes, the voxelizer behind it.
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 use tesseral::mesh::{self, Resolution, VoxelizeOptions};
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(m) = mesh::read::parse(data, "stl") {
+    if let Ok(m) = tesseral::io::mesh::parse(data, "stl") {
         if m.triangles.len() <= 1000 {
             for surface_only in [false, true] {
                 let opts = VoxelizeOptions { resolution: Resolution::Depth(5), surface_only, ..Default::default() };
-                if let Ok(model) = mesh::voxelize(&m, &opts, Path::new("fuzz.stl")) {
+                if let Ok(model) = mesh::voxelize(&m, &opts) {
                     model.tree.assert_valid();
                 }
             }

@@ -1,7 +1,6 @@
 #![no_main]
 //! Fuzzes `tesseral::io::vox::decode`: any bytes give `Ok` or `Err`, never a panic.
 use libfuzzer_sys::fuzz_target;
-use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
     if let Ok(model) = tesseral::io::vox::decode(data) {

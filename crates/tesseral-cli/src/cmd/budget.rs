@@ -48,7 +48,7 @@ impl Budget {
 
     /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
     /// amount), naming the flag that binds.
-    fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
+    pub fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
         let cap = self.leaf_cap();
         let (flag, limit) = if self.max_leaves == cap {
             ("--max-leaves", self.max_leaves.to_string())

@@ -13,6 +13,7 @@ pub mod output;
 pub mod plan;
 pub mod render;
 pub mod replay;
+pub mod replay_log;
 pub mod rsmc;
 pub mod shell;
 pub mod simulate;

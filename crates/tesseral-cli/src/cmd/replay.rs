@@ -8,15 +8,13 @@
 //! `root_size_log2`, `root_min`, `expansions`, `contractions`, `nodes`, `bytes`.
 
 use std::fs::File;
-use std::io::{self, BufRead, BufReader, BufWriter, IsTerminal, Read, Write};
+use std::io::{self, BufReader, BufWriter, IsTerminal, Read, Write};
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use tesseral::dynamic::DynamicOctree;
 
-/// The longest line accepted, in bytes; a longer one is an error (so a hostile file
-/// without newlines cannot make us buffer it whole).
-const MAX_LINE: usize = 4096;
+use super::replay_log::{parse_line, read_line, Op};
 
 /// Arguments of `tesseral replay`.
 #[derive(clap::Args)]
@@ -31,72 +29,6 @@ pub struct Args {
     /// so that every command takes --json.
     #[arg(long)]
     json: bool,
-}
-
-/// What a line asks for.
-enum Op {
-    Insert([i64; 3]),
-    Remove([i64; 3]),
-    Query([i64; 3]),
-    Skip,
-}
-
-fn parse_line(line: &str) -> Result<Op, String> {
-    let line = line.trim();
-    if line.is_empty() || line.starts_with('#') {
-        return Ok(Op::Skip);
-    }
-    let mut words = line.split_whitespace();
-    let op = words.next().unwrap_or_default();
-    let make: fn([i64; 3]) -> Op = match op {
-        "+" => Op::Insert,
-        "-" => Op::Remove,
-        "?" => Op::Query,
-        _ => {
-            return Err(format!(
-                "unknown operation '{op}' (expected '+', '-', '?' or '#')"
-            ))
-        }
-    };
-    let coords: Vec<&str> = words.collect();
-    if coords.len() != 3 {
-        return Err(format!(
-            "'{op}' needs 3 coordinates x y z, found {}",
-            coords.len()
-        ));
-    }
-    let mut v = [0i64; 3];
-    for (a, w) in coords.iter().enumerate() {
-        v[a] = w.parse().map_err(|_| {
-            format!(
-                "coordinate {} '{w}' is not an integer in [-2^63, 2^63)",
-                ["x", "y", "z"][a]
-            )
-        })?;
-    }
-    Ok(make(v))
-}
-
-/// Reads one line into `buf` (without the newline); `Ok(false)` at end of input.
-/// Fails on a line longer than [`MAX_LINE`] bytes or one that is not UTF-8.
-fn read_line<R: BufRead>(r: &mut R, buf: &mut Vec<u8>) -> Result<bool, String> {
-    buf.clear();
-    let n = r
-        .take(MAX_LINE as u64 + 1)
-        .read_until(b'\n', buf)
-        .map_err(|e| format!("read error: {e}"))?;
-    if n == 0 {
-        return Ok(false);
-    }
-    if buf.last() == Some(&b'\n') {
-        buf.pop();
-        if buf.last() == Some(&b'\r') {
-            buf.pop();
-        }
-    } else if buf.len() > MAX_LINE {
-        return Err(format!("line longer than {MAX_LINE} bytes"));
-    }
-    Ok(true)
 }
 
 pub fn run(args: Args) -> Result<()> {

@@ -124,6 +124,41 @@ const MAX_BOX_SIDE: u64 = 1000;
 const MAX_ROWS: u64 = 10_000_000;
 const MAX_START_VOXELS: u64 = 10_000_000;
 
+/// Validates the fields the CLI adds to the chain's checkpoint, and the chain's own
+/// ([`Checkpoint::validate`]), naming the field at fault.
+fn check_checkpoint(cp: &CliCheckpoint, steps: u64) -> Result<()> {
+    cp.chain.validate()?;
+    ensure!(
+        cp.sample_every >= 1,
+        "sample_every is 0; it must be at least 1"
+    );
+    ensure!(
+        steps / cp.sample_every <= MAX_ROWS,
+        "sample_every {} with --steps {steps} gives more than {MAX_ROWS} CSV rows",
+        cp.sample_every
+    );
+    let k = cp.chain.counters;
+    ensure!(
+        cp.base_steps <= k.steps,
+        "base_steps {} exceeds counters.steps {}",
+        cp.base_steps,
+        k.steps
+    );
+    ensure!(
+        cp.base_accepted <= k.accepted,
+        "base_accepted {} exceeds counters.accepted {}",
+        cp.base_accepted,
+        k.accepted
+    );
+    ensure!(
+        k.accepted - cp.base_accepted <= k.steps - cp.base_steps,
+        "base_accepted {} and base_steps {} give more acceptances than steps since the last row",
+        cp.base_accepted,
+        cp.base_steps
+    );
+    Ok(())
+}
+
 fn parse_start(s: &str) -> Result<Vec<Voxel>> {
     if s == "voxel" {
         return Ok(vec![[0, 0, 0]]);
@@ -250,6 +285,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             .with_context(|| format!("reading {}", cp_path.display()))?;
         let cp: CliCheckpoint = serde_json::from_str(&text)
             .with_context(|| format!("parsing {}", cp_path.display()))?;
+        check_checkpoint(&cp, args.steps)
+            .with_context(|| format!("bad checkpoint {}", cp_path.display()))?;
         let p = cp.chain.params;
         let same = |name: &str, given: Option<f64>, saved: f64| -> Result<()> {
             match given {

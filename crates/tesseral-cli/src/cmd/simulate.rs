@@ -1,13 +1,15 @@
 //! `tesseral simulate`: run a world of moving objects and report every contact.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::ops::ControlFlow;
+use std::path::{Path, PathBuf};
 
-use anyhow::{Context, Result};
+use anyhow::{bail, Context, Result};
 use serde::Serialize;
-use tesseral::motion::{read_world, render_frame, Aabb, Body, Frame};
+use tesseral::motion::{read_world_limited, render_frame, Aabb, Body, Contact, Step, WorldError};
 use tesseral::render::{Camera, RenderOptions, View};
 
+use super::budget::Budget;
 use super::output::{self, Limits, Size};
 
 /// Arguments of `tesseral simulate`.
@@ -38,6 +40,13 @@ pub struct Args {
     height: Option<u32>,
     #[command(flatten)]
     limits: Limits,
+    #[command(flatten)]
+    budget: Budget,
+    /// Let the world file name octree files outside its own folder (absolute paths
+    /// or `..`); without it such a path is an error, so that a world file from
+    /// elsewhere cannot make simulate read any file of the machine.
+    #[arg(long)]
+    allow_outside: bool,
 }
 
 #[derive(Serialize)]
@@ -52,13 +61,12 @@ struct ContactOut {
     b_block: Aabb,
 }
 
+/// The head of the `--json` report; `frames` and `contacts` follow it, streamed.
 #[derive(Serialize)]
-struct Report<'a> {
+struct ReportHead<'a> {
     steps: u64,
     time_step: f64,
     objects: Vec<&'a str>,
-    contacts: Vec<ContactOut>,
-    frames: &'a [Frame],
 }
 
 fn name(b: &Body) -> String {
@@ -84,13 +92,19 @@ fn parse_view(s: &str) -> Result<View, String> {
 pub fn run(args: Args) -> Result<()> {
     if let Some(dir) = &args.frames {
         if output::same_file(dir, &args.world) {
-            anyhow::bail!(
+            bail!(
                 "--frames {}: this is the world file; give a folder for the pictures",
                 dir.display()
             );
         }
     }
-    let wf = read_world(&args.world).context("reading the world file")?;
+    let cap = args.budget.leaf_cap() as u64;
+    let wf = match read_world_limited(&args.world, cap, args.allow_outside) {
+        Err(WorldError::TooManyLeaves { path, leaves, .. }) => {
+            return Err(args.budget.refuse(&path.display().to_string(), leaves))
+        }
+        r => r.context("reading the world file")?,
+    };
     let world = &wf.world;
     let size = args.size.unwrap_or(Size {
         width: args.width.map_or(480, |w| w as usize),
@@ -101,98 +115,208 @@ pub fn run(args: Args) -> Result<()> {
         let each = tesseral::io::estimate_image_bytes(size.width as u64, size.height as u64);
         let total = each.saturating_mul(wf.steps.saturating_add(1));
         output::check_size(dir, total, args.limits.max_output)?;
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
-    let sim = world
-        .simulate(wf.time_step, wf.steps)
-        .context("keeping the objects' octrees current")?;
-    if let Some(dir) = &args.frames {
-        write_frames(dir, world, &sim, args.view, (size.width, size.height))?;
-    }
-    let contacts: Vec<ContactOut> = sim
-        .contacts
-        .iter()
-        .map(|c| ContactOut {
-            time: c.time,
-            step: c.step,
-            fraction: c.fraction.to_string(),
-            a: name(&c.a),
-            b: name(&c.b),
-            between_steps: c.between_steps,
-            a_block: c.a_block,
-            b_block: c.b_block,
-        })
-        .collect();
-    let mut out = std::io::stdout().lock();
-    if args.json {
-        let report = Report {
-            steps: wf.steps,
-            time_step: wf.time_step,
-            objects: world.objects.iter().map(|o| o.name.as_str()).collect(),
-            contacts,
-            frames: &sim.frames,
-        };
-        serde_json::to_writer(&mut out, &report)?;
-        writeln!(out)?;
-    } else {
-        for c in &contacts {
-            let note = if c.between_steps {
-                " (between steps: a per-step test misses it)"
-            } else {
-                ""
-            };
-            writeln!(
-                out,
-                "contact at t = {} (step {} + {} of the step): {} and {}{note}",
-                c.time, c.step, c.fraction, c.a, c.b
-            )?;
-        }
-        writeln!(
-            out,
-            "{} in {} of {} ({})",
-            plural(contacts.len() as u64, "contact"),
-            plural(wf.steps, "step"),
-            wf.time_step,
-            plural(world.objects.len() as u64, "object")
-        )?;
-    }
-    Ok(())
-}
-
-fn write_frames(
-    dir: &std::path::Path,
-    world: &tesseral::motion::World,
-    sim: &tesseral::motion::Simulation,
-    view: View,
-    size: (usize, usize),
-) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     let opts = RenderOptions {
-        width: size.0,
-        height: size.1,
-        camera: Camera::view(view),
+        width: size.width,
+        height: size.height,
+        camera: Camera::view(args.view),
         ..RenderOptions::default()
     };
-    let show = std::io::IsTerminal::is_terminal(&std::io::stderr());
+    let show = args.frames.is_some() && std::io::IsTerminal::is_terminal(&std::io::stderr());
     let bar = if show {
-        indicatif::ProgressBar::new(sim.frames.len() as u64)
+        indicatif::ProgressBar::new(wf.steps.saturating_add(1))
     } else {
         indicatif::ProgressBar::hidden()
     };
-    for f in &sim.frames {
-        // Contacts that begin during the move out of this step, where they happen.
-        let swept: Vec<Aabb> = sim
-            .contacts
-            .iter()
-            .filter(|c| c.step == f.step && c.between_steps)
-            .map(|c| c.a_block)
-            .collect();
-        let img = render_frame(world, f, &swept, &opts)
-            .with_context(|| format!("drawing step {}", f.step))?;
-        let path = dir.join(format!("frame_{:05}.png", f.step));
-        img.write_png(&path)
-            .with_context(|| format!("writing {}", path.display()))?;
-        bar.inc(1);
+    // Each step is reported and dropped as it comes: a long run keeps one step in
+    // memory (the review's depth-10 sphere resting in itself kept them all).
+    let stdout = std::io::stdout().lock();
+    let mut report = Reporter {
+        out: Budgeted::new(std::io::BufWriter::new(stdout), args.limits.max_output),
+        json: args.json,
+        contacts_json: Vec::new(),
+        contacts: 0,
+    };
+    if args.json {
+        let head = ReportHead {
+            steps: wf.steps,
+            time_step: wf.time_step,
+            objects: world.objects.iter().map(|o| o.name.as_str()).collect(),
+        };
+        let mut text = serde_json::to_vec(&head)?;
+        text.pop(); // the closing brace: frames and contacts follow
+        report.out.write_all(&text)?;
+        report.out.write_all(b",\"frames\":[")?;
     }
+    let mut failure = None;
+    let boxes = args.json || args.frames.is_some();
+    world
+        .simulate_each(wf.time_step, wf.steps, boxes, |step| {
+            let done = report.step(&step).and_then(|()| match &args.frames {
+                Some(dir) => write_frame(dir, world, &step, &opts),
+                None => Ok(()),
+            });
+            bar.inc(1);
+            match done {
+                Ok(()) => ControlFlow::Continue(()),
+                Err(e) => {
+                    failure = Some(e);
+                    ControlFlow::Break(())
+                }
+            }
+        })
+        .context("keeping the objects' octrees current")?;
     bar.finish_and_clear();
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    if args.json {
+        let contacts = std::mem::take(&mut report.contacts_json);
+        report.out.write_all(b"],\"contacts\":[")?;
+        report.out.write_all(&contacts)?;
+        report.out.write_all(b"]}\n")?;
+    } else {
+        let line = format!(
+            "{} in {} of {} ({})\n",
+            plural(report.contacts, "contact"),
+            plural(wf.steps, "step"),
+            wf.time_step,
+            plural(world.objects.len() as u64, "object")
+        );
+        report.out.write_all(line.as_bytes())?;
+    }
+    report.out.flush()?;
     Ok(())
+}
+
+/// Writes each step as it comes: a contact line, or (with `--json`) the frame, with
+/// the contacts kept as JSON text until the frames are out.
+struct Reporter<W: Write> {
+    out: Budgeted<W>,
+    json: bool,
+    contacts_json: Vec<u8>,
+    contacts: u64,
+}
+
+impl<W: Write> Reporter<W> {
+    fn step(&mut self, step: &Step) -> Result<()> {
+        if self.json {
+            if step.frame.step > 0 {
+                self.out.write_all(b",")?;
+            }
+            serde_json::to_writer(&mut self.out, &step.frame)?;
+            for c in &step.contacts {
+                if self.contacts > 0 {
+                    self.contacts_json.push(b',');
+                }
+                serde_json::to_writer(&mut self.contacts_json, &contact_out(c))?;
+                self.contacts += 1;
+            }
+            // The contacts held back count against the output budget too.
+            self.out.reserve(self.contacts_json.len() as u64)?;
+        } else {
+            for c in step.contacts.iter().map(contact_out) {
+                let note = if c.between_steps {
+                    " (between steps: a per-step test misses it)"
+                } else {
+                    ""
+                };
+                let line = format!(
+                    "contact at t = {} (step {} + {} of the step): {} and {}{note}\n",
+                    c.time, c.step, c.fraction, c.a, c.b
+                );
+                self.out.write_all(line.as_bytes())?;
+                self.contacts += 1;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// A writer that refuses to write more than `limit` bytes (`--max-output`).
+struct Budgeted<W: Write> {
+    inner: W,
+    written: u64,
+    reserved: u64,
+    limit: u64,
+}
+
+impl<W: Write> Budgeted<W> {
+    fn new(inner: W, limit: u64) -> Self {
+        Self {
+            inner,
+            written: 0,
+            reserved: 0,
+            limit,
+        }
+    }
+
+    /// Sets aside `bytes` still to be written; fails when they would not fit.
+    fn reserve(&mut self, bytes: u64) -> std::io::Result<()> {
+        self.reserved = bytes;
+        self.check(0)
+    }
+
+    fn check(&self, more: u64) -> std::io::Result<()> {
+        let total = self
+            .written
+            .saturating_add(self.reserved)
+            .saturating_add(more);
+        if total > self.limit {
+            return Err(std::io::Error::other(format!(
+                "the report would exceed the output limit of {} bytes; raise it with --max-output",
+                self.limit
+            )));
+        }
+        Ok(())
+    }
+}
+
+impl<W: Write> Write for Budgeted<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.check(buf.len() as u64)?;
+        let n = self.inner.write(buf)?;
+        self.written += n as u64;
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+fn contact_out(c: &Contact) -> ContactOut {
+    ContactOut {
+        time: c.time,
+        step: c.step,
+        fraction: c.fraction.to_string(),
+        a: name(&c.a),
+        b: name(&c.b),
+        between_steps: c.between_steps,
+        a_block: c.a_block,
+        b_block: c.b_block,
+    }
+}
+
+/// Draws one step: objects in colour, overlaps red, and the blocks hit during the
+/// move out of this step magenta.
+fn write_frame(
+    dir: &Path,
+    world: &tesseral::motion::World,
+    step: &Step,
+    opts: &RenderOptions,
+) -> Result<()> {
+    let f = &step.frame;
+    let swept: Vec<Aabb> = step
+        .contacts
+        .iter()
+        .filter(|c| c.step == f.step && c.between_steps)
+        .map(|c| c.a_block)
+        .collect();
+    let img =
+        render_frame(world, f, &swept, opts).with_context(|| format!("drawing step {}", f.step))?;
+    let path = dir.join(format!("frame_{:05}.png", f.step));
+    img.write_png(&path)
+        .with_context(|| format!("writing {}", path.display()))
 }

@@ -8,14 +8,18 @@
 //! the colour layer is exact, voxel for voxel, and costs one build per colour.
 
 use std::collections::HashMap;
+use std::ops::ControlFlow;
 
+use super::index::{Bounds, BoxIndex};
 use super::{Colour, Solid};
 
 /// The solid's points that have a colour, as one solid per colour; the parts are
 /// disjoint and together hold exactly the coloured points.
 ///
 /// # Runtime
-/// O(size of the solid × number of union children) to write the expressions; the
+/// O(size of the solid × union children whose boxes overlap) to write the
+/// expressions (a union child is cut only by the later children whose boxes meet
+/// its own: 10,000 separate boxes no longer write 50 million differences); the
 /// cost is in building them.
 #[must_use]
 pub fn colour_parts(solid: &Solid) -> Vec<(Colour, Solid)> {
@@ -64,11 +68,31 @@ fn collect(solid: &Solid, colour: Option<Colour>, out: &mut Vec<(Colour, Solid)>
         }
         Solid::Union(kids) => {
             // The last child holding a point gives its colour: child i keeps the
-            // points that no later child holds.
+            // points that no later child holds. Only a later child whose box meets
+            // child i's can hold one of its points.
+            let boxes: Vec<(u32, Option<Bounds>)> = kids
+                .iter()
+                .enumerate()
+                .map(|(j, k)| (j as u32, k.compile().ok().and_then(|c| c.bbox())))
+                .collect();
+            let index = BoxIndex::new(&boxes);
             for (i, kid) in kids.iter().enumerate() {
                 let mut kid_parts = Vec::new();
                 collect(kid, colour, &mut kid_parts);
-                let later = &kids[i + 1..];
+                let later: Vec<Solid> = match &boxes[i].1 {
+                    Some(b) => {
+                        let mut js = Vec::new();
+                        let _ = index.for_each_meeting(b, |j| {
+                            if j as usize > i {
+                                js.push(j as usize);
+                            }
+                            ControlFlow::Continue(())
+                        });
+                        js.sort_unstable();
+                        js.into_iter().map(|j| kids[j].clone()).collect()
+                    }
+                    None => kids[i + 1..].to_vec(),
+                };
                 for (c, s) in kid_parts {
                     let s = if later.is_empty() {
                         s

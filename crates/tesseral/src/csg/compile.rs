@@ -1,10 +1,12 @@
 //! A solid compiled for evaluation, its conservative cell classifier and its top-down
 //! octree builder.
 
+use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use super::index::{Bounds, BoxIndex};
 use super::{Colour, CsgError, Shape, Solid, Transform};
 use crate::linear::{push_merging, CellClass, Classifier, Leaf, LinearOctree};
 use crate::Voxel;
@@ -102,7 +104,13 @@ pub struct Csg {
     nodes: Vec<Node>,
     kids: Vec<u32>,
     root: u32,
+    /// Per node: for a union of at least [`INDEX_MIN_PARTS`] parts, the index of
+    /// their boxes.
+    index: Vec<Option<BoxIndex>>,
 }
+
+/// Unions of at least this many parts get a [`BoxIndex`]; below it a scan is as fast.
+const INDEX_MIN_PARTS: u32 = 16;
 
 impl Csg {
     pub(crate) fn compile(solid: &Solid) -> Result<Self, CsgError> {
@@ -111,9 +119,25 @@ impl Csg {
             nodes: Vec::new(),
             kids: Vec::new(),
             root: 0,
+            index: Vec::new(),
         };
         c.root = c.add(solid, &Transform::IDENTITY, None, 0)?;
+        c.index = (0..c.nodes.len() as u32)
+            .map(|n| {
+                let node = &c.nodes[n as usize];
+                (node.op == Op::Union && node.len >= INDEX_MIN_PARTS).then(|| {
+                    let parts: Vec<(u32, Option<Bounds>)> =
+                        c.kids_of(n).iter().map(|&k| (k, c.node_bbox(k))).collect();
+                    BoxIndex::new(&parts)
+                })
+            })
+            .collect();
         Ok(c)
+    }
+
+    fn kids_of(&self, n: u32) -> &[u32] {
+        let node = &self.nodes[n as usize];
+        &self.kids[node.first as usize..(node.first + node.len) as usize]
     }
 
     fn add(
@@ -227,6 +251,31 @@ impl Csg {
                     class
                 } else {
                     self.prims[i as usize].class(c, r)
+                }
+            }
+            Op::Union if self.index[n as usize].is_some() => {
+                // Only the parts whose boxes meet the ball can hold its points.
+                let query = (c.map(|v| v - r), c.map(|v| v + r));
+                let mut all_out = true;
+                let found = self.index[n as usize]
+                    .as_ref()
+                    .map(|ix| {
+                        ix.for_each_meeting(&query, |k| match self.eval(k, c, r, known, learn) {
+                            CellClass::Inside => ControlFlow::Break(()),
+                            CellClass::Partial => {
+                                all_out = false;
+                                ControlFlow::Continue(())
+                            }
+                            CellClass::Outside => ControlFlow::Continue(()),
+                        })
+                    })
+                    .is_some_and(|f| f.is_break());
+                if found {
+                    CellClass::Inside
+                } else if all_out {
+                    CellClass::Outside
+                } else {
+                    CellClass::Partial
                 }
             }
             Op::Union => {
@@ -655,6 +704,23 @@ impl Csg {
                     }
                 }
                 self.prims[i as usize].mask4(min)
+            }
+            Op::Union if self.index[n as usize].is_some() => {
+                // The voxel centres of the cell span [min + 0.5, min + 3.5].
+                let lo = min.map(|v| v as f64 + 0.5);
+                let query = (lo, lo.map(|v| v + 3.0));
+                let mut acc = 0;
+                if let Some(ix) = &self.index[n as usize] {
+                    let _ = ix.for_each_meeting(&query, |k| {
+                        acc |= self.eval_mask(k, min, known);
+                        if acc == u64::MAX {
+                            ControlFlow::Break(())
+                        } else {
+                            ControlFlow::Continue(())
+                        }
+                    });
+                }
+                acc
             }
             Op::Union => {
                 let mut acc = 0;

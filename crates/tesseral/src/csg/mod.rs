@@ -25,11 +25,14 @@
 mod budget;
 mod colours;
 mod compile;
+mod index;
 pub mod scene;
 mod shape;
 
 #[cfg(test)]
 pub(crate) mod tests;
+#[cfg(test)]
+mod tests_index;
 
 pub use colours::colour_parts;
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};

@@ -15,6 +15,7 @@
 use std::collections::HashMap;
 use std::fmt;
 use std::path::{Path, PathBuf};
+use std::rc::Rc;
 
 use super::{Colour, Csg, CsgError, Shape, Solid, Transform};
 use crate::linear::LinearOctree;
@@ -27,6 +28,18 @@ pub const MAX_PRIMITIVES: usize = 10_000;
 pub const MAX_NESTING: usize = 64;
 /// The largest scene file, in bytes.
 pub const MAX_SCENE_BYTES: usize = 4 << 20;
+/// The most numbers and lists one value may hold, counted through shared `let`
+/// names: `[a, a]` holds `a` twice.
+pub const MAX_VALUE_ELEMENTS: usize = 1 << 20;
+/// The most numbers and lists the whole scene may build while it is evaluated (list
+/// literals and arithmetic on lists), so that a short file cannot ask for unbounded
+/// work by repeating a large computation.
+pub const MAX_SCENE_WORK: usize = 1 << 24;
+
+/// How many characters of a source line a diagnostic shows, and how many of them
+/// come before the fault.
+const SHOWN_CHARS: usize = 120;
+const SHOWN_BEFORE: usize = 40;
 
 /// The shapes a scene may name.
 pub const SHAPES: &[&str] = &[
@@ -81,12 +94,22 @@ impl fmt::Display for Diagnostic {
         )?;
         let num = self.line.to_string();
         let pad = " ".repeat(num.len());
-        write!(f, "\n{pad} |\n{num} | {}\n{pad} | ", self.source_line)?;
+        // A hostile line can be megabytes long: show a window of it around the fault.
+        let skip = self.column.saturating_sub(1 + SHOWN_BEFORE);
+        let shown: String = self
+            .source_line
+            .chars()
+            .skip(skip)
+            .take(SHOWN_CHARS)
+            .collect();
+        let (cut, under_cut) = if skip > 0 { ("…", " ") } else { ("", "") };
+        write!(f, "\n{pad} |\n{num} | {cut}{shown}\n{pad} | {under_cut}")?;
+        let col = self.column.saturating_sub(1) - skip;
         write!(
             f,
             "{}{}",
-            " ".repeat(self.column.saturating_sub(1)),
-            "^".repeat(self.width.max(1))
+            " ".repeat(col),
+            "^".repeat(self.width.clamp(1, SHOWN_CHARS.saturating_sub(col).max(1)))
         )?;
         if let Some(h) = &self.hint {
             write!(f, "\n{pad} = hint: {h}")?;
@@ -305,10 +328,46 @@ fn describe(t: &Tok) -> String {
     }
 }
 
+/// A value of the scene language. Lists are shared, not copied: a `let` name used
+/// twice costs one pointer, which is what keeps `let b = [a, a, a]` cheap; what a
+/// value *would* cost if expanded is kept in `List::elements` and budgeted.
 #[derive(Debug, Clone, PartialEq)]
 enum Value {
     Num(f64),
-    List(Vec<Value>),
+    List(Rc<List>),
+}
+
+#[derive(Debug, PartialEq)]
+struct List {
+    items: Vec<Value>,
+    /// The numbers and lists this list holds, itself included, counted through
+    /// sharing.
+    elements: usize,
+    /// Lists inside lists: `[1]` has depth 1.
+    depth: usize,
+}
+
+impl std::ops::Deref for List {
+    type Target = [Value];
+    fn deref(&self) -> &[Value] {
+        &self.items
+    }
+}
+
+impl Value {
+    fn elements(&self) -> usize {
+        match self {
+            Value::Num(_) => 1,
+            Value::List(l) => l.elements,
+        }
+    }
+
+    fn depth(&self) -> usize {
+        match self {
+            Value::Num(_) => 0,
+            Value::List(l) => l.depth,
+        }
+    }
 }
 
 struct Parser<'a> {
@@ -319,6 +378,8 @@ struct Parser<'a> {
     lets: HashMap<String, (Value, usize)>,
     prims: usize,
     nesting: usize,
+    /// Numbers and lists built so far, against [`MAX_SCENE_WORK`].
+    work: usize,
 }
 
 struct Settings {
@@ -337,6 +398,7 @@ impl<'a> Parser<'a> {
             lets: HashMap::new(),
             prims: 0,
             nesting: 0,
+            work: 0,
         };
         if text.len() > MAX_SCENE_BYTES {
             return Err(p.err(
@@ -1020,7 +1082,7 @@ impl<'a> Parser<'a> {
                     ));
                 }
                 let mut planes = Vec::new();
-                for it in items {
+                for it in items.iter() {
                     let v = self.list(it, a.3, "planes", 4)?;
                     planes.push([v[0], v[1], v[2], v[3]]);
                 }
@@ -1067,6 +1129,11 @@ impl<'a> Parser<'a> {
                 .iter()
                 .map(|x| match x {
                     Value::Num(f) if f.is_finite() => Ok(*f),
+                    Value::Num(f) => Err(self.err(
+                        span,
+                        format!("`{what}` holds a number that is not finite ({f})"),
+                        Some("check for an overflow such as 1e308 * 10, or inf - inf".into()),
+                    )),
                     _ => Err(self.err(
                         span,
                         format!("`{what}` must hold {n} numbers"),
@@ -1124,13 +1191,17 @@ impl<'a> Parser<'a> {
         Ok(v)
     }
 
+    /// Unary minus, iteratively: a run of signs is any length without using the stack.
     fn unary(&mut self) -> Result<Value, SceneError> {
-        if self.is_punct('-') {
-            let op = self.next();
-            let v = self.unary()?;
-            return self.arith(op, Value::Num(0.0), v);
+        let mut signs = Vec::new();
+        while self.is_punct('-') {
+            signs.push(self.next());
         }
-        self.atom()
+        let mut v = self.atom()?;
+        for op in signs.into_iter().rev() {
+            v = self.arith(op, Value::Num(0.0), v)?;
+        }
+        Ok(v)
     }
 
     fn atom(&mut self) -> Result<Value, SceneError> {
@@ -1172,7 +1243,8 @@ impl<'a> Parser<'a> {
                 }
                 self.next();
                 self.nesting -= 1;
-                Ok(Value::List(items))
+                self.charge(items.len(), t.span)?;
+                self.make_list(items, t.span)
             }
             Tok::Str(_) => Err(self.err(
                 t.span,
@@ -1187,47 +1259,95 @@ impl<'a> Parser<'a> {
         }
     }
 
-    fn arith(&self, op: Token, a: Value, b: Value) -> Result<Value, SceneError> {
+    /// Counts `n` more numbers and lists built against [`MAX_SCENE_WORK`], before they
+    /// are built.
+    fn charge(&mut self, n: usize, span: Span) -> Result<(), SceneError> {
+        self.work = self.work.saturating_add(n);
+        if self.work > MAX_SCENE_WORK {
+            return Err(self.err(
+                span,
+                format!(
+                    "the scene's evaluation exceeds its work budget of {MAX_SCENE_WORK} elements built"
+                ),
+                Some("the scene repeats arithmetic on large lists; simplify it".into()),
+            ));
+        }
+        Ok(())
+    }
+
+    /// A list of `items`, within the budgets on nesting and on elements per value.
+    fn make_list(&self, items: Vec<Value>, span: Span) -> Result<Value, SceneError> {
+        let depth = 1 + items.iter().map(Value::depth).max().unwrap_or(0);
+        if depth > MAX_NESTING {
+            return Err(self.err(
+                span,
+                format!("nesting deeper than {MAX_NESTING} (lists inside lists, through `let` names too)"),
+                Some("flatten the lists".into()),
+            ));
+        }
+        let elements = items
+            .iter()
+            .fold(1usize, |n, v| n.saturating_add(v.elements()));
+        if elements > MAX_VALUE_ELEMENTS {
+            return Err(self.err(
+                span,
+                format!(
+                    "this value holds more than {MAX_VALUE_ELEMENTS} elements (the budget per value), counting each use of a `let` name"
+                ),
+                Some("a list of lists repeated at every level grows exponentially; flatten it".into()),
+            ));
+        }
+        Ok(Value::List(Rc::new(List {
+            items,
+            elements,
+            depth,
+        })))
+    }
+
+    fn arith(&mut self, op: Token, a: Value, b: Value) -> Result<Value, SceneError> {
         let Tok::Punct(c) = op.tok else {
             unreachable!("arith is called with an operator")
         };
+        if c == '/' && matches!(b, Value::Num(y) if y == 0.0) {
+            return Err(self.err(op.span, "division by zero", None));
+        }
+        // The result is as large as the larger operand: charge it before building.
+        self.charge(a.elements().max(b.elements()), op.span)?;
+        self.combine(c, op.span, &a, &b)
+    }
+
+    /// `a c b` elementwise; the depth of the recursion is that of the values, which
+    /// [`Parser::make_list`] bounds by [`MAX_NESTING`].
+    fn combine(&self, c: char, span: Span, a: &Value, b: &Value) -> Result<Value, SceneError> {
         let f = |x: f64, y: f64| match c {
             '+' => x + y,
             '-' => x - y,
             '*' => x * y,
             _ => x / y,
         };
-        if c == '/' && b == Value::Num(0.0) {
-            return Err(self.err(op.span, "division by zero", None));
-        }
-        match (a, b) {
-            (Value::Num(x), Value::Num(y)) => Ok(Value::Num(f(x, y))),
-            (Value::List(xs), Value::List(ys)) if "+-".contains(c) && xs.len() == ys.len() => {
-                xs.into_iter()
-                    .zip(ys)
-                    .map(|(x, y)| self.arith(op.clone(), x, y))
-                    .collect::<Result<_, _>>()
-                    .map(Value::List)
+        let items: Result<Vec<Value>, SceneError> = match (a, b) {
+            (Value::Num(x), Value::Num(y)) => return Ok(Value::Num(f(*x, *y))),
+            (Value::List(xs), Value::List(ys)) if "+-".contains(c) && xs.len() == ys.len() => xs
+                .iter()
+                .zip(ys.iter())
+                .map(|(x, y)| self.combine(c, span, x, y))
+                .collect(),
+            (Value::List(xs), Value::Num(_)) if "*/".contains(c) => {
+                xs.iter().map(|x| self.combine(c, span, x, b)).collect()
             }
-            (Value::List(xs), Value::Num(y)) if "*/".contains(c) => xs
-                .into_iter()
-                .map(|x| self.arith(op.clone(), x, Value::Num(y)))
-                .collect::<Result<_, _>>()
-                .map(Value::List),
-            (Value::Num(x), Value::List(ys)) if c == '*' => ys
-                .into_iter()
-                .map(|y| self.arith(op.clone(), Value::Num(x), y))
-                .collect::<Result<_, _>>()
-                .map(Value::List),
+            (Value::Num(_), Value::List(ys)) if c == '*' => {
+                ys.iter().map(|y| self.combine(c, span, a, y)).collect()
+            }
             _ => Err(self.err(
-                op.span,
+                span,
                 format!("`{c}` cannot combine these values"),
                 Some(
                     "lists of equal length add and subtract; a list multiplies or divides by a number"
                         .into(),
                 ),
             )),
-        }
+        };
+        self.make_list(items?, span)
     }
 
     // ------------------------------------------------------------ the space

@@ -128,6 +128,13 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
         )));
     }
     let voxel_size = scale / max_dim as f64;
+    // A subnormal size (or one that underflows to 0) cannot be written back or used
+    // to place anything: it would make a `.tess` with voxel size 0.
+    if !voxel_size.is_normal() {
+        return Err(FormatError::corrupt(
+            format!("scale {scale:e} over {max_dim} voxels gives a voxel size of {voxel_size:e}, too small to represent"),
+        ));
+    }
     // Move a whole number of voxels of translate into the integer coordinates.
     let mut shift = [0i64; 3];
     let mut rest = translate;

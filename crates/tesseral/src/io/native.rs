@@ -252,7 +252,7 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
             tail.f64().map_err(&bad)?,
             tail.f64().map_err(&bad)?,
         ];
-        if !(voxel_size.is_finite() && voxel_size > 0.0) || translate.iter().any(|t| !t.is_finite())
+        if !(voxel_size.is_normal() && voxel_size > 0.0) || translate.iter().any(|t| !t.is_finite())
         {
             return Err(bad(format!("frame: voxel size {voxel_size} or translate {translate:?} is not finite and positive")));
         }

@@ -215,43 +215,24 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
         }
     };
     if models.len() > 1 && nodes.contains_key(&0) {
-        let mut stack = vec![(0i32, [0i64; 3], 0u32)];
-        let mut visits = 0usize;
-        while let Some((id, t, depth)) = stack.pop() {
-            visits += 1;
-            if depth > 64 || visits > 1 << 20 {
-                return Err(bad("scene graph is cyclic or too deep".into()));
-            }
-            match nodes.get(&id) {
-                Some(Node::Transform { t: dt, child }) => {
-                    stack.push((
-                        *child,
-                        [t[0] + dt[0], t[1] + dt[1], t[2] + dt[2]],
-                        depth + 1,
-                    ));
-                }
-                Some(Node::Group(kids)) => {
-                    stack.extend(kids.iter().map(|&k| (k, t, depth + 1)));
-                }
-                Some(Node::Shape(ids)) => {
-                    for &m in ids {
-                        let model = usize::try_from(m)
-                            .ok()
-                            .and_then(|m| models.get(m))
-                            .ok_or_else(|| {
-                                bad(format!("shape names model {m}, which does not exist"))
-                            })?;
-                        let s = model.size;
-                        place(model, [t[0] - s[0] / 2, t[1] - s[1] / 2, t[2] - s[2] / 2]);
-                    }
-                }
-                None => {
-                    return Err(bad(format!(
-                        "scene graph names node {id}, which does not exist"
-                    )))
-                }
-            }
+        // Every placement counts against the dense-voxel cap before any is expanded:
+        // a small scene graph can place one model many times.
+        let mut placed_voxels = 0u64;
+        walk_graph(&nodes, &models, &mut |m, _| {
+            placed_voxels += m.voxels.len() as u64;
+            placed_voxels <= MAX_DENSE_VOXELS
+        })
+        .map_err(&bad)?;
+        if placed_voxels > MAX_DENSE_VOXELS {
+            return Err(FormatError::too_large(format!(
+                "the scene graph places more than {MAX_DENSE_VOXELS} voxels"
+            )));
         }
+        walk_graph(&nodes, &models, &mut |m, offset| {
+            place(m, offset);
+            true
+        })
+        .map_err(&bad)?;
     } else {
         for m in &models {
             place(m, [0, 0, 0]);
@@ -291,6 +272,49 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
         colors: Some(colors),
         ..Model::new(tree)
     })
+}
+
+/// Visits every placement of a model by the scene graph from node 0, with the
+/// model's lowest corner, until `visit` returns false.
+fn walk_graph(
+    nodes: &HashMap<i32, Node>,
+    models: &[VoxModel],
+    visit: &mut dyn FnMut(&VoxModel, Voxel) -> bool,
+) -> Result<(), String> {
+    let mut stack = vec![(0i32, [0i64; 3], 0u32)];
+    let mut visits = 0usize;
+    while let Some((id, t, depth)) = stack.pop() {
+        visits += 1;
+        if depth > 64 || visits > 1 << 20 {
+            return Err("scene graph is cyclic or too deep".into());
+        }
+        match nodes.get(&id) {
+            Some(Node::Transform { t: dt, child }) => {
+                stack.push((
+                    *child,
+                    [t[0] + dt[0], t[1] + dt[1], t[2] + dt[2]],
+                    depth + 1,
+                ));
+            }
+            Some(Node::Group(kids)) => {
+                stack.extend(kids.iter().map(|&k| (k, t, depth + 1)));
+            }
+            Some(Node::Shape(ids)) => {
+                for &m in ids {
+                    let model = usize::try_from(m)
+                        .ok()
+                        .and_then(|m| models.get(m))
+                        .ok_or_else(|| format!("shape names model {m}, which does not exist"))?;
+                    let s = model.size;
+                    if !visit(model, [t[0] - s[0] / 2, t[1] - s[1] / 2, t[2] - s[2] / 2]) {
+                        return Ok(());
+                    }
+                }
+            }
+            None => return Err(format!("scene graph names node {id}, which does not exist")),
+        }
+    }
+    Ok(())
 }
 
 fn chunk_header(r: &mut Reader<'_>) -> Result<([u8; 4], usize, usize), String> {

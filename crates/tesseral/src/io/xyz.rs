@@ -2,7 +2,7 @@
 //! coordinates (negative allowed), with `#` comments and blank lines. A `.xyz` we write
 //! lists exactly the black voxels, in tesseral order, after a comment header.
 
-use std::io::{self, BufRead, Write};
+use std::io::{self, BufRead, Read, Write};
 use std::path::Path;
 
 use super::FormatError;
@@ -20,14 +20,38 @@ pub fn read(path: &Path) -> Result<LinearOctree, FormatError> {
     LinearOctree::from_voxels_fitted(&voxels).map_err(|e| attach(FormatError::Octree(e)))
 }
 
+/// The most voxels an `.xyz` file may list (24 bytes each in memory, 800 MB at the
+/// cap); larger sets belong in a `.tess` file.
+pub const MAX_XYZ_VOXELS: usize = 1 << 25;
+/// The longest line, in bytes: a file with no newlines is not buffered whole.
+pub const MAX_XYZ_LINE: usize = 4096;
+
 /// Parses `.xyz` text.
 ///
 /// # Errors
-/// [`FormatError::Syntax`] for a malformed line, [`FormatError::Io`] if reading fails.
-pub fn parse(reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
+/// [`FormatError::Syntax`] for a malformed or overlong line, [`FormatError::Io`] if
+/// reading fails, [`FormatError::TooLarge`] past [`MAX_XYZ_VOXELS`] voxels.
+pub fn parse(mut reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
     let mut voxels = Vec::new();
-    for (index, line) in reader.lines().enumerate() {
-        let line = line.map_err(FormatError::Io)?;
+    let mut buf = Vec::new();
+    for index in 0usize.. {
+        buf.clear();
+        let n = Read::take(&mut reader, MAX_XYZ_LINE as u64 + 1)
+            .read_until(b'\n', &mut buf)
+            .map_err(FormatError::Io)?;
+        if n == 0 {
+            break;
+        }
+        if buf.last() == Some(&b'\n') {
+            buf.pop();
+        } else if buf.len() > MAX_XYZ_LINE {
+            return Err(FormatError::Syntax {
+                line: index + 1,
+                column: MAX_XYZ_LINE + 1,
+                message: format!("line longer than {MAX_XYZ_LINE} bytes"),
+            });
+        }
+        let line = String::from_utf8_lossy(&buf);
         let syntax = |column: usize, message: String| FormatError::Syntax {
             line: index + 1,
             column,
@@ -61,6 +85,12 @@ pub fn parse(reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
             v[a] = text
                 .parse()
                 .map_err(|_| syntax(column, format!("`{text}` is not an integer coordinate")))?;
+        }
+        if voxels.len() == MAX_XYZ_VOXELS {
+            return Err(FormatError::too_large(format!(
+                "more than {MAX_XYZ_VOXELS} voxels (line {}); store large sets as .tess",
+                index + 1
+            )));
         }
         voxels.push(v);
     }

@@ -2,7 +2,7 @@
 
 use rayon::prelude::*;
 
-use super::{check_depth, push_merging, Leaf, LinearOctree, OctreeError};
+use super::{check_space, push_merging, Leaf, LinearOctree, OctreeError};
 use crate::Voxel;
 
 /// How a cell relates to a solid.
@@ -70,7 +70,7 @@ impl LinearOctree {
         origin: Voxel,
         classifier: &impl Classifier,
     ) -> Result<Self, OctreeError> {
-        check_depth(depth)?;
+        check_space(depth, origin)?;
         let space = Self::from_parts(depth, origin, Vec::new());
         let mut leaves = Vec::new();
         build_cell(&space, classifier, 0, depth, &mut leaves);

@@ -38,6 +38,17 @@ pub enum OctreeError {
     /// A coordinate or origin left the range of `i64`.
     #[error("a coordinate overflows the 64-bit integer range")]
     Overflow,
+    /// The space `[origin, origin + 2^depth)` runs past the range of `i64`.
+    #[error(
+        "the space of side 2^{depth} from origin ({}, {}, {}) runs past the range of 64-bit coordinates",
+        .origin[0], .origin[1], .origin[2]
+    )]
+    SpaceOverflow {
+        /// The depth.
+        depth: u8,
+        /// The origin.
+        origin: Voxel,
+    },
     /// A dense bit array is shorter than its dimensions say.
     #[error("a dense array of {dims:?} voxels needs {needed} words of 64 bits, got {got}")]
     DenseTooShort {
@@ -73,7 +84,7 @@ impl LinearOctree {
     /// # Errors
     /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
     pub fn empty(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
-        check_depth(depth)?;
+        check_space(depth, origin)?;
         Ok(Self {
             depth,
             origin,
@@ -86,7 +97,7 @@ impl LinearOctree {
     /// # Errors
     /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
     pub fn full(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
-        check_depth(depth)?;
+        check_space(depth, origin)?;
         Ok(Self {
             depth,
             origin,
@@ -110,7 +121,7 @@ impl LinearOctree {
         origin: Voxel,
         leaves: impl IntoIterator<Item = Leaf>,
     ) -> Result<Self, OctreeError> {
-        check_depth(depth)?;
+        check_space(depth, origin)?;
         let mut merged = Vec::new();
         for leaf in leaves {
             push_merging(&mut merged, leaf);
@@ -136,7 +147,7 @@ impl LinearOctree {
         origin: Voxel,
         voxels: impl IntoIterator<Item = Voxel>,
     ) -> Result<Self, OctreeError> {
-        check_depth(depth)?;
+        check_space(depth, origin)?;
         let space = Self {
             depth,
             origin,
@@ -170,7 +181,13 @@ impl LinearOctree {
         let extent = (0..3).map(|a| hi[a].abs_diff(lo[a]) + 1).max().unwrap_or(1);
         let depth = extent.next_power_of_two().trailing_zeros();
         let depth = u8::try_from(depth).unwrap_or(u8::MAX);
-        Self::from_voxels(depth, lo, voxels.iter().copied())
+        if depth > MAX_DEPTH {
+            return Err(OctreeError::DepthTooLarge(depth));
+        }
+        // Near the top of i64 the space starts lower, so that it ends inside i64.
+        let last = (1i64 << depth) - 1;
+        let origin = lo.map(|c| c.min(i64::MAX - last));
+        Self::from_voxels(depth, origin, voxels.iter().copied())
     }
 
     /// The tree's depth D: it spans `2^D` voxels per axis.
@@ -319,6 +336,11 @@ impl LinearOctree {
             "depth {} > {MAX_DEPTH}",
             self.depth
         );
+        assert!(
+            check_space(self.depth, self.origin).is_ok(),
+            "the space from {:?} runs past i64",
+            self.origin
+        );
         let space_end = 1u64 << (3 * u32::from(self.depth));
         for (i, l) in self.leaves.iter().enumerate() {
             assert!(
@@ -359,9 +381,15 @@ impl LinearOctree {
     }
 }
 
-fn check_depth(depth: u8) -> Result<(), OctreeError> {
+/// Checks the depth, and that the space `[origin, origin + 2^depth)` lies inside
+/// `i64` on every axis (so no voxel of the tree wraps).
+fn check_space(depth: u8, origin: Voxel) -> Result<(), OctreeError> {
     if depth > MAX_DEPTH {
         return Err(OctreeError::DepthTooLarge(depth));
+    }
+    let last = (1i64 << depth) - 1;
+    if origin.iter().any(|o| o.checked_add(last).is_none()) {
+        return Err(OctreeError::SpaceOverflow { depth, origin });
     }
     Ok(())
 }

@@ -461,7 +461,7 @@ impl LinearOctree {
     /// assert!(b.contains([3, 3, 3]));
     /// ```
     pub fn resample(&self, depth: u8, origin: Voxel) -> Result<(Self, u64), OctreeError> {
-        super::check_depth(depth)?;
+        super::check_space(depth, origin)?;
         if depth == self.depth && origin == self.origin {
             return Ok((self.clone(), 0));
         }

@@ -303,11 +303,11 @@ impl LinearOctree {
         dims: [u32; 3],
         bits: &[u64],
     ) -> Result<Self, OctreeError> {
-        super::check_depth(depth)?;
+        super::check_space(depth, origin)?;
         let side = 1u64 << depth;
         if let Some(a) = (0..3).find(|&a| u64::from(dims[a]) > side) {
             let mut v = origin;
-            v[a] += side as i64;
+            v[a] = v[a].saturating_add(side as i64);
             return Err(OctreeError::OutOfBounds(v));
         }
         let total = dims.iter().map(|&d| d as usize).product::<usize>();

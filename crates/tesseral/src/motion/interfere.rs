@@ -49,8 +49,8 @@ impl Placement {
     /// The world box `w` seen in the placed tree's own coordinates (the inverse map).
     #[inline]
     pub(crate) fn unplace_box(&self, w: &IBox) -> IBox {
-        let lo = [0, 1, 2].map(|a| w.lo[a] - self.offset[a]);
-        let hi = [0, 1, 2].map(|a| w.hi[a] - self.offset[a]);
+        let lo = [0, 1, 2].map(|a| w.lo[a] - i128::from(self.offset[a]));
+        let hi = [0, 1, 2].map(|a| w.hi[a] - i128::from(self.offset[a]));
         if self.rotation.is_identity() {
             return IBox { lo, hi };
         }
@@ -63,14 +63,14 @@ impl Placement {
     pub(crate) fn place_box(&self, b: &IBox) -> IBox {
         if self.rotation.is_identity() {
             return IBox {
-                lo: [0, 1, 2].map(|a| b.lo[a] + self.offset[a]),
-                hi: [0, 1, 2].map(|a| b.hi[a] + self.offset[a]),
+                lo: [0, 1, 2].map(|a| b.lo[a] + i128::from(self.offset[a])),
+                hi: [0, 1, 2].map(|a| b.hi[a] + i128::from(self.offset[a])),
             };
         }
         let (lo, hi) = self.rotation.apply_box(b.lo, b.hi);
         IBox {
-            lo: [0, 1, 2].map(|a| lo[a] + self.offset[a]),
-            hi: [0, 1, 2].map(|a| hi[a] + self.offset[a]),
+            lo: [0, 1, 2].map(|a| lo[a] + i128::from(self.offset[a])),
+            hi: [0, 1, 2].map(|a| hi[a] + i128::from(self.offset[a])),
         }
     }
 }
@@ -138,11 +138,43 @@ impl Aabb {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[doc(hidden)]
 pub struct IBox {
-    pub lo: Voxel,
-    pub hi: Voxel,
+    pub lo: Wide,
+    pub hi: Wide,
+}
+
+/// A point of a box in 128-bit coordinates: a box of `i64` voxels ends one past
+/// `i64::MAX`, and the gap between boxes at opposite ends of `i64` is 2^64.
+#[doc(hidden)]
+pub type Wide = [i128; 3];
+
+/// `v` widened to [`Wide`].
+#[doc(hidden)]
+#[inline]
+#[must_use]
+pub fn wide(v: Voxel) -> Wide {
+    v.map(i128::from)
+}
+
+/// `v` clamped into `i64`: for coordinates known to lie in a tree's space.
+#[doc(hidden)]
+#[inline]
+#[must_use]
+pub fn narrow(v: i128) -> i64 {
+    v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64
 }
 
 impl IBox {
+    /// The cube of side `side` from `min`.
+    #[inline]
+    #[must_use]
+    pub fn cube(min: Voxel, side: i64) -> IBox {
+        let lo = wide(min);
+        IBox {
+            lo,
+            hi: lo.map(|c| c + i128::from(side)),
+        }
+    }
+
     #[inline]
     pub fn overlaps(&self, o: &IBox) -> bool {
         (0..3).all(|a| self.lo[a] < o.hi[a] && o.lo[a] < self.hi[a])
@@ -166,26 +198,69 @@ impl IBox {
     #[inline]
     pub fn volume(&self) -> u64 {
         (0..3)
-            .map(|a| (self.hi[a] - self.lo[a]).max(0) as u64)
-            .product()
+            .map(|a| u64::try_from((self.hi[a] - self.lo[a]).max(0)).unwrap_or(u64::MAX))
+            .fold(1u64, u64::saturating_mul)
     }
 
-    /// The squared Euclidean gap between the two closed boxes.
+    /// The squared Euclidean gap between the two closed boxes, exactly: each axis's
+    /// gap is below 2^64, so the sum of three squares needs a little over 128 bits.
     #[inline]
-    pub fn gap2(&self, o: &IBox) -> u128 {
-        let mut d = 0u128;
+    pub fn gap2(&self, o: &IBox) -> Gap2 {
+        let mut d = Gap2::default();
         for a in 0..3 {
-            let g = (o.lo[a] - self.hi[a]).max(self.lo[a] - o.hi[a]).max(0);
-            d += (g as u128) * (g as u128);
+            let g = (o.lo[a] - self.hi[a]).max(self.lo[a] - o.hi[a]).max(0) as u128;
+            d = d.plus(g * g);
         }
         d
     }
 
+    /// The box's voxels; only for boxes inside a tree's space, which fits `i64`.
     pub fn aabb(&self) -> Aabb {
         Aabb {
-            min: self.lo,
-            max: [self.hi[0] - 1, self.hi[1] - 1, self.hi[2] - 1],
+            min: self.lo.map(narrow),
+            max: self.hi.map(|c| narrow(c - 1)),
         }
+    }
+}
+
+/// A squared distance between boxes: `carry · 2^128 + low`, ordered as the number.
+#[doc(hidden)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, PartialOrd, Ord)]
+pub struct Gap2 {
+    carry: u8,
+    low: u128,
+}
+
+impl Gap2 {
+    /// The largest value, above every real gap.
+    pub const MAX: Gap2 = Gap2 {
+        carry: u8::MAX,
+        low: u128::MAX,
+    };
+
+    #[inline]
+    fn plus(self, x: u128) -> Gap2 {
+        let (low, over) = self.low.overflowing_add(x);
+        Gap2 {
+            carry: self.carry + u8::from(over),
+            low,
+        }
+    }
+
+    /// The value, saturated at `u128::MAX` (reached only by gaps beyond 1.8·10^19).
+    #[must_use]
+    pub fn saturated(self) -> u128 {
+        if self.carry > 0 {
+            u128::MAX
+        } else {
+            self.low
+        }
+    }
+
+    /// The square root of the value, as `f64`.
+    #[must_use]
+    pub fn sqrt(self) -> f64 {
+        (f64::from(self.carry) * 2f64.powi(128) + self.low as f64).sqrt()
     }
 }
 
@@ -434,7 +509,7 @@ pub fn clearance<A: Traversable + ?Sized, B: Traversable + ?Sized>(
     b: &B,
     place: Placement,
 ) -> Option<f64> {
-    clearance_squared(Placed::fixed(a), Placed::new(b, place)).map(|d| (d as f64).sqrt())
+    clearance_gap2(Placed::fixed(a), Placed::new(b, place)).map(Gap2::sqrt)
 }
 
 /// The squared clearance of two placed trees, exactly, or `None` when either is empty.
@@ -443,12 +518,20 @@ pub fn clearance_squared<A: Traversable + ?Sized, B: Traversable + ?Sized>(
     a: Placed<'_, A>,
     b: Placed<'_, B>,
 ) -> Option<u128> {
+    clearance_gap2(a, b).map(Gap2::saturated)
+}
+
+/// The squared clearance, exactly, past `u128` (trees at opposite ends of `i64`).
+fn clearance_gap2<A: Traversable + ?Sized, B: Traversable + ?Sized>(
+    a: Placed<'_, A>,
+    b: Placed<'_, B>,
+) -> Option<Gap2> {
     let ra = a.tree.root_node()?;
     let rb = b.tree.root_node()?;
     let mut c = Clearance {
         a,
         b,
-        best: u128::MAX,
+        best: Gap2::MAX,
     };
     c.visit(ra, rb);
     Some(c.best)
@@ -457,7 +540,7 @@ pub fn clearance_squared<A: Traversable + ?Sized, B: Traversable + ?Sized>(
 struct Clearance<'t, A: Traversable + ?Sized, B: Traversable + ?Sized> {
     a: Placed<'t, A>,
     b: Placed<'t, B>,
-    best: u128,
+    best: Gap2,
 }
 
 impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Clearance<'_, A, B> {
@@ -474,7 +557,7 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Clearance<'_, A, B> {
             self.best = d;
             return;
         }
-        let mut order = [(0u128, 0usize); 8];
+        let mut order = [(Gap2::default(), 0usize); 8];
         if !fa && (fb || self.a.tree.node_size(&na) >= self.b.tree.node_size(&nb)) {
             let mut kids = [na; 8];
             let n = self.a.tree.node_children(&na, &mut kids);

@@ -21,6 +21,7 @@ mod interfere;
 mod orient;
 mod plan;
 mod plan_estimate;
+mod simulate;
 mod sweep;
 mod traverse;
 mod view;
@@ -40,6 +41,7 @@ pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
 pub use plan_estimate::{estimate_plan, PlanEstimate, PLAN_BYTES_PER_CELL};
+pub use simulate::Step;
 #[cfg(test)]
 use sweep::first_contact_brute;
 pub use sweep::{first_contact, Fraction, SweptContact};
@@ -47,7 +49,9 @@ pub use view::{BoxTree, Traversable};
 pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
 };
-pub use world_file::{read_solid, read_world, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS};
+pub use world_file::{
+    read_solid, read_world, read_world_limited, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS,
+};
 
 #[cfg(test)]
 mod tests;

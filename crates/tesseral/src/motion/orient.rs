@@ -5,6 +5,7 @@
 use std::fmt;
 use std::str::FromStr;
 
+use super::interfere::Wide;
 use crate::linear::Block;
 use crate::Voxel;
 
@@ -191,7 +192,7 @@ impl Rotation {
     /// Maps the half-open box `[lo, hi)` of voxels (each cube mapped as by
     /// [`Rotation::apply_cube`]); returns the new `(lo, hi)`.
     #[inline]
-    pub(crate) fn apply_box(self, lo: Voxel, hi: Voxel) -> (Voxel, Voxel) {
+    pub(crate) fn apply_box(self, lo: Wide, hi: Wide) -> (Wide, Wide) {
         let mut l = [0; 3];
         let mut h = [0; 3];
         for a in 0..3 {

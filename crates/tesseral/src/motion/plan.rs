@@ -25,7 +25,7 @@ use std::ops::ControlFlow;
 
 use serde::Serialize;
 
-use super::interfere::{clearance_at, interference, IBox, Placed, Placement};
+use super::interfere::{clearance_at, interference, narrow, wide, IBox, Placed, Placement};
 use super::orient::Rotation;
 use super::sweep::first_contact;
 use super::traverse::Node;
@@ -89,8 +89,14 @@ impl MinkowskiQuery<'_> {
     fn visit(&mut self, na: Node, nb: Node) -> ControlFlow<()> {
         // Points a + b with a in [a.lo, a.hi) and b in [b.lo, b.hi): [a.lo + b.lo, a.hi + b.hi - 1).
         let s = IBox {
-            lo: [0, 1, 2].map(|i| na.min[i] + nb.min[i]),
-            hi: [0, 1, 2].map(|i| na.min[i] + nb.min[i] + na.side() + nb.side() - 1),
+            lo: [0, 1, 2].map(|i| i128::from(na.min[i]) + i128::from(nb.min[i])),
+            hi: [0, 1, 2].map(|i| {
+                i128::from(na.min[i])
+                    + i128::from(nb.min[i])
+                    + i128::from(na.side())
+                    + i128::from(nb.side())
+                    - 1
+            }),
         };
         if !s.overlaps(&self.p) {
             return ControlFlow::Continue(());
@@ -136,10 +142,7 @@ impl Classifier for MinkowskiClassifier<'_> {
         let mut q = MinkowskiQuery {
             a: self.a.leaves(),
             b: self.b.leaves(),
-            p: IBox {
-                lo: min,
-                hi: min.map(|c| c + side),
-            },
+            p: IBox::cube(min, side),
             partial: false,
         };
         match q.visit(ra, rb) {
@@ -344,10 +347,7 @@ struct FreeClassifier<'t> {
 impl Classifier for FreeClassifier<'_> {
     fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
         let side = 1i64 << size_log2;
-        let p = IBox {
-            lo: min,
-            hi: min.map(|c| c + side),
-        };
+        let p = IBox::cube(min, side);
         if !p.overlaps(&self.bounds) {
             return CellClass::Outside;
         }
@@ -385,10 +385,7 @@ impl FreeSpace {
 
     fn ibox(&self, i: usize) -> IBox {
         let b = self.cells[i];
-        IBox {
-            lo: b.min,
-            hi: b.min.map(|c| c + b.size()),
-        }
+        IBox::cube(b.min, b.size())
     }
 
     /// Free cells meeting the box `q`.
@@ -399,10 +396,7 @@ impl FreeSpace {
     }
 
     fn cells_in_node(&self, n: Node, q: &IBox, out: &mut Vec<usize>) {
-        let b = IBox {
-            lo: n.min,
-            hi: n.min.map(|c| c + n.side()),
-        };
+        let b = IBox::cube(n.min, n.side());
         if !b.overlaps(q) {
             return;
         }
@@ -521,8 +515,8 @@ pub fn plan(
         &FreeClassifier {
             cobs: &cobs,
             bounds: IBox {
-                lo: bounds.min,
-                hi: bounds.max.map(|c| c + 1),
+                lo: wide(bounds.min),
+                hi: wide(bounds.max).map(|c| c + 1),
             },
         },
     )?;
@@ -690,11 +684,11 @@ fn astar(
             let mut q = p;
             for b in 0..3 {
                 if b == a {
-                    q[b] = if up { there.lo[b] } else { there.hi[b] - 1 };
+                    q[b] = narrow(if up { there.lo[b] } else { there.hi[b] - 1 });
                 } else {
                     let lo = here.lo[b].max(there.lo[b]);
                     let hi = here.hi[b].min(there.hi[b]) - 1;
-                    q[b] = p[b].clamp(lo, hi);
+                    q[b] = narrow(i128::from(p[b]).clamp(lo, hi));
                 }
             }
             let ng = g[s] + l1(p, q);

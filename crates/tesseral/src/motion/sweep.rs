@@ -117,7 +117,9 @@ fn slab_interval(a: &IBox, b: &IBox, v: Voxel) -> Option<(Option<Fraction>, Opti
     let mut hi: Option<Fraction> = None;
     for (ax, &s) in v.iter().enumerate() {
         // Overlap on this axis: b.lo + t v < a.hi and a.lo < b.hi + t v.
-        let (p, q) = (a.hi[ax] - b.lo[ax], a.lo[ax] - b.hi[ax]); // t v < p, t v > q
+        // Clamped to ±i64::MAX: |p| beyond it exceeds |s|, a time past the motion's end.
+        let fit = |x: i128| x.clamp(-i128::from(i64::MAX), i128::from(i64::MAX)) as i64;
+        let (p, q) = (fit(a.hi[ax] - b.lo[ax]), fit(a.lo[ax] - b.hi[ax])); // t v < p, t v > q
         let (l, h) = match s.cmp(&0) {
             Ordering::Equal => {
                 if q < 0 && 0 < p {
@@ -263,10 +265,7 @@ impl<A: Traversable + ?Sized, B: Traversable + ?Sized> Sweep<'_, A, B> {
 /// (for tests: obviously right, quadratic).
 #[cfg(test)]
 pub(crate) fn first_contact_brute(a: &[Voxel], b: &[Voxel], v: Voxel) -> Option<Fraction> {
-    let unit = |p: Voxel| IBox {
-        lo: p,
-        hi: [p[0] + 1, p[1] + 1, p[2] + 1],
-    };
+    let unit = |p: Voxel| IBox::cube(p, 1);
     a.iter()
         .flat_map(|&p| {
             b.iter()

@@ -141,10 +141,7 @@ impl Traversable for LinearOctree {
     #[inline]
     fn node_box(&self, n: &Node) -> IBox {
         let s = n.side();
-        IBox {
-            lo: n.min,
-            hi: [n.min[0] + s, n.min[1] + s, n.min[2] + s],
-        }
+        IBox::cube(n.min, s)
     }
 
     #[inline]
@@ -360,8 +357,8 @@ impl Traversable for BoxTree {
         let b = &self.nodes[n.0 as usize];
         let o = self.origin;
         IBox {
-            lo: [0, 1, 2].map(|a| o[a] + i64::from(b.lo[a])),
-            hi: [0, 1, 2].map(|a| o[a] + i64::from(b.hi[a])),
+            lo: [0, 1, 2].map(|a| i128::from(o[a]) + i128::from(b.lo[a])),
+            hi: [0, 1, 2].map(|a| i128::from(o[a]) + i128::from(b.hi[a])),
         }
     }
 
@@ -395,9 +392,9 @@ impl Traversable for BoxTree {
         let b = &self.nodes[n.0 as usize];
         let o = self.origin;
         // The query relative to the origin, clamped into i32 (the nodes' range).
-        let clamp = |v: i64| v.clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32;
-        let lo = [0, 1, 2].map(|a| clamp(q.lo[a] - o[a]));
-        let hi = [0, 1, 2].map(|a| clamp(q.hi[a] - o[a]));
+        let clamp = |v: i128| v.clamp(i128::from(i32::MIN), i128::from(i32::MAX)) as i32;
+        let lo = [0, 1, 2].map(|a| clamp(q.lo[a] - i128::from(o[a])));
+        let hi = [0, 1, 2].map(|a| clamp(q.hi[a] - i128::from(o[a])));
         let first = b.first as usize;
         let mut m = 0;
         for (i, c) in self.nodes[first..first + usize::from(b.count)]

@@ -10,15 +10,15 @@
 //! time at which a pair begins to overlap, so a fast object cannot tunnel through a
 //! thin wall unseen.
 
+use std::ops::ControlFlow;
+
 use serde::Serialize;
 
-use super::interfere::{interference_placed, Aabb, Placed, Placement};
+use super::interfere::{Aabb, Placed, Placement};
 use super::orient::Rotation;
-use super::plan::rotated;
-use super::sweep::{first_contact, Fraction};
+use super::sweep::Fraction;
 use super::view::BoxTree;
 use crate::linear::{LinearOctree, OctreeError};
-use crate::pointer::PointerOctree;
 use crate::Voxel;
 
 /// How an object moves: its position (the offset added to its octree's voxels after
@@ -95,15 +95,15 @@ pub enum TranslationMethod {
 }
 
 impl TranslationMethod {
-    fn keeps_trees(self) -> bool {
+    pub(super) fn keeps_trees(self) -> bool {
         self != TranslationMethod::Offset
     }
 }
 
 /// The bodies of a world prepared for queries.
-struct Prepared {
-    environment: BoxTree,
-    objects: Vec<BoxTree>,
+pub(super) struct Prepared {
+    pub(super) environment: BoxTree,
+    pub(super) objects: Vec<BoxTree>,
 }
 
 /// One moving object.
@@ -204,7 +204,7 @@ impl World {
         }
     }
 
-    fn body(&self, i: Option<usize>) -> Body {
+    pub(super) fn body(&self, i: Option<usize>) -> Body {
         match i {
             None => Body::Environment,
             Some(index) => Body::Object {
@@ -216,7 +216,7 @@ impl World {
 
     /// Body `i` (`None`: the environment) where it stands at `offsets`; `boxes` holds
     /// the prepared environment and objects.
-    fn placed<'s>(
+    pub(super) fn placed<'s>(
         &self,
         boxes: &'s Prepared,
         i: Option<usize>,
@@ -236,7 +236,7 @@ impl World {
     }
 
     /// The pairs that can collide: environment–object, then object–object.
-    fn pairs(&self) -> Vec<(Option<usize>, usize)> {
+    pub(super) fn pairs(&self) -> Vec<(Option<usize>, usize)> {
         let n = self.objects.len();
         let mut pairs: Vec<(Option<usize>, usize)> = (0..n).map(|i| (None, i)).collect();
         for i in 0..n {
@@ -248,168 +248,25 @@ impl World {
     }
 
     /// Advances the world `steps` times by `time_step`, from time 0, testing every
-    /// pair for interference at each step and with the swept test between steps.
-    ///
-    /// A contact is reported when a pair that does not overlap at the start of a step
-    /// begins to overlap during the move to the next step (or at step 0 when it
-    /// overlaps from the start). The contact time is exact for the linear move
-    /// between the two rounded step positions.
+    /// pair for interference at each step and with the swept test between steps, and
+    /// keeps every frame and contact (see [`World::simulate_each`], which streams them
+    /// instead).
     ///
     /// # Runtime
-    /// `steps × pairs` interference and swept traversals, plus, with
-    /// [`TranslationMethod::Linear`] or [`TranslationMethod::Labels`], one translation
-    /// of each object's tree per step.
+    /// As [`World::simulate_each`]; the memory holds every frame's overlap boxes.
     ///
     /// # Errors
-    /// Only when trees are kept current: [`OctreeError`] when a translated tree
-    /// would outgrow [`crate::linear::MAX_DEPTH`] or its coordinates overflow.
+    /// As [`World::simulate_each`].
     pub fn simulate(&self, time_step: f64, steps: u64) -> Result<Simulation, OctreeError> {
-        let pairs = self.pairs();
-        let offsets_at = |n: u64| -> Vec<Voxel> {
-            let t = n as f64 * time_step;
-            self.objects
-                .iter()
-                .map(|o| o.trajectory.offset_at(t))
-                .collect()
+        let mut sim = Simulation {
+            contacts: Vec::new(),
+            frames: Vec::new(),
         };
-        let mut contacts = Vec::new();
-        let mut frames = Vec::new();
-        let mut offsets = offsets_at(0);
-        let mut current: Vec<LinearOctree> = Vec::new();
-        let mut pointers: Vec<PointerOctree> = Vec::new();
-        if self.method.keeps_trees() {
-            for (o, off) in self.objects.iter().zip(&offsets) {
-                current.push(rotated(&o.tree, o.rotation).translate(*off)?);
-            }
-        }
-        if self.method == TranslationMethod::Labels {
-            pointers = current.iter().map(PointerOctree::from_linear).collect();
-        }
-        // Each body is prepared once (the objects again after each move when their
-        // trees are kept current), so every query runs on tight boxes.
-        let mut boxes = Prepared {
-            environment: BoxTree::new(&self.environment),
-            objects: if self.method.keeps_trees() {
-                current.iter().map(BoxTree::new).collect()
-            } else {
-                self.objects.iter().map(|o| BoxTree::new(&o.tree)).collect()
-            },
-        };
-        let mut overlapping = vec![false; pairs.len()];
-        for n in 0..=steps {
-            let time = n as f64 * time_step;
-            let mut frame = Frame {
-                step: n,
-                time,
-                offsets: offsets.clone(),
-                overlaps: Vec::new(),
-                contact_boxes: Vec::new(),
-            };
-            for (p, &(i, j)) in pairs.iter().enumerate() {
-                let hit = interference_placed(
-                    self.placed(&boxes, i, &offsets),
-                    self.placed(&boxes, Some(j), &offsets),
-                    true,
-                );
-                if hit.intersects {
-                    frame.overlaps.push((i, j, hit.overlap_voxels));
-                    frame.contact_boxes.extend(hit.contacts);
-                    if n == 0 {
-                        // In contact from the start.
-                        let c = first_contact(
-                            self.placed(&boxes, i, &offsets),
-                            [0; 3],
-                            self.placed(&boxes, Some(j), &offsets),
-                            [0; 3],
-                        );
-                        if let Some(c) = c {
-                            contacts.push(Contact {
-                                time,
-                                step: 0,
-                                fraction: Fraction::ZERO,
-                                a: self.body(i),
-                                b: self.body(Some(j)),
-                                a_block: c.a_block,
-                                b_block: c.b_block,
-                                between_steps: false,
-                            });
-                        }
-                    }
-                }
-                overlapping[p] = hit.intersects;
-            }
-            frames.push(frame);
-            if n == steps {
-                break;
-            }
-            let next = offsets_at(n + 1);
-            let moves: Vec<Voxel> = (0..self.objects.len())
-                .map(|k| [0, 1, 2].map(|a| next[k][a] - offsets[k][a]))
-                .collect();
-            let mut step_contacts = Vec::new();
-            for (p, &(i, j)) in pairs.iter().enumerate() {
-                if overlapping[p] {
-                    continue;
-                }
-                let a_move = i.map_or([0; 3], |i| moves[i]);
-                let Some(c) = first_contact(
-                    self.placed(&boxes, i, &offsets),
-                    a_move,
-                    self.placed(&boxes, Some(j), &offsets),
-                    moves[j],
-                ) else {
-                    continue;
-                };
-                let still = match self.method {
-                    TranslationMethod::Offset => interference_placed(
-                        self.placed(&boxes, i, &next),
-                        self.placed(&boxes, Some(j), &next),
-                        false,
-                    ),
-                    TranslationMethod::Linear | TranslationMethod::Labels => {
-                        // The trees stand at the step's start: place them by the moves.
-                        let at = |k: Option<usize>| match k {
-                            None => Placed::fixed(&boxes.environment),
-                            Some(k) => Placed::new(&boxes.objects[k], Placement::at(moves[k])),
-                        };
-                        interference_placed(at(i), at(Some(j)), false)
-                    }
-                };
-                step_contacts.push(Contact {
-                    time: time + c.time.to_f64() * time_step,
-                    step: n,
-                    fraction: c.time,
-                    a: self.body(i),
-                    b: self.body(Some(j)),
-                    a_block: c.a_block,
-                    b_block: c.b_block,
-                    between_steps: !still.intersects,
-                });
-            }
-            step_contacts.sort_by_key(|x| x.fraction);
-            contacts.extend(step_contacts);
-            match self.method {
-                TranslationMethod::Offset => {}
-                TranslationMethod::Linear => {
-                    for (k, mv) in moves.iter().enumerate() {
-                        if *mv != [0; 3] {
-                            current[k] = current[k].translate(*mv)?;
-                            boxes.objects[k] = BoxTree::new(&current[k]);
-                        }
-                    }
-                }
-                TranslationMethod::Labels => {
-                    for (k, mv) in moves.iter().enumerate() {
-                        if *mv != [0; 3] {
-                            pointers[k].translate(*mv)?;
-                            current[k] = pointers[k].to_linear();
-                            boxes.objects[k] = BoxTree::new(&current[k]);
-                        }
-                    }
-                }
-            }
-            offsets = next;
-        }
-        Ok(Simulation { contacts, frames })
+        self.simulate_each(time_step, steps, true, |step| {
+            sim.frames.push(step.frame);
+            sim.contacts.extend(step.contacts);
+            ControlFlow::Continue(())
+        })?;
+        Ok(sim)
     }
 }

@@ -69,6 +69,18 @@ pub enum WorldError {
     /// A scene file the world names could not be read or built.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// The environment and objects hold more leaves in total than the budget.
+    #[error(
+        "{path}: the environment and objects read so far hold {leaves} leaves, more than the budget of {budget}"
+    )]
+    TooManyLeaves {
+        /// The world file.
+        path: PathBuf,
+        /// The leaves counted when the budget was crossed.
+        leaves: u64,
+        /// The budget.
+        budget: u64,
+    },
 }
 
 #[derive(Deserialize)]
@@ -138,12 +150,35 @@ pub fn read_solid(path: &Path) -> Result<crate::linear::LinearOctree, WorldError
 /// Positions and times must stay where an `i64` offset and an `f64` time are exact.
 const MAX_COORD: f64 = (1u64 << 40) as f64;
 
-/// Reads a world file (see the module documentation for the format).
+/// Reads a world file (see the module documentation for the format), with the
+/// default budget of [`crate::csg::DEFAULT_MAX_LEAVES`] leaves over all its bodies.
+///
+/// # Errors
+/// As [`read_world_limited`].
+pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
+    read_world_limited(path, crate::csg::DEFAULT_MAX_LEAVES as u64, false)
+}
+
+/// Reads a world file, with a budget on the leaves of the environment and all the
+/// objects together (1,024 objects that each name a large octree would otherwise
+/// hold 1,024 copies of it). The total is checked after each body is read, so at
+/// most one body's leaves are read past the budget.
+///
+/// The octree paths in the file must stay inside its folder (relative, with no
+/// `..`), so that a world file from elsewhere cannot make the reader open any file
+/// of the machine (`/dev/zero`, another user's data); `allow_outside` lifts this.
+/// A symbolic link inside the folder is followed.
 ///
 /// # Errors
 /// [`WorldError`] naming the file and the line and column, or the object and field,
-/// at fault; or the octree file that could not be read.
-pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
+/// at fault; or the octree file that could not be read;
+/// [`WorldError::TooManyLeaves`] when the bodies hold more than `max_leaves`;
+/// [`WorldError::Invalid`] for a path outside the folder without `allow_outside`.
+pub fn read_world_limited(
+    path: &Path,
+    max_leaves: u64,
+    allow_outside: bool,
+) -> Result<WorldFile, WorldError> {
     let text = std::fs::read_to_string(path).map_err(|source| WorldError::Io {
         path: path.to_owned(),
         source,
@@ -184,7 +219,32 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
         }
     };
     let dir = path.parent().unwrap_or(Path::new(""));
-    let environment = read_solid(&dir.join(&spec.environment))?;
+    let inside = |field: &str, p: &str| -> Result<PathBuf, WorldError> {
+        let rel = Path::new(p);
+        let escapes = rel.components().any(|c| {
+            !matches!(
+                c,
+                std::path::Component::Normal(_) | std::path::Component::CurDir
+            )
+        });
+        if escapes && !allow_outside {
+            return Err(invalid(format!(
+                "{field} {p:?} leaves the world file's folder (an absolute path or `..`); \
+                 move the file beside the world file, or allow it with --allow-outside"
+            )));
+        }
+        Ok(dir.join(rel))
+    };
+    let environment = read_solid(&inside("environment", &spec.environment)?)?;
+    let mut leaves = environment.leaf_count() as u64;
+    let over = |leaves: u64| WorldError::TooManyLeaves {
+        path: path.to_owned(),
+        leaves,
+        budget: max_leaves,
+    };
+    if leaves > max_leaves {
+        return Err(over(leaves));
+    }
     let mut objects = Vec::with_capacity(spec.objects.len());
     for (i, o) in spec.objects.into_iter().enumerate() {
         let name = o.name.unwrap_or_else(|| format!("object{i}"));
@@ -234,7 +294,11 @@ pub fn read_world(path: &Path) -> Result<WorldFile, WorldError> {
                 Trajectory::Constant { start, velocity }
             }
         };
-        let tree = read_solid(&dir.join(&o.octree))?;
+        let tree = read_solid(&inside(&format!("object {name:?}, octree"), &o.octree)?)?;
+        leaves = leaves.saturating_add(tree.leaf_count() as u64);
+        if leaves > max_leaves {
+            return Err(over(leaves));
+        }
         objects.push(MovingObject {
             name,
             tree,

@@ -152,23 +152,20 @@ impl<L: Lattice> Chain<L> {
     /// Continues the chain saved in `cp` on `lattice` (which must be empty).
     ///
     /// # Errors
-    /// [`RsmcError::BadCheckpoint`] for another layout version or voxels that are not
-    /// bounded by one sphere.
+    /// [`RsmcError::BadCheckpoint`] naming the field, for any field that
+    /// [`Checkpoint::validate`] rejects, or a surface larger than its area cap.
     pub fn from_checkpoint(lattice: L, cp: Checkpoint) -> Result<Self, RsmcError> {
-        if cp.format != CHECKPOINT_FORMAT {
-            return Err(RsmcError::BadCheckpoint(format!(
-                "format {} (this program reads {CHECKPOINT_FORMAT})",
-                cp.format
-            )));
+        cp.validate()?;
+        let chain = Self::build(lattice, cp.params, cp.seed, cp.rng, cp.counters, &cp.voxels)?;
+        if let Some(m) = cp.params.max_area {
+            if chain.area() > m {
+                return Err(RsmcError::BadCheckpoint(format!(
+                    "params.max_area: the surface's area {} exceeds it ({m})",
+                    chain.area()
+                )));
+            }
         }
-        cp.params.validate()?;
-        if !cp.voxels.windows(2).all(|w| w[0] < w[1]) {
-            return Err(RsmcError::BadCheckpoint(
-                "voxels are not sorted and distinct".into(),
-            ));
-        }
-        topology::check_sphere(&cp.voxels).map_err(|e| RsmcError::BadCheckpoint(e.to_string()))?;
-        Self::build(lattice, cp.params, cp.seed, cp.rng, cp.counters, &cp.voxels)
+        Ok(chain)
     }
 
     fn build(

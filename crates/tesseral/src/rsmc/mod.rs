@@ -25,6 +25,7 @@
 //! ```
 
 mod chain;
+mod checkpoint;
 mod dense;
 pub mod enumerate;
 pub mod legality;
@@ -37,6 +38,7 @@ mod tests;
 pub mod topology;
 
 pub use chain::{Chain, Checkpoint, Counters, Params, CHECKPOINT_FORMAT};
+pub use checkpoint::MAX_CHECKPOINT_COORDINATE;
 pub use dense::{DenseLattice, MAX_CELLS};
 
 use crate::Voxel;

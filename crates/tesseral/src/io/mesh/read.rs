@@ -612,7 +612,24 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
                         for _ in 0..n as u64 {
                             let v = body.value(prop.ty)?;
                             if take {
-                                poly.push(if v >= 0.0 && v < u32::MAX as f64 {
+                                // A vertex index is a whole number from 0: `1.5` or `-2`
+                                // is an error that says so, not a face to guess at.
+                                let why = if v.fract() != 0.0 {
+                                    Some("is not a whole number")
+                                } else if v < 0.0 {
+                                    Some("is negative")
+                                } else {
+                                    None
+                                };
+                                if let Some(why) = why {
+                                    let msg = format!("face {index}: vertex index {v} {why}");
+                                    return Err(if body.format == PlyFormat::Ascii {
+                                        syntax(body.line, 1, msg)
+                                    } else {
+                                        FormatError::corrupt(format!("{msg} (byte {})", body.pos))
+                                    });
+                                }
+                                poly.push(if v < u32::MAX as f64 {
                                     v as u32
                                 } else {
                                     u32::MAX

@@ -120,8 +120,8 @@ fn parse_header(bytes: &[u8], first: &str) -> Result<Header, FormatError> {
                 let r: f64 = v
                     .parse()
                     .map_err(|_| bad(format!("res `{v}` is not a number")))?;
-                if !(r.is_finite() && r > 0.0) {
-                    return Err(bad(format!("res {r} must be finite and positive")));
+                if !(r.is_normal() && r > 0.0) {
+                    return Err(bad(format!("res {r} must be finite, positive and normal")));
                 }
                 res = Some(r);
             }
@@ -274,49 +274,52 @@ pub fn decode_ot(bytes: &[u8]) -> Result<Model, FormatError> {
     let mut coloured_voxels = 0u64;
     // Stack of (children mask, next child, code, depth).
     let mut stack: Vec<(u8, u8, u64, u8)> = Vec::with_capacity(17);
-    let mut read_node =
-        |pos: &mut usize, code: u64, depth: u8, nodes: &mut u64| -> Result<u8, FormatError> {
-            if *pos + node_len + 1 > data.len() {
-                return Err(bad(format!("data ends at byte {} inside a node", *pos)));
-            }
-            let d = &data[*pos..*pos + node_len + 1];
-            *pos += node_len + 1;
-            *nodes += 1;
-            let value = f32::from_le_bytes([d[0], d[1], d[2], d[3]]);
-            let children = d[node_len];
-            if children != 0 && depth == OCTOMAP_DEPTH {
-                return Err(bad(format!(
-                    "byte {}: a node at depth 16 claims children",
-                    *pos - 1
-                )));
-            }
-            if !value.is_finite() {
-                return Err(bad(format!(
-                    "byte {}: log-odds {value} is not finite",
-                    *pos - node_len - 1
-                )));
-            }
-            if children == 0 {
-                values.push((Leaf::new(code, OCTOMAP_DEPTH - depth), value));
-            }
-            if children == 0 && value < 0.0 {
-                free.push(Leaf::new(code, OCTOMAP_DEPTH - depth));
-            }
-            if children == 0 && value >= 0.0 {
-                let leaf = Leaf::new(code, OCTOMAP_DEPTH - depth);
-                leaves.push(leaf);
-                if color {
-                    coloured_voxels += leaf.voxel_count();
-                    if coloured_voxels > MAX_COLORED_VOXELS {
-                        return Err(FormatError::too_large(
-                            "too many coloured voxels".to_string(),
+    let mut read_node = |pos: &mut usize,
+                         code: u64,
+                         depth: u8,
+                         nodes: &mut u64|
+     -> Result<u8, FormatError> {
+        if *pos + node_len + 1 > data.len() {
+            return Err(bad(format!("data ends at byte {} inside a node", *pos)));
+        }
+        let d = &data[*pos..*pos + node_len + 1];
+        *pos += node_len + 1;
+        *nodes += 1;
+        let value = f32::from_le_bytes([d[0], d[1], d[2], d[3]]);
+        let children = d[node_len];
+        if children != 0 && depth == OCTOMAP_DEPTH {
+            return Err(bad(format!(
+                "byte {}: a node at depth 16 claims children",
+                *pos - 1
+            )));
+        }
+        if !value.is_finite() {
+            return Err(bad(format!(
+                "byte {}: log-odds {value} is not finite",
+                *pos - node_len - 1
+            )));
+        }
+        if children == 0 {
+            values.push((Leaf::new(code, OCTOMAP_DEPTH - depth), value));
+        }
+        if children == 0 && value < 0.0 {
+            free.push(Leaf::new(code, OCTOMAP_DEPTH - depth));
+        }
+        if children == 0 && value >= 0.0 {
+            let leaf = Leaf::new(code, OCTOMAP_DEPTH - depth);
+            leaves.push(leaf);
+            if color {
+                coloured_voxels += leaf.voxel_count();
+                if coloured_voxels > MAX_COLORED_VOXELS {
+                    return Err(FormatError::too_large(
+                            format!("more than {MAX_COLORED_VOXELS} coloured voxels, the budget of a colour layer"),
                         ));
-                    }
-                    leaf_colors.push((leaf, [d[4], d[5], d[6], 255]));
                 }
+                leaf_colors.push((leaf, [d[4], d[5], d[6], 255]));
             }
-            Ok(children)
-        };
+        }
+        Ok(children)
+    };
     let root = read_node(&mut pos, 0, 0, &mut nodes)?;
     stack.push((root, 0, 0, 0));
     while let Some(top) = stack.last_mut() {
