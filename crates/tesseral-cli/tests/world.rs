@@ -428,3 +428,74 @@ fn collisions_follow_the_frame_rule() {
     .unwrap();
     fails(d, &["collide", "a.tess", "c.tess"], "voxel sizes differ");
 }
+
+#[test]
+fn plans_follow_the_frame_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A wall at x = 4 with a way round it at y = 6; a one-voxel object.
+    let wall = LinearOctree::from_voxels(4, [0; 3], (0..6).map(|y| [4, y, 0])).unwrap();
+    let dot = LinearOctree::from_voxels(3, [0; 3], [[0, 0, 0]]).unwrap();
+    let env = Model::new(wall).with_frame(Frame::new(0.5, [0.0; 3]));
+    write_model(&d.join("env.tess"), &env).unwrap();
+    // The object's frame puts it 2 voxels along x from the environment's.
+    let placed = Model::new(dot.clone()).with_frame(Frame::new(0.5, [1.0, 0.0, 0.0]));
+    write_model(&d.join("obj.tess"), &placed).unwrap();
+    write_model(
+        &d.join("obj0.tess"),
+        &Model::new(dot.clone()).with_frame(Frame::new(0.5, [0.0; 3])),
+    )
+    .unwrap();
+    let plan = |obj: &str, from: &str, to: &str| {
+        json(
+            d,
+            &[
+                "plan", "env.tess", obj, "--from", from, "--to", to, "--margin", "2", "--json",
+            ],
+        )
+    };
+    let framed = plan("obj.tess", "0,0,0", "6,0,0");
+    let moved = plan("obj0.tess", "2,0,0", "8,0,0");
+    assert_eq!(framed["found"], true, "{framed}");
+    assert_eq!(framed["length"], moved["length"]);
+    let shift = |v: &serde_json::Value| -> Vec<[i64; 3]> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|w| std::array::from_fn(|a| w[a].as_i64().unwrap()))
+            .collect()
+    };
+    let got: Vec<[i64; 3]> = shift(&framed["waypoints"])
+        .into_iter()
+        .map(|w| [w[0] + 2, w[1], w[2]])
+        .collect();
+    assert_eq!(got, shift(&moved["waypoints"]));
+    // World units: each waypoint is its offset times the voxel size.
+    for (w, world) in shift(&framed["waypoints"])
+        .iter()
+        .zip(framed["waypoints_world"].as_array().unwrap())
+    {
+        for a in 0..3 {
+            assert_eq!(world[a].as_f64().unwrap(), w[a] as f64 * 0.5);
+        }
+    }
+    assert_eq!(framed["voxel_size"], 0.5);
+    write_model(
+        &d.join("fine.tess"),
+        &Model::new(dot).with_frame(Frame::new(0.25, [0.0; 3])),
+    )
+    .unwrap();
+    fails(
+        d,
+        &[
+            "plan",
+            "env.tess",
+            "fine.tess",
+            "--from",
+            "0,0,0",
+            "--to",
+            "6,0,0",
+        ],
+        "voxel sizes differ",
+    );
+}

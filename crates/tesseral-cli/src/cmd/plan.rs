@@ -5,7 +5,8 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use serde::Serialize;
-use tesseral::motion::{estimate_plan, plan, read_solid, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::model::Frame;
+use tesseral::motion::{estimate_plan, plan, render_plan, Aabb, PlanOptions, Rotation};
 use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
@@ -16,9 +17,12 @@ use super::output::{self, Size};
 /// Arguments of `tesseral plan`.
 #[derive(clap::Args)]
 pub struct Args {
-    /// The environment octree file (the obstacles).
+    /// The environment octree file or scene (the obstacles). Offsets, waypoints and
+    /// lengths are in its voxels; `--json` adds them in its frame's world units.
     env: PathBuf,
-    /// The moving object's octree file.
+    /// The moving object's octree file or scene. It starts where its frame puts it in
+    /// the environment's frame (equal voxel sizes and a whole-voxel offset, else an
+    /// error naming both), and --from/--to move it from there, as in `collide`.
     obj: PathBuf,
     /// The start: the integer offset X,Y,Z of the object.
     #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true)]
@@ -94,6 +98,12 @@ struct Found<'a> {
     clearance: Option<f64>,
     free_cells: usize,
     settled: usize,
+    /// The environment's voxel size and the world translation of each waypoint
+    /// (the object's displacement, in world units).
+    voxel_size: f64,
+    waypoints_world: Vec<[f64; 3]>,
+    length_world: f64,
+    clearance_world: Option<f64>,
 }
 
 #[derive(Serialize)]
@@ -111,8 +121,23 @@ pub fn run(args: Args) -> Result<()> {
         }
         output::guard("--output", path, &["png"], &[&args.env, &args.obj])?;
     }
-    let env = read_solid(&args.env).context("reading the environment")?;
-    let obj = read_solid(&args.obj).context("reading the object")?;
+    let env = super::octree::read(&args.env).context("reading the environment")?;
+    let obj = super::octree::read(&args.obj).context("reading the object")?;
+    // The frame rule of `collide`: the object sits where its frame puts it in the
+    // environment's lattice, and the offsets move it from there.
+    let placed = env.frame.offset_to(&obj.frame).with_context(|| {
+        format!(
+            "planning {} through {}",
+            args.obj.display(),
+            args.env.display()
+        )
+    })?;
+    let frame = env.frame;
+    let env = env.tree;
+    let obj = obj
+        .tree
+        .translate(placed)
+        .context("placing the object in the environment's frame")?;
     let options = PlanOptions {
         rotation: args.rotate,
         smooth: !args.no_smooth,
@@ -157,6 +182,10 @@ pub fn run(args: Args) -> Result<()> {
                     clearance: p.clearance,
                     free_cells: p.free_cells,
                     settled: p.settled,
+                    voxel_size: frame.voxel_size,
+                    waypoints_world: p.waypoints.iter().map(|&w| world(&frame, w)).collect(),
+                    length_world: p.length * frame.voxel_size,
+                    clearance_world: p.clearance.map(|c| c * frame.voxel_size),
                 };
                 serde_json::to_writer(&mut out, &f)?;
                 writeln!(out)?;
@@ -171,6 +200,14 @@ pub fn run(args: Args) -> Result<()> {
                 match p.clearance {
                     Some(c) => writeln!(out, "clearance: {c:.3}")?,
                     None => writeln!(out, "clearance: unbounded (empty environment)")?,
+                }
+                if !frame.is_unit() {
+                    writeln!(
+                        out,
+                        "voxel size {}: length {:.3} in world units",
+                        frame.voxel_size,
+                        p.length * frame.voxel_size
+                    )?;
                 }
                 for w in &p.waypoints {
                     writeln!(out, "{},{},{}", w[0], w[1], w[2])?;
@@ -196,6 +233,11 @@ pub fn run(args: Args) -> Result<()> {
             std::process::exit(1);
         }
     }
+}
+
+/// A waypoint (an offset in voxels) as a displacement in world units.
+fn world(frame: &Frame, w: Voxel) -> [f64; 3] {
+    w.map(|c| c as f64 * frame.voxel_size)
 }
 
 fn picture(
