@@ -499,3 +499,37 @@ fn plans_follow_the_frame_rule() {
         "voxel sizes differ",
     );
 }
+
+#[test]
+fn simulations_follow_the_frame_rule() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let wall = LinearOctree::from_voxels(4, [0; 3], (0..4).map(|y| [6, y, 0])).unwrap();
+    let dot = LinearOctree::from_voxels(3, [0; 3], [[0, 0, 0]]).unwrap();
+    write_model(
+        &d.join("env.tess"),
+        &Model::new(wall).with_frame(Frame::new(0.5, [0.0; 3])),
+    )
+    .unwrap();
+    // Placed 2 voxels along x by its frame, the dot touches the wall at x = 6 after
+    // 3 steps of 1 voxel and enters it at step 4; unplaced it would take 5 and 6.
+    let placed = |name: &str, h: f64, x: f64| {
+        write_model(
+            &d.join(name),
+            &Model::new(dot.clone()).with_frame(Frame::new(h, [x, 0.0, 0.0])),
+        )
+        .unwrap();
+        let world = format!(
+            r#"{{"environment": "env.tess", "steps": 8, "objects": [
+                {{"name": "dot", "octree": "{name}", "start": [0, 0, 0], "velocity": [1, 0, 0]}}]}}"#
+        );
+        std::fs::write(d.join("world.json"), world).unwrap();
+    };
+    placed("dot.tess", 0.5, 1.0);
+    let report = json(d, &["simulate", "world.json", "--json"]);
+    assert_eq!(report["voxel_size"], 0.5, "{report}");
+    assert_eq!(report["contacts"][0]["time"], 3.0, "{report}");
+    assert_eq!(report["frames"][4]["overlaps"][0][2], 1, "{report}");
+    placed("fine.tess", 0.25, 0.0);
+    fails(d, &["simulate", "world.json"], "voxel sizes differ");
+}

@@ -67,6 +67,9 @@ struct ReportHead<'a> {
     steps: u64,
     time_step: f64,
     objects: Vec<&'a str>,
+    /// The environment's frame: positions and contact boxes are in its voxels.
+    voxel_size: f64,
+    translate: [f64; 3],
 }
 
 fn name(b: &Body) -> String {
@@ -143,6 +146,8 @@ pub fn run(args: Args) -> Result<()> {
             steps: wf.steps,
             time_step: wf.time_step,
             objects: world.objects.iter().map(|o| o.name.as_str()).collect(),
+            voxel_size: wf.frame.voxel_size,
+            translate: wf.frame.translate,
         };
         let mut text = serde_json::to_vec(&head)?;
         text.pop(); // the closing brace: frames and contacts follow

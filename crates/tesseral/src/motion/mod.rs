@@ -50,7 +50,8 @@ pub use world::{
     Body, Contact, Frame, MovingObject, Simulation, Trajectory, TranslationMethod, World,
 };
 pub use world_file::{
-    read_solid, read_world, read_world_limited, WorldError, WorldFile, MAX_OBJECTS, MAX_STEPS,
+    read_body, read_solid, read_world, read_world_limited, WorldError, WorldFile, MAX_OBJECTS,
+    MAX_STEPS,
 };
 
 #[cfg(test)]

@@ -24,7 +24,8 @@ use serde::Deserialize;
 use super::orient::Rotation;
 use super::world::{MovingObject, Trajectory, TranslationMethod, World};
 use crate::csg::SceneError;
-use crate::io::{read_octree, FormatError};
+use crate::io::{read_model, read_octree, FormatError};
+use crate::model::{Frame, Model};
 
 /// The most steps a world file may ask for.
 pub const MAX_STEPS: u64 = 1_000_000;
@@ -126,8 +127,10 @@ struct WaypointSpec {
 /// A world read from a file, with how long to run it.
 #[derive(Debug, Clone)]
 pub struct WorldFile {
-    /// The world.
+    /// The world, in the environment's voxels.
     pub world: World,
+    /// The environment's frame: positions, velocities and contacts are in its voxels.
+    pub frame: Frame,
     /// The time between steps.
     pub time_step: f64,
     /// How many steps to take.
@@ -135,7 +138,8 @@ pub struct WorldFile {
 }
 
 /// Reads a solid: a `.tss` scene file (built with [`crate::csg::Scene::build`]) or an
-/// octree file in any format [`read_octree`] knows.
+/// octree file in any format [`read_octree`] knows. The frame is dropped; see
+/// [`read_body`] to keep it.
 ///
 /// # Errors
 /// [`WorldError::Scene`] or [`WorldError::Octree`], naming the file and place.
@@ -144,6 +148,20 @@ pub fn read_solid(path: &Path) -> Result<crate::linear::LinearOctree, WorldError
         Ok(crate::csg::Scene::read(path)?.build()?)
     } else {
         Ok(read_octree(path)?)
+    }
+}
+
+/// Reads a solid with its frame: a `.tss` scene (its scene units) or an octree file.
+///
+/// # Errors
+/// As [`read_solid`].
+pub fn read_body(path: &Path) -> Result<Model, WorldError> {
+    if crate::io::extension(path) == "tss" {
+        let scene = crate::csg::Scene::read(path)?;
+        let tree = scene.build()?;
+        Ok(Model::new(tree).with_frame(scene.frame()))
+    } else {
+        Ok(read_model(path)?)
     }
 }
 
@@ -235,7 +253,12 @@ pub fn read_world_limited(
         }
         Ok(dir.join(rel))
     };
-    let environment = read_solid(&inside("environment", &spec.environment)?)?;
+    let env_path = inside("environment", &spec.environment)?;
+    let Model {
+        tree: environment,
+        frame,
+        ..
+    } = read_body(&env_path)?;
     let mut leaves = environment.leaf_count() as u64;
     let over = |leaves: u64| WorldError::TooManyLeaves {
         path: path.to_owned(),
@@ -294,7 +317,16 @@ pub fn read_world_limited(
                 Trajectory::Constant { start, velocity }
             }
         };
-        let tree = read_solid(&inside(&format!("object {name:?}, octree"), &o.octree)?)?;
+        let body = read_body(&inside(&format!("object {name:?}, octree"), &o.octree)?)?;
+        // The frame rule of `collide`: the object sits where its frame puts it in
+        // the environment's lattice, and its trajectory moves it from there.
+        let placed = frame
+            .offset_to(&body.frame)
+            .map_err(|e| field("octree", format!("{e} (against the environment)")))?;
+        let tree = body
+            .tree
+            .translate(placed)
+            .map_err(|e| field("octree", e.to_string()))?;
         leaves = leaves.saturating_add(tree.leaf_count() as u64);
         if leaves > max_leaves {
             return Err(over(leaves));
@@ -323,6 +355,7 @@ pub fn read_world_limited(
             objects,
             method,
         },
+        frame,
         time_step: spec.time_step,
         steps: spec.steps,
     })
