@@ -134,3 +134,52 @@ fn small_hostile_files_fail_with_the_reason() {
         assert!(!d.join("o.tess").exists(), "{args:?}");
     }
 }
+
+/// Issue 19 item 8: coincident triangles cost triangles × covered area. A closed box
+/// with 2,000 copies of a large triangle through it took 17 s and 4.2 GB at depth 9;
+/// 20,000 copies were refused by the area budget. Folded first, they cost nothing,
+/// and the solid is the box's (the copies cancel in pairs under ray parity).
+#[test]
+fn coincident_triangles_are_folded_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let box_and_triangle = "v 0 0 0\nv 64 0 0\nv 0 64 0\nv 64 64 0\nv 0 0 64\nv 64 0 64\n\
+        v 0 64 64\nv 64 64 64\nv -8 -8 32\nv 200 -8 32\nv -8 200 32\n\
+        f 1 3 4 2\nf 5 6 8 7\nf 1 2 6 5\nf 3 7 8 4\nf 1 5 7 3\nf 2 4 8 6\n";
+    std::fs::write(
+        d.join("stacked.obj"),
+        format!("{box_and_triangle}{}", "f 9 10 11\n".repeat(20_000)),
+    )
+    .unwrap();
+    let out = run_capped(
+        d,
+        &["convert", "stacked.obj", "stacked.tess", "--depth", "9"],
+        1024,
+        60,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The same box without the triangles, on the same grid (the extent includes the
+    // triangle's corners in both).
+    std::fs::write(
+        d.join("plain.obj"),
+        format!("{box_and_triangle}f 9 10 11\nf 9 11 10\n"),
+    )
+    .unwrap();
+    let out = run_capped(
+        d,
+        &["convert", "plain.obj", "plain.tess", "--depth", "9"],
+        1024,
+        60,
+    );
+    assert!(out.status.success());
+    let a = tesseral::io::read_model(&d.join("stacked.tess")).unwrap();
+    let b = tesseral::io::read_model(&d.join("plain.tess")).unwrap();
+    assert!(a.tree.same_voxels(&b.tree).unwrap());
+    // The box is 64 / (208 / 512) = 157.5 voxels on a side.
+    let n = a.tree.voxel_count();
+    assert!((157u64.pow(3)..=158u64.pow(3)).contains(&n), "{n} voxels");
+}
