@@ -1,4 +1,5 @@
-//! `tesseral info FILE [--json]`: what an octree file holds.
+//! `tesseral info FILE [--json] [--tree | --codes]`: what an octree file holds, or
+//! the octree in the papers' notations.
 
 use std::path::PathBuf;
 
@@ -19,8 +20,47 @@ pub struct Args {
     /// colored_voxels, free_voxels, free_leaves, log_odds).
     #[arg(long)]
     json: bool,
+    /// Print the octree as the indented node list of Ahuja & Nash Fig. 4 instead:
+    /// each gray and black node's label path from the root `r` (such as `r05`),
+    /// indented by depth; white nodes are not listed. With --json: `{"nodes":
+    /// [{"label", "depth", "colour"}]}`.
+    #[arg(long, conflicts_with = "codes")]
+    tree: bool,
+    /// Print the leaves as locational codes with Harakal & Chmúrny's "X" postfix
+    /// instead, one per line in tesseral order (`05XX`: a block two levels above a
+    /// voxel). With --json: `{"codes": [...]}`.
+    #[arg(long)]
+    codes: bool,
     #[command(flatten)]
     budget: Budget,
+}
+
+/// `--tree` and `--codes`: the papers' notations, streamed line by line.
+fn notation(args: &Args, tree: &tesseral::linear::LinearOctree) -> Result<()> {
+    if args.json {
+        // Streamed as it is made: a large tree never sits in memory as JSON.
+        let items: Box<dyn Iterator<Item = serde_json::Value>> = if args.tree {
+            Box::new(tree.node_list().map(
+                |n| serde_json::json!({"label": n.label(), "depth": n.depth(), "colour": n.colour}),
+            ))
+        } else {
+            Box::new(tree.locational_codes().map(serde_json::Value::from))
+        };
+        crate::out!("{{\"{}\":[", if args.tree { "nodes" } else { "codes" })?;
+        for (i, item) in items.enumerate() {
+            crate::out!("{}{item}", if i == 0 { "" } else { "," })?;
+        }
+        crate::outln!("]}}")?;
+    } else if args.tree {
+        for node in tree.node_list() {
+            crate::outln!("{node}")?;
+        }
+    } else {
+        for code in tree.locational_codes() {
+            crate::outln!("{code}")?;
+        }
+    }
+    Ok(())
 }
 
 /// The `--json` output. Its keys are a public interface: only ever add to them.
@@ -65,6 +105,9 @@ struct Info {
 pub fn run(args: Args) -> Result<()> {
     let model = octree::read_model(&args.file, &args.budget, &Default::default())?;
     let tree = &model.tree;
+    if args.tree || args.codes {
+        return notation(&args, tree);
+    }
     let bbox = tree.bbox();
     let frame = model.frame;
     let info = Info {

@@ -97,5 +97,8 @@ fn render(t: &PaperTable) -> String {
     for n in notes {
         let _ = writeln!(out, "{n}");
     }
+    for n in &t.notes {
+        let _ = writeln!(out, "Note: {n}");
+    }
     out
 }

@@ -247,7 +247,15 @@ pub struct PaperTable {
     pub columns: Vec<String>,
     /// The rows.
     pub rows: Vec<TableRow>,
+    /// Notes printed under the table: errata of the paper's text near it.
+    pub notes: Vec<&'static str>,
 }
+
+/// Harakal & Chmúrny §2, eq. (1), checked by counting the nodes of full octrees
+/// (`linear::node_list` tests).
+pub const HC_EQ1_ERRATUM: &str = "Eq. (1), §2: the paper gives the node count of a full \
+     octree of depth n as (8^n + 1)/7; the sum it writes, 1 + 8 + ... + 8^n, is \
+     (8^(n+1) - 1)/7 (n = 2: 73 nodes, not 9.29).";
 
 impl PaperTable {
     /// The cells where the paper printed something else: `(row, column, cell)`.
@@ -349,6 +357,7 @@ pub fn ahuja_nash_tables() -> Vec<PaperTable> {
                     .collect(),
             })
             .collect(),
+        notes: Vec::new(),
     };
     let t2 = PaperTable {
         id: "ahuja-nash-2",
@@ -375,6 +384,7 @@ pub fn ahuja_nash_tables() -> Vec<PaperTable> {
                     .collect(),
             })
             .collect(),
+        notes: Vec::new(),
     };
     vec![t1, t2]
 }
@@ -400,6 +410,7 @@ pub fn harakal_tables() -> Vec<PaperTable> {
                     .collect(),
             })
             .collect(),
+        notes: vec![HC_EQ1_ERRATUM],
     };
     let t2 = PaperTable {
         id: "harakal-2",
@@ -420,6 +431,7 @@ pub fn harakal_tables() -> Vec<PaperTable> {
                     .collect(),
             })
             .collect(),
+        notes: Vec::new(),
     };
     vec![t1, t2]
 }

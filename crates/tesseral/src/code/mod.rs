@@ -25,6 +25,7 @@ mod arith;
 pub mod batch;
 pub mod digits;
 mod error;
+pub mod muldiv;
 pub mod notation;
 pub mod padic;
 mod word;
@@ -106,3 +107,5 @@ pub fn decode_wide(code: u128) -> [u64; 3] {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_muldiv;

@@ -9,6 +9,7 @@
 mod build;
 pub(crate) mod grow;
 mod leaf;
+mod node_list;
 mod ops;
 mod resample;
 mod sort;
@@ -16,6 +17,7 @@ mod transform;
 
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
+pub use node_list::{Node, NodeColour};
 pub use ops::SetOp;
 pub use transform::{rotation_labels, Axis};
 
