@@ -245,7 +245,11 @@ fn tables_json() {
     let text = ok(&["tables", "harakal", "--json"]);
     let v: serde_json::Value = serde_json::from_str(&text).expect("valid JSON");
     let tables = v["tables"].as_array().expect("tables array");
-    assert_eq!(tables.len(), 2);
+    assert_eq!(
+        tables.len(),
+        3,
+        "tables 1, 2 and the digit multiplication table"
+    );
     let cell = &tables[0]["rows"][5]["cells"][5];
     assert_eq!(cell["value"], "50");
     assert_eq!(cell["printed"], "16");

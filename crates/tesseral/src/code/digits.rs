@@ -386,7 +386,29 @@ pub fn ahuja_nash_tables() -> Vec<PaperTable> {
             .collect(),
         notes: Vec::new(),
     };
-    vec![t1, t2]
+    let t3 = PaperTable {
+        id: "harakal-mul",
+        source: "Harakal & Chmúrny, §3 (a table not in the paper: defined in docs/arithmetic.md)",
+        title: "Octree tesseral digit multiplication, axis by axis",
+        legend: "row * column: each axis bit multiplied, so the digit product is the bitwise AND; no carry",
+        corner: "*",
+        columns: digit_columns(),
+        rows: (0..8u8)
+            .map(|a| TableRow {
+                label: a.to_string(),
+                cells: (0..8u8)
+                    .map(|b| {
+                        let v = (a & b).to_string();
+                        cell(v.clone(), &v)
+                    })
+                    .collect(),
+            })
+            .collect(),
+        notes: vec![
+            "A code times a code shifts and adds these rows with Table 1: see `tesseral calc mul --explain`.",
+        ],
+    };
+    vec![t1, t2, t3]
 }
 
 /// Harakal & Chmúrny §3 Tables 1 and 2, computed; the two errata are marked.
@@ -433,5 +455,27 @@ pub fn harakal_tables() -> Vec<PaperTable> {
             .collect(),
         notes: Vec::new(),
     };
-    vec![t1, t2]
+    let t3 = PaperTable {
+        id: "harakal-mul",
+        source: "Harakal & Chmúrny, §3 (a table not in the paper: defined in docs/arithmetic.md)",
+        title: "Octree tesseral digit multiplication, axis by axis",
+        legend: "row * column: each axis bit multiplied, so the digit product is the bitwise AND; no carry",
+        corner: "*",
+        columns: digit_columns(),
+        rows: (0..8u8)
+            .map(|a| TableRow {
+                label: a.to_string(),
+                cells: (0..8u8)
+                    .map(|b| {
+                        let v = (a & b).to_string();
+                        cell(v.clone(), &v)
+                    })
+                    .collect(),
+            })
+            .collect(),
+        notes: vec![
+            "A code times a code shifts and adds these rows with Table 1: see `tesseral calc mul --explain`.",
+        ],
+    };
+    vec![t1, t2, t3]
 }

@@ -14,6 +14,7 @@ use tesseral::code::notation::{format_padded, format_padic, parse_octal, parse_p
 use tesseral::code::{Axis, Space, MAX_DEPTH_U128};
 
 mod explain;
+mod muldiv;
 use explain::{explain_add, explain_bits, explain_sub};
 
 /// Arguments of `tesseral calc`.
@@ -54,6 +55,38 @@ enum Op {
         /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
         #[arg(allow_hyphen_values = true)]
         b: String,
+    },
+    /// Tesseral multiplication A * B: coordinates multiplied axis by axis (7 is the
+    /// unit; 70 doubles; a negative coordinate mirrors), by shift and add on the codes.
+    Mul {
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
+        #[arg(allow_hyphen_values = true)]
+        a: String,
+        /// Octal code, e.g. 70 (or ...6062, a code with negative coordinates).
+        #[arg(allow_hyphen_values = true)]
+        b: String,
+    },
+    /// Tesseral division B / A by the P-adic method: exact on each axis whose divisor
+    /// is odd, a 2-adic number with repeating digits when not an integer (such as
+    /// ...[01]1, 1/3 along x).
+    Div {
+        /// The dividend: octal code, e.g. 6530.
+        #[arg(allow_hyphen_values = true)]
+        b: String,
+        /// The divisor: octal code, e.g. 70.
+        #[arg(allow_hyphen_values = true)]
+        a: String,
+    },
+    /// Rotation with scaling by the integer quaternion q = a + bi + cj + dk: the
+    /// coordinates of CODE become q v q̄ (rotated by 2·atan2(|(b,c,d)|, a) about
+    /// (b, c, d), scaled by a² + b² + c² + d²).
+    Qmul {
+        /// Octal code, e.g. 642 (or ...6062, a code with negative coordinates).
+        #[arg(allow_hyphen_values = true)]
+        code: String,
+        /// The quaternion a,b,c,d, such as 1,0,0,1 (a quarter turn about z, times 2).
+        #[arg(allow_hyphen_values = true)]
+        q: String,
     },
     /// Negation: the two's complement of every axis.
     Neg {
@@ -214,6 +247,20 @@ pub fn run(args: Args) -> Result<()> {
             writeln!(out, "{}", mode.show(code))?;
             let carry = if mode.bounded { r.carry } else { 0 };
             return finish(&args, &mode, &out, None, ("borrow", carry));
+        }
+        Op::Mul { a, b } => {
+            let (ca, cb) = (mode.parse("A", a)?, mode.parse("B", b)?);
+            let carry = muldiv::mul(&mode, ca, cb, args.explain, &mut out)?;
+            return finish(&args, &mode, &out, None, ("carry", carry));
+        }
+        Op::Div { b, a } => {
+            let (cb, ca) = (mode.parse("B", b)?, mode.parse("A", a)?);
+            muldiv::div(&mode, cb, ca, args.explain, &mut out)?;
+        }
+        Op::Qmul { code, q } => {
+            let c = mode.parse("CODE", code)?;
+            let p = muldiv::qmul(&mode, c, q, args.explain, &mut out)?;
+            return finish(&args, &mode, &out, Some(p), ("carry", 0));
         }
         Op::Neg { a } => {
             let ca = mode.parse("A", a)?;
