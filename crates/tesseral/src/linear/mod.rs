@@ -6,6 +6,7 @@
 //! canonical form: sorted, disjoint, and with no eight black siblings left unmerged.
 //! Two equal solids in the same space therefore have equal leaf lists.
 
+mod affine;
 mod build;
 pub(crate) mod grow;
 mod leaf;
@@ -15,6 +16,7 @@ mod resample;
 mod sort;
 mod transform;
 
+pub use affine::{rotation_matrix, BoxState};
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};
@@ -61,6 +63,9 @@ pub enum OctreeError {
         /// The number of words given.
         got: usize,
     },
+    /// A transform's parameters make no solid (a zero scale factor, a singular map).
+    #[error("{0}")]
+    InvalidArgument(String),
 }
 
 /// A solid as a sorted list of maximal black blocks (a linear octree).
@@ -525,3 +530,5 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
 pub(crate) mod tests;
 #[cfg(test)]
 pub(crate) mod tests_ops;
+#[cfg(test)]
+mod tests_affine;

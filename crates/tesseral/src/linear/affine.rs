@@ -1,0 +1,408 @@
+//! Any affine map of an existing octree, and integer scaling by any factor per axis,
+//! by point sampling (the papers' last rows: Ahuja & Nash Fig. 5 discusses why such
+//! maps fragment the tree).
+//!
+//! **Definition.** The output lives on the input's lattice. Output voxel `w` is black
+//! iff the inverse map of its centre `w + ½` lies in a black input voxel (voxels are
+//! half-open, as everywhere). The definition is exact, so it is tested against brute
+//! force over every output centre.
+//!
+//! **Top-down.** An output cell's centres map back into a parallelepiped of the
+//! input. Its bounding box of input voxels is classified against the input octree
+//! ([`LinearOctree::box_state`]): all black makes the cell black, all white makes it
+//! white, and only the rest is split. The work then follows the output's leaves, not
+//! its voxels. A single voxel is decided by its centre exactly.
+
+use super::{CellClass, Classifier, LinearOctree, OctreeError, MAX_DEPTH};
+use crate::Voxel;
+
+/// What an inclusive box of voxels holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BoxState {
+    /// No black voxel.
+    Empty,
+    /// Every voxel black.
+    Full,
+    /// Some of each.
+    Mixed,
+}
+
+impl LinearOctree {
+    /// Whether the inclusive box `[lo, hi]` of voxels is all white, all black or
+    /// mixed; voxels outside the space are white. O(log n + boundary nodes), with an
+    /// early exit at the first mixed evidence.
+    ///
+    /// ```
+    /// use tesseral::linear::{BoxState, LinearOctree};
+    /// let t = LinearOctree::from_voxels(2, [0; 3], [[0, 0, 0], [1, 0, 0]]).unwrap();
+    /// assert_eq!(t.box_state([0, 0, 0], [1, 0, 0]), BoxState::Full);
+    /// assert_eq!(t.box_state([0, 0, 0], [2, 0, 0]), BoxState::Mixed);
+    /// assert_eq!(t.box_state([2, 2, 2], [9, 9, 9]), BoxState::Empty);
+    /// ```
+    #[must_use]
+    pub fn box_state(&self, lo: Voxel, hi: Voxel) -> BoxState {
+        if (0..3).any(|a| lo[a] > hi[a]) {
+            return BoxState::Empty;
+        }
+        let o = self.origin();
+        let side = 1i128 << self.depth();
+        let outside = (0..3).any(|a| {
+            i128::from(lo[a]) < i128::from(o[a]) || i128::from(hi[a]) >= i128::from(o[a]) + side
+        });
+        let inside_any = (0..3).all(|a| {
+            i128::from(hi[a]) >= i128::from(o[a]) && i128::from(lo[a]) < i128::from(o[a]) + side
+        });
+        if !inside_any {
+            return BoxState::Empty;
+        }
+        let rel_lo: [u64; 3] = std::array::from_fn(|a| (lo[a].max(o[a]) - o[a]) as u64);
+        let rel_hi: [u64; 3] = std::array::from_fn(|a| {
+            (i128::from(hi[a]).min(i128::from(o[a]) + side - 1) - i128::from(o[a])) as u64
+        });
+        let mut seen = Seen {
+            black: false,
+            white: outside,
+        };
+        visit(
+            self.leaves(),
+            0,
+            self.depth(),
+            [0; 3],
+            (rel_lo, rel_hi),
+            &mut seen,
+        );
+        match (seen.black, seen.white) {
+            (false, _) => BoxState::Empty,
+            (true, false) => BoxState::Full,
+            (true, true) => BoxState::Mixed,
+        }
+    }
+}
+
+struct Seen {
+    black: bool,
+    white: bool,
+}
+
+/// Visits the node of `size_log2` at relative corner `min` with first code `code`,
+/// whose leaves are `leaves`, where it meets the box.
+fn visit(
+    leaves: &[super::Leaf],
+    code: u64,
+    size_log2: u8,
+    min: [u64; 3],
+    (lo, hi): ([u64; 3], [u64; 3]),
+    seen: &mut Seen,
+) {
+    if seen.black && seen.white {
+        return;
+    }
+    let side = 1u64 << size_log2;
+    if (0..3).any(|a| min[a] > hi[a] || min[a] + side - 1 < lo[a]) {
+        return;
+    }
+    match leaves.first() {
+        None => {
+            seen.white = true;
+            return;
+        }
+        Some(l) if l.size_log2() >= size_log2 => {
+            seen.black = true;
+            return;
+        }
+        _ => {}
+    }
+    let child = size_log2 - 1;
+    let cells = 1u64 << (3 * u32::from(child));
+    let mut rest = leaves;
+    for d in 0..8u64 {
+        let start = code + d * cells;
+        let n = rest.partition_point(|l| l.code() < start + cells);
+        let (mine, after) = rest.split_at(n);
+        rest = after;
+        let cmin = [0, 1, 2].map(|a| min[a] + ((d >> a) & 1) * (side / 2));
+        visit(mine, start, child, cmin, (lo, hi), seen);
+        if seen.black && seen.white {
+            return;
+        }
+    }
+}
+
+/// A map from output voxels back to input voxels.
+trait Sampling: Sync {
+    /// The input voxel holding the preimage of output voxel `w`'s centre.
+    fn preimage(&self, w: Voxel) -> Voxel;
+    /// An inclusive box of input voxels holding the preimages of the centres of the
+    /// output cell `[min, max]`.
+    fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel);
+}
+
+struct MapClassifier<'a, S> {
+    input: &'a LinearOctree,
+    map: S,
+}
+
+impl<S: Sampling> Classifier for MapClassifier<'_, S> {
+    fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
+        let black = |state| match state {
+            BoxState::Empty => CellClass::Outside,
+            BoxState::Full => CellClass::Inside,
+            BoxState::Mixed => CellClass::Partial,
+        };
+        if size_log2 == 0 {
+            let v = self.map.preimage(min);
+            return if self.input.contains(v) {
+                CellClass::Inside
+            } else {
+                CellClass::Outside
+            };
+        }
+        let max = min.map(|c| c + (1i64 << size_log2) - 1);
+        let (lo, hi) = self.map.preimage_box(min, max);
+        black(self.input.box_state(lo, hi))
+    }
+}
+
+/// Scaling by an integer per axis: `w ↦ floor((2w + 1) / 2k)`, exact.
+struct IntScale([i64; 3]);
+
+impl Sampling for IntScale {
+    fn preimage(&self, w: Voxel) -> Voxel {
+        std::array::from_fn(|a| {
+            // floor((2w + 1) / 2k), the divisor made positive for div_euclid.
+            let (n, d) = (2 * i128::from(w[a]) + 1, 2 * i128::from(self.0[a]));
+            let (n, d) = if d < 0 { (-n, -d) } else { (n, d) };
+            n.div_euclid(d) as i64
+        })
+    }
+    fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel) {
+        let (a, b) = (self.preimage(min), self.preimage(max));
+        (
+            std::array::from_fn(|i| a[i].min(b[i])),
+            std::array::from_fn(|i| a[i].max(b[i])),
+        )
+    }
+}
+
+/// An affine map `q = m p + t` on continuous lattice coordinates, sampled through its
+/// inverse.
+struct Affine {
+    inv: [[f64; 3]; 3],
+    t: [f64; 3],
+}
+
+/// Slack added around a preimage box so that float rounding in the box never
+/// disagrees with the single-centre test.
+const SLACK: f64 = 1e-7;
+
+impl Affine {
+    fn back(&self, q: [f64; 3]) -> [f64; 3] {
+        let d = [0, 1, 2].map(|j| q[j] - self.t[j]);
+        [0, 1, 2].map(|i| (0..3).map(|j| self.inv[i][j] * d[j]).sum())
+    }
+}
+
+impl Sampling for Affine {
+    fn preimage(&self, w: Voxel) -> Voxel {
+        self.back(w.map(|c| c as f64 + 0.5)).map(|c| c.floor() as i64)
+    }
+    fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel) {
+        let c = self.back(min.map(|c| c as f64 + 0.5));
+        let (mut lo, mut hi) = (c, c);
+        for i in 0..3 {
+            for j in 0..3 {
+                let span = self.inv[i][j] * (max[j] - min[j]) as f64;
+                if span < 0.0 {
+                    lo[i] += span;
+                } else {
+                    hi[i] += span;
+                }
+            }
+        }
+        (
+            lo.map(|c| (c - SLACK).floor() as i64),
+            hi.map(|c| (c + SLACK).floor() as i64),
+        )
+    }
+}
+
+fn inverse(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+    if !det.is_finite() || det.abs() < 1e-12 {
+        return None;
+    }
+    let c = |i: usize, j: usize| {
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+    };
+    Some(std::array::from_fn(|i| std::array::from_fn(|j| c(j, i) / det)))
+}
+
+/// The smallest space (power-of-two cube) holding the inclusive box `[lo, hi]`.
+fn space_for(lo: [i128; 3], hi: [i128; 3]) -> Result<(u8, Voxel), OctreeError> {
+    let extent = (0..3).map(|a| hi[a] - lo[a] + 1).max().unwrap_or(1).max(1);
+    let depth = (128 - (extent - 1).leading_zeros()) as u8;
+    if depth > MAX_DEPTH {
+        return Err(OctreeError::DepthTooLarge(depth));
+    }
+    let origin: Option<Voxel> = lo
+        .iter()
+        .map(|&c| i64::try_from(c).ok())
+        .collect::<Option<Vec<_>>>()
+        .map(|v| [v[0], v[1], v[2]]);
+    let origin = origin.ok_or(OctreeError::Overflow)?;
+    if (0..3).any(|a| i128::from(origin[a]) + (1i128 << depth) > i128::from(i64::MAX)) {
+        return Err(OctreeError::Overflow);
+    }
+    Ok((depth, origin))
+}
+
+impl LinearOctree {
+    /// The tree scaled by the integer `k[a]` along each axis about the lattice origin:
+    /// voxel `v` becomes the block of voxels `w` with `floor((w + ½)/k) = v`, so
+    /// `k = (3, 1, 2)` turns each voxel into a 3 × 1 × 2 block and a negative factor
+    /// mirrors (`-1` maps `v` to `-1 - v`). Equal positive powers of two take the fast
+    /// path of [`LinearOctree::scale_up`]. Exact.
+    ///
+    /// # Errors
+    /// [`OctreeError::InvalidArgument`] for a zero factor; [`OctreeError::Overflow`] or
+    /// [`OctreeError::DepthTooLarge`] when the result leaves the lattice.
+    ///
+    /// ```
+    /// use tesseral::linear::LinearOctree;
+    /// let t = LinearOctree::from_voxels(1, [0; 3], [[1, 0, 0]]).unwrap();
+    /// let s = t.scale_axes([3, 1, -2]).unwrap();
+    /// assert_eq!(s.voxel_count(), 6);
+    /// assert!(s.contains([3, 0, -1]) && s.contains([5, 0, -2]) && !s.contains([2, 0, -1]));
+    /// ```
+    pub fn scale_axes(&self, k: [i64; 3]) -> Result<Self, OctreeError> {
+        if k.contains(&0) {
+            return Err(OctreeError::InvalidArgument(
+                "a scale factor of 0 collapses the solid".into(),
+            ));
+        }
+        if k[0] > 0 && k[0] == k[1] && k[1] == k[2] && (k[0] as u64).is_power_of_two() {
+            return self.scale_up(k[0].trailing_zeros() as u8);
+        }
+        let Some((blo, bhi)) = self.bbox() else {
+            return Ok(self.clone());
+        };
+        let (mut lo, mut hi) = ([0i128; 3], [0i128; 3]);
+        for a in 0..3 {
+            let f = i128::from(k[a]);
+            let (p, q) = (f * i128::from(blo[a]), f * (i128::from(bhi[a]) + 1));
+            lo[a] = p.min(q);
+            hi[a] = p.max(q) - 1;
+        }
+        let (depth, origin) = space_for(lo, hi)?;
+        let classifier = MapClassifier {
+            input: self,
+            map: IntScale(k),
+        };
+        Self::from_classifier(depth, origin, &classifier)
+    }
+
+    /// The tree under the affine map `q = m·p + t` of continuous lattice coordinates
+    /// (voxel `v` spans `[v, v + 1)`), by point sampling on the same lattice: output
+    /// voxel `w` is black iff `m⁻¹·(w + ½ − t)` lies in a black voxel. Built top-down,
+    /// so the work follows the output's leaves.
+    ///
+    /// # Errors
+    /// [`OctreeError::InvalidArgument`] for a singular or non-finite map;
+    /// [`OctreeError::Overflow`] / [`OctreeError::DepthTooLarge`] when the image
+    /// leaves the lattice.
+    ///
+    /// ```
+    /// use tesseral::linear::LinearOctree;
+    /// let t = LinearOctree::from_voxels(3, [0; 3], [[0, 0, 0], [1, 0, 0], [2, 0, 0]]).unwrap();
+    /// // A quarter turn about z through the lattice origin: x becomes y.
+    /// let r = t.affine([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]], [0.0; 3]).unwrap();
+    /// assert!(r.contains([-1, 2, 0]) && r.voxel_count() == 3);
+    /// ```
+    pub fn affine(&self, m: [[f64; 3]; 3], t: [f64; 3]) -> Result<Self, OctreeError> {
+        let bad = || OctreeError::InvalidArgument("the map is singular or not finite".into());
+        if !t.iter().chain(m.iter().flatten()).all(|c| c.is_finite()) {
+            return Err(bad());
+        }
+        let inv = inverse(m).ok_or_else(bad)?;
+        let Some((blo, bhi)) = self.bbox() else {
+            return Ok(self.clone());
+        };
+        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+        for corner in 0..8 {
+            let p: [f64; 3] = std::array::from_fn(|a| {
+                if corner >> a & 1 == 0 {
+                    blo[a] as f64
+                } else {
+                    bhi[a] as f64 + 1.0
+                }
+            });
+            for i in 0..3 {
+                let q = (0..3).map(|j| m[i][j] * p[j]).sum::<f64>() + t[i];
+                lo[i] = lo[i].min(q);
+                hi[i] = hi[i].max(q);
+            }
+        }
+        let limit = 2f64.powi(62);
+        if !(0..3).all(|a| lo[a].abs() < limit && hi[a].abs() < limit) {
+            return Err(OctreeError::Overflow);
+        }
+        let (depth, origin) = space_for(
+            lo.map(|c| c.floor() as i128 - 1),
+            hi.map(|c| c.ceil() as i128 + 1),
+        )?;
+        let classifier = MapClassifier {
+            input: self,
+            map: Affine { inv, t },
+        };
+        Self::from_classifier(depth, origin, &classifier)
+    }
+}
+
+/// The matrix of a rotation by `degrees` about the unit vector along `axis`
+/// (Rodrigues), with exact entries for multiples of 90°.
+#[must_use]
+pub fn rotation_matrix(axis: [f64; 3], degrees: f64) -> [[f64; 3]; 3] {
+    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let k = axis.map(|c| c / n);
+    let turns = degrees / 90.0;
+    let (s, c) = if turns == turns.round() {
+        match (turns as i64).rem_euclid(4) {
+            0 => (0.0, 1.0),
+            1 => (1.0, 0.0),
+            2 => (0.0, -1.0),
+            _ => (-1.0, 0.0),
+        }
+    } else {
+        degrees.to_radians().sin_cos()
+    };
+    let v = 1.0 - c;
+    [
+        [
+            c + k[0] * k[0] * v,
+            k[0] * k[1] * v - k[2] * s,
+            k[0] * k[2] * v + k[1] * s,
+        ],
+        [
+            k[1] * k[0] * v + k[2] * s,
+            c + k[1] * k[1] * v,
+            k[1] * k[2] * v - k[0] * s,
+        ],
+        [
+            k[2] * k[0] * v - k[1] * s,
+            k[2] * k[1] * v + k[0] * s,
+            c + k[2] * k[2] * v,
+        ],
+    ]
+}
+
+#[cfg(test)]
+pub(super) mod tests_support {
+    /// The inverse the maps use, for the brute-force tests.
+    pub fn inverse(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        super::inverse(m).expect("regular")
+    }
+}
