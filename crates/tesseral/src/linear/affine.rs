@@ -287,17 +287,25 @@ impl LinearOctree {
         if k[0] > 0 && k[0] == k[1] && k[1] == k[2] && (k[0] as u64).is_power_of_two() {
             return self.scale_up(k[0].trailing_zeros() as u8);
         }
-        let Some((blo, bhi)) = self.bbox() else {
+        let Some(bbox) = self.bbox() else {
             return Ok(self.clone());
         };
-        let (mut lo, mut hi) = ([0i128; 3], [0i128; 3]);
-        for a in 0..3 {
-            let f = i128::from(k[a]);
-            let (p, q) = (f * i128::from(blo[a]), f * (i128::from(bhi[a]) + 1));
-            lo[a] = p.min(q);
-            hi[a] = p.max(q) - 1;
+        let (depth, origin) = scale_space(bbox, k)?;
+        self.scale_axes_in(k, depth, origin)
+    }
+
+    /// [`LinearOctree::scale_axes`] into the given space (which should hold the
+    /// image: see [`scale_space`]), with no fast path.
+    ///
+    /// # Errors
+    /// [`OctreeError::InvalidArgument`] for a zero factor; as
+    /// [`LinearOctree::from_classifier`].
+    pub fn scale_axes_in(&self, k: [i64; 3], depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
+        if k.contains(&0) {
+            return Err(OctreeError::InvalidArgument(
+                "a scale factor of 0 collapses the solid".into(),
+            ));
         }
-        let (depth, origin) = space_for(lo, hi)?;
         let classifier = MapClassifier {
             input: self,
             map: IntScale(k),
@@ -323,43 +331,89 @@ impl LinearOctree {
     /// assert!(r.contains([-1, 2, 0]) && r.voxel_count() == 3);
     /// ```
     pub fn affine(&self, m: [[f64; 3]; 3], t: [f64; 3]) -> Result<Self, OctreeError> {
+        let Some(bbox) = self.bbox() else {
+            return Ok(self.clone());
+        };
+        let (depth, origin) = affine_space(bbox, m, t)?;
+        self.affine_in(m, t, depth, origin)
+    }
+
+    /// [`LinearOctree::affine`] into the given space (which should hold the image:
+    /// see [`affine_space`]).
+    ///
+    /// # Errors
+    /// As [`LinearOctree::affine`].
+    pub fn affine_in(
+        &self,
+        m: [[f64; 3]; 3],
+        t: [f64; 3],
+        depth: u8,
+        origin: Voxel,
+    ) -> Result<Self, OctreeError> {
         let bad = || OctreeError::InvalidArgument("the map is singular or not finite".into());
         if !t.iter().chain(m.iter().flatten()).all(|c| c.is_finite()) {
             return Err(bad());
         }
         let inv = inverse(m).ok_or_else(bad)?;
-        let Some((blo, bhi)) = self.bbox() else {
-            return Ok(self.clone());
-        };
-        let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
-        for corner in 0..8 {
-            let p: [f64; 3] = std::array::from_fn(|a| {
-                if corner >> a & 1 == 0 {
-                    blo[a] as f64
-                } else {
-                    bhi[a] as f64 + 1.0
-                }
-            });
-            for i in 0..3 {
-                let q = (0..3).map(|j| m[i][j] * p[j]).sum::<f64>() + t[i];
-                lo[i] = lo[i].min(q);
-                hi[i] = hi[i].max(q);
-            }
-        }
-        let limit = 2f64.powi(62);
-        if !(0..3).all(|a| lo[a].abs() < limit && hi[a].abs() < limit) {
-            return Err(OctreeError::Overflow);
-        }
-        let (depth, origin) = space_for(
-            lo.map(|c| c.floor() as i128 - 1),
-            hi.map(|c| c.ceil() as i128 + 1),
-        )?;
         let classifier = MapClassifier {
             input: self,
             map: Affine { inv, t },
         };
         Self::from_classifier(depth, origin, &classifier)
     }
+}
+
+/// The smallest space holding the image of the voxel box `bbox` (inclusive) under
+/// scaling by `k` per axis.
+///
+/// # Errors
+/// [`OctreeError::Overflow`] or [`OctreeError::DepthTooLarge`] past the lattice.
+pub fn scale_space(bbox: (Voxel, Voxel), k: [i64; 3]) -> Result<(u8, Voxel), OctreeError> {
+    let (blo, bhi) = bbox;
+    let (mut lo, mut hi) = ([0i128; 3], [0i128; 3]);
+    for a in 0..3 {
+        let f = i128::from(k[a]);
+        let (p, q) = (f * i128::from(blo[a]), f * (i128::from(bhi[a]) + 1));
+        lo[a] = p.min(q);
+        hi[a] = p.max(q) - 1;
+    }
+    space_for(lo, hi)
+}
+
+/// The smallest space holding the image of the voxel box `bbox` (inclusive) under
+/// the affine map `q = m·p + t`, with a voxel of margin.
+///
+/// # Errors
+/// [`OctreeError::Overflow`] or [`OctreeError::DepthTooLarge`] past the lattice.
+pub fn affine_space(
+    bbox: (Voxel, Voxel),
+    m: [[f64; 3]; 3],
+    t: [f64; 3],
+) -> Result<(u8, Voxel), OctreeError> {
+    let (blo, bhi) = bbox;
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for corner in 0..8 {
+        let p: [f64; 3] = std::array::from_fn(|a| {
+            if corner >> a & 1 == 0 {
+                blo[a] as f64
+            } else {
+                bhi[a] as f64 + 1.0
+            }
+        });
+        for i in 0..3 {
+            let q = (0..3).map(|j| m[i][j] * p[j]).sum::<f64>() + t[i];
+            lo[i] = lo[i].min(q);
+            hi[i] = hi[i].max(q);
+        }
+    }
+    let limit = 2f64.powi(62);
+    if !(0..3).all(|a| lo[a].abs() < limit && hi[a].abs() < limit) {
+        return Err(OctreeError::Overflow);
+    }
+    space_for(
+        lo.map(|c| c.floor() as i128 - 1),
+        hi.map(|c| c.ceil() as i128 + 1),
+    )
 }
 
 /// The matrix of a rotation by `degrees` about the unit vector along `axis`

@@ -16,7 +16,7 @@ mod resample;
 mod sort;
 mod transform;
 
-pub use affine::{rotation_matrix, BoxState};
+pub use affine::{affine_space, rotation_matrix, scale_space, BoxState};
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};

@@ -29,10 +29,13 @@
 //!   the frame's placement moves with them, so a point's world position follows the
 //!   same rigid motion whatever the frame. Translation by voxels keeps the frame.
 
+mod affine;
 mod frame;
 mod layer;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_affine;
 
 pub use frame::{Frame, FrameMismatch, FRAME_TOLERANCE};
 pub use layer::{Layer, LayerValue, Rgba};

@@ -10,17 +10,17 @@ use super::*;
 
 /// A world cube's state: black or free, with its colour and log-odds bits.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Cell {
-    black: bool,
+pub(super) struct Cell {
+    pub(super) black: bool,
     color: Option<Rgba>,
     log_odds: Option<u32>,
 }
 
 /// World cubes keyed by their lowest corner in units of 1/1024 (frames in these tests
 /// are dyadic, so the keys are exact).
-type World = HashMap<[i64; 3], Cell>;
+pub(super) type World = HashMap<[i64; 3], Cell>;
 
-fn key(p: [f64; 3]) -> [i64; 3] {
+pub(super) fn key(p: [f64; 3]) -> [i64; 3] {
     p.map(|c| {
         let k = c * 1024.0;
         assert_eq!(k, k.round(), "world coordinate {c} not on the test grid");
@@ -28,7 +28,7 @@ fn key(p: [f64; 3]) -> [i64; 3] {
     })
 }
 
-fn world(m: &Model) -> World {
+pub(super) fn world(m: &Model) -> World {
     let mut w = World::new();
     for v in m.tree.voxels() {
         let cell = Cell {
@@ -54,7 +54,7 @@ const ODDS: [f32; 3] = [0.85, -0.405, 3.5];
 
 /// A random model in frame `(h, t)`: black voxels, maybe colours, maybe free space
 /// and log-odds.
-fn random_model(rng: &mut Pcg64Mcg, h: f64, t: [f64; 3]) -> Model {
+pub(super) fn random_model(rng: &mut Pcg64Mcg, h: f64, t: [f64; 3]) -> Model {
     let origin: Voxel = std::array::from_fn(|_| rng.random_range(-6..6));
     let depth = 3;
     let mut black = Vec::new();
@@ -101,7 +101,7 @@ fn random_model(rng: &mut Pcg64Mcg, h: f64, t: [f64; 3]) -> Model {
     m
 }
 
-fn random_frame(rng: &mut Pcg64Mcg) -> (f64, [f64; 3]) {
+pub(super) fn random_frame(rng: &mut Pcg64Mcg) -> (f64, [f64; 3]) {
     let h = [0.25, 0.5, 1.0, 2.0][rng.random_range(0..4)];
     let t = std::array::from_fn(|_| h * f64::from(rng.random_range(-8..8)) + 0.125);
     (h, t)
@@ -164,7 +164,7 @@ fn expected_set_op(a: &Model, b: &Model, op: SetOp) -> World {
     out
 }
 
-fn check(m: &Model, expected: &World, what: &str, seed: u64) {
+pub(super) fn check(m: &Model, expected: &World, what: &str, seed: u64) {
     m.assert_valid();
     let got = world(m);
     assert_eq!(
@@ -198,7 +198,7 @@ fn set_operations_follow_the_world_model() {
     }
 }
 
-fn moved(w: &World, f: impl Fn([i64; 3]) -> Vec<[i64; 3]>) -> World {
+pub(super) fn moved(w: &World, f: impl Fn([i64; 3]) -> Vec<[i64; 3]>) -> World {
     w.iter()
         .flat_map(|(k, c)| f(*k).into_iter().map(move |k| (k, *c)))
         .collect()
