@@ -34,8 +34,8 @@ impl Model {
             return self.scale_up(k[0].trailing_zeros() as u8);
         }
         let mut frame = self.frame;
-        for a in 0..3 {
-            frame.translate[a] *= k[a] as f64;
+        for (t, &f) in frame.translate.iter_mut().zip(&k) {
+            *t *= f as f64;
         }
         let Some(bbox) = self.known_bbox() else {
             let tree = self.tree.scale_axes(k)?;
