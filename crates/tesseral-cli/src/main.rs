@@ -37,11 +37,13 @@ enum Command {
     Info(cmd::info::Args),
     /// Translates an octree by an integer vector.
     Translate(cmd::transform::TranslateArgs),
-    /// Rotates an octree by quarter turns about an axis.
+    /// Rotates an octree by quarter turns, or by any angle about any axis.
     Rotate(cmd::transform::RotateArgs),
+    /// Maps an octree by any affine map x -> M x + offset (point sampling).
+    Transform(cmd::affine::TransformArgs),
     /// Mirrors an octree in an axis.
     Mirror(cmd::transform::MirrorArgs),
-    /// Scales an octree by 2^K.
+    /// Scales an octree by 2^K or by any integer per axis.
     Scale(cmd::transform::ScaleArgs),
     /// Set operations: union, intersection, difference, xor.
     Op(cmd::op::Args),
@@ -76,6 +78,7 @@ fn main() -> ExitCode {
         Command::Info(args) => cmd::info::run(args),
         Command::Translate(args) => cmd::transform::translate(args),
         Command::Rotate(args) => cmd::transform::rotate(args),
+        Command::Transform(args) => cmd::affine::transform(args),
         Command::Mirror(args) => cmd::transform::mirror(args),
         Command::Scale(args) => cmd::transform::scale(args),
         Command::Op(args) => cmd::op::run(args),

@@ -9,7 +9,15 @@ pub const GROUPS: &[(&str, &[&str])] = &[
     ("Formats", &["convert"]),
     (
         "Octree operations",
-        &["translate", "rotate", "mirror", "scale", "op", "complement"],
+        &[
+            "translate",
+            "rotate",
+            "transform",
+            "mirror",
+            "scale",
+            "op",
+            "complement",
+        ],
     ),
     ("Motion", &["collide", "simulate", "plan"]),
     ("Dynamic octrees and Monte Carlo", &["replay", "rsmc"]),

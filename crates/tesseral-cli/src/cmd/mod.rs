@@ -1,5 +1,6 @@
 //! One module per subcommand. Each has an `Args` (clap derive) and a `run`.
 
+pub mod affine;
 pub mod budget;
 pub mod build;
 pub mod calc;

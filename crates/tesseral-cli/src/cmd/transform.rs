@@ -31,7 +31,7 @@ pub struct TranslateArgs {
     by: Option<[i64; 3]>,
     /// The displacement `X,Y,Z` in world units (metres for an OctoMap map); it must be
     /// a whole number of voxels.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_world_vector, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = super::affine::parse_world_vector, allow_hyphen_values = true)]
     by_world: Option<[f64; 3]>,
     /// The output octree file.
     #[arg(short, long)]
@@ -139,16 +139,36 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
 pub struct RotateArgs {
     /// The input octree file.
     input: PathBuf,
-    /// The axis of rotation.
-    #[arg(long, value_enum)]
-    axis: AxisArg,
-    /// Quarter turns, right-handed (about z, +x goes to +y); negative allowed.
+    /// The axis of rotation: x, y, z, or (with --degrees) a vector X,Y,Z.
+    #[arg(long, value_parser = super::affine::parse_axis, allow_hyphen_values = true)]
+    axis: [f64; 3],
+    /// Quarter turns, right-handed (about z, +x goes to +y); negative allowed. Exact,
+    /// within the space.
+    #[arg(
+        long,
+        allow_hyphen_values = true,
+        required_unless_present = "degrees",
+        conflicts_with = "degrees"
+    )]
+    turns: Option<i32>,
+    /// Any angle in degrees, right-handed, by point sampling at voxel centres (see
+    /// docs/octrees.md); reports the fragmentation (leaves before and after) on stderr.
     #[arg(long, allow_hyphen_values = true)]
-    turns: i32,
+    degrees: Option<f64>,
+    /// With --degrees: the point X,Y,Z (world units) the axis passes through; the
+    /// centre of the bounding box by default.
+    #[arg(long, value_parser = super::affine::parse_world_vector, allow_hyphen_values = true, requires = "degrees")]
+    about: Option<[f64; 3]>,
+    /// With --degrees: also rotate the result back and report the voxels lost and
+    /// gained.
+    #[arg(long, requires = "degrees")]
+    roundtrip: bool,
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
-    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis, turns.
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, axis,
+    /// turns; with --degrees: degrees, axis_vector, about, leaves_before,
+    /// leaves_after, voxels_before, roundtrip_lost, roundtrip_gained.
     #[arg(long)]
     json: bool,
     #[command(flatten)]
@@ -158,13 +178,49 @@ pub struct RotateArgs {
 pub fn rotate(args: RotateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
+    if let Some(degrees) = args.degrees {
+        if !degrees.is_finite() {
+            anyhow::bail!("--degrees `{degrees}`: not a finite angle");
+        }
+        let (out, extra) =
+            super::affine::rotate_degrees(&model, args.axis, degrees, args.about, args.roundtrip)?;
+        super::affine::report_fragmentation(&extra, args.json);
+        return octree::write(
+            &args.output,
+            &out,
+            &args.limits,
+            octree::Report {
+                json: args.json,
+                extra,
+            },
+        );
+    }
+    let turns = args.turns.unwrap_or(0);
+    let axis = match args.axis {
+        [1.0, 0.0, 0.0] => AxisArg::X,
+        [0.0, 1.0, 0.0] => AxisArg::Y,
+        [0.0, 0.0, 1.0] => AxisArg::Z,
+        _ => anyhow::bail!("--turns needs --axis x, y or z; a vector axis takes --degrees"),
+    };
+    let args = RotateQuarter { axis, turns, args };
+    rotate_quarter(args, model)
+}
+
+struct RotateQuarter {
+    axis: AxisArg,
+    turns: i32,
+    args: RotateArgs,
+}
+
+fn rotate_quarter(q: RotateQuarter, model: Model) -> Result<()> {
+    let RotateQuarter { axis, turns, args } = q;
     octree::write(
         &args.output,
-        &model.rotate_in_space(args.axis.into(), args.turns)?,
+        &model.rotate_in_space(axis.into(), turns)?,
         &args.limits,
         octree::Report {
             json: args.json,
-            extra: serde_json::json!({ "axis": axis_name(args.axis), "turns": args.turns }),
+            extra: serde_json::json!({ "axis": axis_name(axis), "turns": turns }),
         },
     )
 }
@@ -206,24 +262,78 @@ pub fn mirror(args: MirrorArgs) -> Result<()> {
 pub struct ScaleArgs {
     /// The input octree file.
     input: PathBuf,
-    /// The factor `2^K`: K > 0 scales up exactly, K < 0 scales down conservatively
-    /// (a block with any black voxel becomes black).
-    #[arg(long, value_parser = octree::parse_power_of_two, allow_hyphen_values = true)]
-    by: i32,
+    /// The factor: `2^K` (K > 0 scales up exactly, K < 0 scales down conservatively:
+    /// a block with any black voxel becomes black), a whole number N, or one integer
+    /// per axis `KX,KY,KZ` (each voxel becomes a KX × KY × KZ block; a negative factor
+    /// mirrors). Exact; the frame's placement scales with it.
+    #[arg(long, value_parser = parse_scale, allow_hyphen_values = true)]
+    by: ScaleBy,
     /// The output octree file.
     #[arg(short, long)]
     output: PathBuf,
-    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, scale_log2.
+    /// Print JSON: output, voxels, leaves, depth, origin, bbox_min, bbox_max, and
+    /// scale_log2 (for 2^K) or scale (per axis).
     #[arg(long)]
     json: bool,
     #[command(flatten)]
     limits: octree::OutArgs,
 }
 
+/// What `scale --by` asks for.
+#[derive(Clone, Copy)]
+pub enum ScaleBy {
+    /// `2^K`.
+    PowerOfTwo(i32),
+    /// An integer per axis.
+    Axes([i64; 3]),
+}
+
+fn parse_scale(text: &str) -> Result<ScaleBy, String> {
+    if text.contains(',') {
+        let k = octree::parse_vector(text)?;
+        if let Some(a) = k.iter().position(|&c| c == 0) {
+            return Err(format!(
+                "`{text}`: the factor along {} is 0, which collapses the solid",
+                ["x", "y", "z"][a]
+            ));
+        }
+        if k.iter().any(|c| c.unsigned_abs() > 1 << 20) {
+            return Err(format!("`{text}`: factors must lie within ±2^20"));
+        }
+        return Ok(ScaleBy::Axes(k));
+    }
+    if let Ok(k) = octree::parse_power_of_two(text) {
+        return Ok(ScaleBy::PowerOfTwo(k));
+    }
+    match text.trim().parse::<i64>() {
+        Ok(0) => Err(format!("`{text}`: a factor of 0 collapses the solid")),
+        Ok(n) if n.unsigned_abs() <= 1 << 20 => Ok(ScaleBy::Axes([n; 3])),
+        _ => Err(format!(
+            "`{text}`: expected 2^K, a whole number, or KX,KY,KZ (such as 3,1,2)"
+        )),
+    }
+}
+
 pub fn scale(args: ScaleArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
-    let k = args.by;
+    let k = match args.by {
+        ScaleBy::PowerOfTwo(k) => k,
+        ScaleBy::Axes(k) => {
+            let scaled = model
+                .scale_axes(k)
+                .with_context(|| format!("scaling {} by {k:?}", args.input.display()))?;
+            return octree::write(
+                &args.output,
+                &scaled,
+                &args.limits,
+                octree::Report {
+                    json: args.json,
+                    extra: serde_json::json!({ "scale": k }),
+                },
+            );
+        }
+    };
     let scaled = if k >= 0 {
         model.scale_up(k as u8)
     } else {
@@ -268,23 +378,6 @@ pub fn complement(args: ComplementArgs) -> Result<()> {
             extra: serde_json::json!({}),
         },
     )
-}
-
-/// Parses `X,Y,Z` in world units.
-fn parse_world_vector(text: &str) -> Result<[f64; 3], String> {
-    let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!("expected three numbers `X,Y,Z`, got `{text}`"));
-    }
-    let mut v = [0.0; 3];
-    for (a, p) in parts.iter().enumerate() {
-        v[a] = p
-            .parse::<f64>()
-            .ok()
-            .filter(|x| x.is_finite())
-            .ok_or_else(|| format!("`{p}` is not a finite number (in `{text}`)"))?;
-    }
-    Ok(v)
 }
 
 /// The axis's name in JSON output.

@@ -529,6 +529,6 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
 #[cfg(test)]
 pub(crate) mod tests;
 #[cfg(test)]
-pub(crate) mod tests_ops;
-#[cfg(test)]
 mod tests_affine;
+#[cfg(test)]
+pub(crate) mod tests_ops;

@@ -21,9 +21,7 @@ fn random_tree(rng: &mut Pcg64, depth: u8, density: f64) -> (LinearOctree, HashS
             for y in 0..side {
                 for z in 0..side {
                     let d = [x - c[0], y - c[1], z - c[2]];
-                    if d.iter().map(|v| v * v).sum::<i64>() <= r * r
-                        || rng.random_bool(density)
-                    {
+                    if d.iter().map(|v| v * v).sum::<i64>() <= r * r || rng.random_bool(density) {
                         set.insert([origin[0] + x, origin[1] + y, origin[2] + z]);
                     }
                 }
@@ -133,7 +131,10 @@ fn affine_maps_are_point_sampled_exactly() {
             * 4.0
             + 10.0;
         let c: [f64; 3] = std::array::from_fn(|i| {
-            (0..3).map(|j| m[i][j] * (blo[j] + bhi[j] + 1) as f64 / 2.0).sum::<f64>() + off[i]
+            (0..3)
+                .map(|j| m[i][j] * (blo[j] + bhi[j] + 1) as f64 / 2.0)
+                .sum::<f64>()
+                + off[i]
         });
         let mut want = 0u64;
         let lo = c.map(|v| (v - r) as i64);
@@ -147,11 +148,20 @@ fn affine_maps_are_point_sampled_exactly() {
                     });
                     let black = set.contains(&p);
                     want += u64::from(black);
-                    assert_eq!(out.contains([x, y, z]), black, "case {case}: {:?}", [x, y, z]);
+                    assert_eq!(
+                        out.contains([x, y, z]),
+                        black,
+                        "case {case}: {:?}",
+                        [x, y, z]
+                    );
                 }
             }
         }
-        assert_eq!(out.voxel_count(), want, "case {case}: voxels outside the box");
+        assert_eq!(
+            out.voxel_count(),
+            want,
+            "case {case}: voxels outside the box"
+        );
     }
 }
 

@@ -72,7 +72,10 @@ impl Model {
         let Some((lo, hi)) = self.tree.bbox() else {
             return self.frame.translate;
         };
-        let (a, b) = (self.frame.voxel_corner(lo), self.frame.voxel_corner(hi.map(|c| c + 1)));
+        let (a, b) = (
+            self.frame.voxel_corner(lo),
+            self.frame.voxel_corner(hi.map(|c| c + 1)),
+        );
         std::array::from_fn(|i| (a[i] + b[i]) / 2.0)
     }
 

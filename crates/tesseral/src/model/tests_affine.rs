@@ -71,7 +71,11 @@ fn values_follow_their_voxels_under_any_rotation() {
         let r = m.rotate_about(rot, about).unwrap();
         r.assert_valid();
         // Each output voxel carries the values of the voxel its centre came from.
-        for w in r.tree.voxels().chain(r.free.iter().flat_map(|f| f.voxels())) {
+        for w in r
+            .tree
+            .voxels()
+            .chain(r.free.iter().flat_map(|f| f.voxels()))
+        {
             let c = r.frame.to_world(w.map(|x| x as f64 + 0.5));
             let d = [0, 1, 2].map(|i| c[i] - about[i]);
             // The inverse of a rotation is its transpose.

@@ -1,0 +1,66 @@
+//! The tesseral side of `benches/openvdb-transform/run.sh`: a solid sphere of radius
+//! R (voxel centres inside) rotated by DEGREES about z through the origin with
+//! point sampling, on one thread; best of 5.
+//!
+//! `cargo run --release -p tesseral --example rotate_sphere -- [R] [DEGREES]`
+
+use std::time::Instant;
+
+use tesseral::linear::{rotation_matrix, CellClass, LinearOctree};
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let r: i64 = args.next().map_or(100, |a| a.parse().expect("radius"));
+    let degrees: f64 = args.next().map_or(30.0, |a| a.parse().expect("degrees"));
+    // In doubled coordinates the centre of voxel x is 2x + 1: inside when
+    // |2c|^2 <= 4 r^2, exactly as the OpenVDB harness fills its grid.
+    let sphere = move |min: [i64; 3], k: u8| {
+        let s = 1i64 << k;
+        let (mut near, mut far) = (0i64, 0i64);
+        for &m in &min {
+            let (lo, hi) = (2 * m + 1, 2 * (m + s) - 1);
+            let n = if lo > 0 {
+                lo
+            } else if hi < 0 {
+                hi
+            } else {
+                0
+            };
+            let f = lo.abs().max(hi.abs());
+            near += n * n;
+            far += f * f;
+        }
+        if far <= 4 * r * r {
+            CellClass::Inside
+        } else if near > 4 * r * r {
+            CellClass::Outside
+        } else {
+            CellClass::Partial
+        }
+    };
+    let depth = (64 - (2 * r + 2).leading_zeros()) as u8;
+    let half = 1i64 << (depth - 1);
+    let tree = LinearOctree::from_classifier(depth, [-half; 3], &sphere).expect("sphere");
+    let m = rotation_matrix([0.0, 0.0, 1.0], degrees);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("one thread");
+    let mut best = f64::MAX;
+    let mut out = None;
+    for _ in 0..5 {
+        let start = Instant::now();
+        let o = pool.install(|| tree.affine(m, [0.0; 3]).expect("rotate"));
+        best = best.min(start.elapsed().as_secs_f64());
+        out = Some(o);
+    }
+    let out = out.expect("five runs");
+    println!(
+        "tesseral: sphere r={r} ({} voxels, {} leaves) rotated {degrees} deg about z, one core: {:.1} ms, {} voxels, {} leaves",
+        tree.voxel_count(),
+        tree.leaf_count(),
+        best * 1e3,
+        out.voxel_count(),
+        out.leaf_count()
+    );
+}
