@@ -13,7 +13,9 @@
 //! white, and only the rest is split. The work then follows the output's leaves, not
 //! its voxels. A single voxel is decided by its centre exactly.
 
-use super::{CellClass, Classifier, LinearOctree, OctreeError, MAX_DEPTH};
+use rayon::prelude::*;
+
+use super::{push_merging, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
 use crate::Voxel;
 
 /// What an inclusive box of voxels holds.
@@ -161,43 +163,73 @@ trait Sampling: Sync {
     fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel);
 }
 
-struct MapClassifier<'a, S> {
-    input: &'a LinearOctree,
-    map: S,
+/// Builds the image of `input` under `map` in the space of `space` top-down: cells
+/// are classified by their preimage boxes, and a 2 × 2 × 2 cell is decided from its
+/// eight centres with one binary search (their codes are close), so no voxel is
+/// looked up twice.
+fn build_mapped<S: Sampling>(
+    input: &LinearOctree,
+    map: &S,
+    space: &LinearOctree,
+    code: u64,
+    k: u8,
+    out: &mut Vec<Leaf>,
+) {
+    let min = space.voxel_of(code);
+    if k == 0 {
+        if input.contains(map.preimage(min)) {
+            out.push(Leaf::new(code, 0));
+        }
+        return;
+    }
+    if k == 1 {
+        let bits = eight_centres(input, map, min);
+        if bits == 0xff {
+            push_merging(out, Leaf::new(code, 1));
+        } else {
+            out.extend((0..8u64).filter(|d| bits >> d & 1 == 1).map(|d| Leaf::new(code + d, 0)));
+        }
+        return;
+    }
+    let max = min.map(|c| c + (1i64 << k) - 1);
+    let (lo, hi) = map.preimage_box(min, max);
+    match input.box_state(lo, hi) {
+        BoxState::Empty => {}
+        BoxState::Full => out.push(Leaf::new(code, k)),
+        BoxState::Mixed => {
+            let cells = 1u64 << (3 * u32::from(k - 1));
+            if k >= PARALLEL_MIN_SIZE_LOG2 {
+                let parts: Vec<Vec<Leaf>> = (0..8u64)
+                    .into_par_iter()
+                    .map(|d| {
+                        let mut part = Vec::new();
+                        build_mapped(input, map, space, code + d * cells, k - 1, &mut part);
+                        part
+                    })
+                    .collect();
+                out.extend(parts.into_iter().flatten());
+            } else {
+                for d in 0..8 {
+                    build_mapped(input, map, space, code + d * cells, k - 1, out);
+                }
+            }
+            if let Some(last) = out.pop() {
+                push_merging(out, last);
+            }
+        }
+    }
 }
 
-impl<S: Sampling> Classifier for MapClassifier<'_, S> {
-    fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
-        let black = |state| match state {
-            BoxState::Empty => CellClass::Outside,
-            BoxState::Full => CellClass::Inside,
-            BoxState::Mixed => CellClass::Partial,
-        };
-        if size_log2 == 0 {
-            let v = self.map.preimage(min);
-            return if self.input.contains(v) {
-                CellClass::Inside
-            } else {
-                CellClass::Outside
-            };
-        }
-        if size_log2 == 1 {
-            // Eight centres: cheaper to test each than to query their box.
-            let mut n = 0;
-            for d in 0..8 {
-                let w = [0, 1, 2].map(|a| min[a] + ((d >> a) & 1));
-                n += u32::from(self.input.contains(self.map.preimage(w)));
-            }
-            return match n {
-                0 => CellClass::Outside,
-                8 => CellClass::Inside,
-                _ => CellClass::Partial,
-            };
-        }
-        let max = min.map(|c| c + (1i64 << size_log2) - 1);
-        let (lo, hi) = self.map.preimage_box(min, max);
-        black(self.input.box_state(lo, hi))
-    }
+/// Below this cell size (log2) the recursion stays on one thread.
+const PARALLEL_MIN_SIZE_LOG2: u8 = 5;
+
+/// Bit `d` set when the centre of voxel `min + d` (child label `d`) maps into a
+/// black voxel.
+fn eight_centres<S: Sampling>(input: &LinearOctree, map: &S, min: Voxel) -> u8 {
+    (0..8u8).fold(0, |bits, d| {
+        let w = [0, 1, 2].map(|a| min[a] + i64::from((d >> a) & 1));
+        bits | (u8::from(input.contains(map.preimage(w))) << d)
+    })
 }
 
 /// Scaling by an integer per axis: `w ↦ floor((2w + 1) / 2k)`, exact.
@@ -301,6 +333,20 @@ fn space_for(lo: [i128; 3], hi: [i128; 3]) -> Result<(u8, Voxel), OctreeError> {
 }
 
 impl LinearOctree {
+    /// The image of `input` under `map` in the space `(depth, origin)`.
+    fn mapped<S: Sampling>(
+        input: &Self,
+        map: &S,
+        depth: u8,
+        origin: Voxel,
+    ) -> Result<Self, OctreeError> {
+        super::check_space(depth, origin)?;
+        let space = Self::from_parts(depth, origin, Vec::new());
+        let mut leaves = Vec::new();
+        build_mapped(input, map, &space, 0, depth, &mut leaves);
+        Ok(Self::from_parts(depth, origin, leaves))
+    }
+
     /// The tree scaled by the integer `k[a]` along each axis about the lattice origin:
     /// voxel `v` becomes the block of voxels `w` with `floor((w + ½)/k) = v`, so
     /// `k = (3, 1, 2)` turns each voxel into a 3 × 1 × 2 block and a negative factor
@@ -351,11 +397,7 @@ impl LinearOctree {
                 "a scale factor of 0 collapses the solid".into(),
             ));
         }
-        let classifier = MapClassifier {
-            input: self,
-            map: IntScale(k),
-        };
-        Self::from_classifier(depth, origin, &classifier)
+        Self::mapped(self, &IntScale(k), depth, origin)
     }
 
     /// The tree under the affine map `q = m·p + t` of continuous lattice coordinates
@@ -400,11 +442,7 @@ impl LinearOctree {
             return Err(bad());
         }
         let inv = inverse(m).ok_or_else(bad)?;
-        let classifier = MapClassifier {
-            input: self,
-            map: Affine { inv, t },
-        };
-        Self::from_classifier(depth, origin, &classifier)
+        Self::mapped(self, &Affine { inv, t }, depth, origin)
     }
 }
 
