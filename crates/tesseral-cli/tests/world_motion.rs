@@ -146,3 +146,35 @@ fn simulations_follow_the_frame_rule() {
     placed("fine.tess", 0.25, 0.0);
     fails(d, &["simulate", "world.json"], "voxel sizes differ");
 }
+
+/// Issue 16 §5: a long bar passes an L-shaped corridor only by turning.
+#[test]
+fn plan_turns_a_bar_through_an_l_shaped_corridor() {
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let d = scenes.as_path();
+    let args = |extra: &[&'static str]| -> Vec<&'static str> {
+        let mut a = vec![
+            "plan",
+            "l-corridor.xyz",
+            "bar.xyz",
+            "--from",
+            "-12,0,0",
+            "--to",
+            "6,20,0",
+            "--json",
+        ];
+        a.extend_from_slice(extra);
+        a
+    };
+    let out = common::run(d, &args(&[]));
+    assert_eq!(out.status.code(), Some(1), "no path without turning");
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert!(v["reason"].as_str().unwrap().contains("at the goal"), "{v}");
+    let v = json(d, &args(&["--rotations"]));
+    assert_eq!(v["found"], true, "{v}");
+    assert!(v["turns"].as_u64().unwrap() >= 1);
+    let w = v["waypoints"].as_array().unwrap();
+    assert_eq!(w.first().unwrap(), &serde_json::json!([-12, 0, 0]));
+    assert_eq!(w.last().unwrap(), &serde_json::json!([6, 20, 0]));
+    assert_eq!(w.len(), v["orientations"].as_array().unwrap().len());
+}

@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use serde::Serialize;
 use tesseral::model::Frame;
-use tesseral::motion::{estimate_plan, plan, render_plan, Aabb, PlanOptions, Rotation};
+use tesseral::motion::{
+    estimate_plan, plan, plan_with_turns, render_plan, Aabb, PlanOptions, Rotation,
+};
 use tesseral::render::{Camera, RenderOptions, View};
 use tesseral::Voxel;
 
@@ -41,6 +43,11 @@ pub struct Args {
     /// in; replaces the bounding box and --margin.
     #[arg(long, value_parser = parse_region, allow_hyphen_values = true)]
     region: Option<Aabb>,
+    /// Let the object turn by quarter turns about x, y and z on the way (over the 24
+    /// orientations of the cube, each turn checked along its sweep); --rotate gives
+    /// the starting orientation. Paths are unit moves and turns, not smoothed.
+    #[arg(long, conflicts_with_all = ["no_smooth", "output"])]
+    rotations: bool,
     /// Keep the raw A* path (no smoothing).
     #[arg(long)]
     no_smooth: bool,
@@ -159,6 +166,9 @@ pub fn run(args: Args) -> Result<()> {
             hint,
         )?;
     }
+    if args.rotations {
+        return plan_turning(&args, &env, &obj, &frame, &options);
+    }
     let result = plan(&env, &obj, args.from, args.to, &options);
     if let Some(path) = &args.output {
         picture(
@@ -230,6 +240,60 @@ pub fn run(args: Args) -> Result<()> {
             }
             out.flush()?;
             // No path is an answer, not a failure of the command: exit status 1.
+            std::process::exit(1);
+        }
+    }
+}
+
+/// `plan --rotations`: A* over (offset, orientation), moves and quarter turns.
+fn plan_turning(
+    args: &Args,
+    env: &tesseral::linear::LinearOctree,
+    obj: &tesseral::linear::LinearOctree,
+    frame: &Frame,
+    options: &PlanOptions,
+) -> Result<()> {
+    let mut out = std::io::stdout().lock();
+    match plan_with_turns(env, obj, args.from, args.to, args.rotate, options) {
+        Ok(p) => {
+            let waypoints = p.waypoints();
+            if args.json {
+                let v = serde_json::json!({
+                    "found": true,
+                    "waypoints": waypoints.iter().map(|w| w.0).collect::<Vec<_>>(),
+                    "orientations": waypoints.iter().map(|w| w.1.to_string()).collect::<Vec<_>>(),
+                    "moves": p.moves,
+                    "turns": p.turns,
+                    "settled": p.settled,
+                    "voxel_size": frame.voxel_size,
+                    "waypoints_world": waypoints.iter().map(|w| world(frame, w.0)).collect::<Vec<_>>(),
+                });
+                writeln!(out, "{v}")?;
+            } else {
+                writeln!(
+                    out,
+                    "path: {} waypoints, {} unit moves and {} quarter turns",
+                    waypoints.len(),
+                    p.moves,
+                    p.turns
+                )?;
+                for (w, r) in &waypoints {
+                    writeln!(out, "{},{},{} {r}", w[0], w[1], w[2])?;
+                }
+            }
+            Ok(())
+        }
+        Err(why) => {
+            if args.json {
+                writeln!(
+                    out,
+                    "{}",
+                    serde_json::json!({"found": false, "reason": why.to_string()})
+                )?;
+            } else {
+                writeln!(out, "{why}")?;
+            }
+            out.flush()?;
             std::process::exit(1);
         }
     }

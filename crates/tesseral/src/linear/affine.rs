@@ -187,7 +187,11 @@ fn build_mapped<S: Sampling>(
         if bits == 0xff {
             push_merging(out, Leaf::new(code, 1));
         } else {
-            out.extend((0..8u64).filter(|d| bits >> d & 1 == 1).map(|d| Leaf::new(code + d, 0)));
+            out.extend(
+                (0..8u64)
+                    .filter(|d| bits >> d & 1 == 1)
+                    .map(|d| Leaf::new(code + d, 0)),
+            );
         }
         return;
     }

@@ -21,6 +21,7 @@ mod interfere;
 mod orient;
 mod plan;
 mod plan_estimate;
+mod plan_turns;
 mod simulate;
 mod sweep;
 mod traverse;
@@ -41,6 +42,7 @@ pub use plan::{
     config_obstacles, minkowski_sum, plan, reflected, rotated, NoPath, Plan, PlanOptions,
 };
 pub use plan_estimate::{estimate_plan, PlanEstimate, PLAN_BYTES_PER_CELL};
+pub use plan_turns::{plan_with_turns, quarter_turn_sweep, TurnPlan};
 pub use simulate::Step;
 #[cfg(test)]
 use sweep::first_contact_brute;
@@ -56,3 +58,5 @@ pub use world_file::{
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_turns;

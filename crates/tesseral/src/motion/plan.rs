@@ -182,7 +182,7 @@ pub fn minkowski_sum(a: &LinearOctree, b: &LinearOctree) -> Result<LinearOctree,
     minkowski_in(a, b, depth, origin)
 }
 
-fn minkowski_in(
+pub(crate) fn minkowski_in(
     a: &LinearOctree,
     b: &LinearOctree,
     depth: u8,
