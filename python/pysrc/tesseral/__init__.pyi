@@ -1,0 +1,20 @@
+from ._tesseral import (
+    DynamicOctree as DynamicOctree,
+    FormatError as FormatError,
+    Octree as Octree,
+    OctreeError as OctreeError,
+    Scene as Scene,
+    SceneError as SceneError,
+    __version__ as __version__,
+    collide as collide,
+    plan as plan,
+    render as render,
+    simulate as simulate,
+)
+from . import _tesseral
+
+class calc:
+    encode = _tesseral.encode
+    decode = _tesseral.decode
+    add = _tesseral.add
+    sub = _tesseral.sub

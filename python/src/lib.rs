@@ -1,0 +1,34 @@
+//! Python bindings of tesseral: the `tesseral._tesseral` extension module, wrapped by
+//! the pure-Python package in `pysrc/tesseral`. Arrays cross as numpy arrays (one copy
+//! at most), and long calls release the GIL.
+
+use pyo3::prelude::*;
+
+mod arrays;
+mod calc;
+mod dynamic;
+mod errors;
+mod motion;
+mod octree;
+mod scene;
+
+#[pymodule]
+fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = m.py();
+    m.add("FormatError", py.get_type::<errors::FormatError>())?;
+    m.add("SceneError", py.get_type::<errors::SceneError>())?;
+    m.add("OctreeError", py.get_type::<errors::OctreeError>())?;
+    m.add_class::<octree::Octree>()?;
+    m.add_class::<scene::Scene>()?;
+    m.add_class::<dynamic::DynamicOctree>()?;
+    m.add_function(wrap_pyfunction!(scene::render, m)?)?;
+    m.add_function(wrap_pyfunction!(motion::collide, m)?)?;
+    m.add_function(wrap_pyfunction!(motion::plan, m)?)?;
+    m.add_function(wrap_pyfunction!(motion::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(calc::encode, m)?)?;
+    m.add_function(wrap_pyfunction!(calc::decode, m)?)?;
+    m.add_function(wrap_pyfunction!(calc::add, m)?)?;
+    m.add_function(wrap_pyfunction!(calc::sub, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,246 @@
+//! `tesseral.Scene` and `tesseral.render`.
+
+use std::path::{Path, PathBuf};
+
+use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyBytes;
+use tesseral::csg::Scene as CsgScene;
+use tesseral::model::Model;
+use tesseral::render::{self as draw, Camera, Image, Projection, RenderOptions, View};
+
+use crate::errors;
+use crate::octree::Octree;
+
+/// A parsed `.tss` scene (see docs/scenes.md).
+#[pyclass(module = "tesseral", frozen)]
+pub struct Scene {
+    scene: CsgScene,
+}
+
+#[pymethods]
+impl Scene {
+    /// Parses scene text; errors raise SceneError with `line` and `column`.
+    #[staticmethod]
+    fn parse(py: Python<'_>, text: &str) -> PyResult<Scene> {
+        CsgScene::parse(text, Path::new("<scene>"))
+            .map(|scene| Scene { scene })
+            .map_err(|e| errors::scene(py, e))
+    }
+
+    /// Reads a `.tss` file.
+    #[staticmethod]
+    fn read(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
+        CsgScene::read(&path)
+            .map(|scene| Scene { scene })
+            .map_err(|e| errors::scene(py, e))
+    }
+
+    /// Builds the scene's octree with its frame and colours, at the scene's depth or
+    /// at `depth` (the same bounds, coarser or finer voxels).
+    #[pyo3(signature = (depth = None))]
+    fn build(&self, py: Python<'_>, depth: Option<u8>) -> PyResult<Octree> {
+        let scene = self.at_depth(depth)?;
+        py.allow_threads(|| scene.build_model_limited(tesseral::csg::DEFAULT_MAX_LEAVES))
+            .map(Octree::new)
+            .map_err(|e| errors::scene(py, e))
+    }
+
+    /// Depth of the scene's space.
+    #[getter]
+    fn depth(&self) -> u8 {
+        self.scene.depth
+    }
+
+    /// The number of top-level objects.
+    #[getter]
+    fn objects(&self) -> usize {
+        self.scene.objects
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene({} objects, depth {}, voxel {})",
+            self.scene.objects, self.scene.depth, self.scene.voxel
+        )
+    }
+
+    /// A PNG picture, for Jupyter.
+    fn _repr_png_<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyBytes>> {
+        let img = render_scene(py, &self.scene, &Options::default())?;
+        png(py, &img)
+    }
+}
+
+impl Scene {
+    fn at_depth(&self, depth: Option<u8>) -> PyResult<CsgScene> {
+        let mut s = self.scene.clone();
+        if let Some(d) = depth {
+            if !(1..=16).contains(&d) {
+                return Err(PyValueError::new_err(format!(
+                    "depth {d}: expected 1 to 16"
+                )));
+            }
+            s.voxel *= 2f64.powi(i32::from(s.depth) - i32::from(d));
+            s.depth = d;
+        }
+        Ok(s)
+    }
+}
+
+/// The render options a Python call can give.
+pub struct Options {
+    pub size: (usize, usize),
+    pub view: View,
+    pub azimuth: Option<f64>,
+    pub elevation: Option<f64>,
+    pub zoom: f64,
+    pub outline: bool,
+    pub shadows: bool,
+    pub perspective: Option<f64>,
+    pub background: [u8; 3],
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            size: (480, 360),
+            view: View::Iso,
+            azimuth: None,
+            elevation: None,
+            zoom: 1.0,
+            outline: false,
+            shadows: true,
+            perspective: None,
+            background: [255, 255, 255],
+        }
+    }
+}
+
+impl Options {
+    fn render_options(&self) -> RenderOptions {
+        let (az, el) = self.view.angles();
+        RenderOptions {
+            width: self.size.0,
+            height: self.size.1,
+            camera: Camera {
+                azimuth_deg: self.azimuth.unwrap_or(az),
+                elevation_deg: self.elevation.unwrap_or(el),
+                zoom: self.zoom,
+                projection: self
+                    .perspective
+                    .map_or(Projection::Orthographic, |fov_deg| {
+                        Projection::Perspective { fov_deg }
+                    }),
+            },
+            outline: self.outline,
+            shadows: self.shadows,
+            background: self.background,
+            ..RenderOptions::default()
+        }
+    }
+}
+
+/// A model drawn with its stored colours.
+pub fn render_model(py: Python<'_>, m: &Model, o: &Options) -> PyResult<Image> {
+    let opts = o.render_options();
+    Ok(py.allow_threads(|| {
+        let stored = m.colors.as_ref().map(|l| {
+            move |p: [f64; 3]| {
+                l.get(p.map(|c| c.floor() as i64))
+                    .map_or(draw::DEFAULT_COLOUR, |c| [c[0], c[1], c[2]])
+            }
+        });
+        let surface = draw::Surface {
+            colour: stored
+                .as_ref()
+                .map(|f| f as &(dyn Fn([f64; 3]) -> [u8; 3] + Sync)),
+            normal: None,
+        };
+        draw::render(&m.tree, surface, &opts)
+    }))
+}
+
+/// A scene drawn with its objects' colours and exact normals.
+fn render_scene(py: Python<'_>, scene: &CsgScene, o: &Options) -> PyResult<Image> {
+    let csg = scene.csg().map_err(|e| errors::scene(py, e))?;
+    let tree = py
+        .allow_threads(|| scene.build())
+        .map_err(|e| errors::scene(py, e))?;
+    let opts = o.render_options();
+    Ok(py.allow_threads(|| {
+        let colour = |p: [f64; 3]| csg.colour_at(p).map_or(draw::DEFAULT_COLOUR, |k| k.0);
+        let normal = |p: [f64; 3]| csg.normal_at(p);
+        let surface = draw::Surface {
+            colour: Some(&colour),
+            normal: Some(&normal),
+        };
+        draw::render(&tree, surface, &opts)
+    }))
+}
+
+/// PNG bytes of an image.
+pub fn png<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyBytes>> {
+    let mut buf = Vec::new();
+    img.encode_png(&mut buf)
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    Ok(PyBytes::new(py, &buf))
+}
+
+/// Renders an Octree or a Scene as an H×W×3 uint8 array. Keyword arguments are the
+/// CLI's options: size=(w, h), view ('iso', 'front', 'top', 'side'), azimuth,
+/// elevation, zoom, outline, shadows, perspective (field of view in degrees),
+/// background (r, g, b).
+#[pyfunction]
+#[pyo3(signature = (obj, size = (800, 600), view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = (255, 255, 255)))]
+#[allow(clippy::too_many_arguments)]
+pub fn render<'py>(
+    py: Python<'py>,
+    obj: &Bound<'py, PyAny>,
+    size: (usize, usize),
+    view: &str,
+    azimuth: Option<f64>,
+    elevation: Option<f64>,
+    zoom: f64,
+    outline: bool,
+    shadows: bool,
+    perspective: Option<f64>,
+    background: (u8, u8, u8),
+) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    let view = View::parse(view).ok_or_else(|| {
+        PyValueError::new_err(format!("view {view:?}: expected iso, front, top or side"))
+    })?;
+    if !(16..=8192).contains(&size.0) || !(16..=8192).contains(&size.1) {
+        return Err(PyValueError::new_err(format!(
+            "size {size:?}: each side must be 16 to 8192 pixels"
+        )));
+    }
+    let finite = |x: Option<f64>| x.is_none_or(f64::is_finite);
+    if !(finite(azimuth) && finite(elevation) && zoom.is_finite() && zoom > 0.0) {
+        return Err(PyValueError::new_err(
+            "azimuth, elevation and zoom must be finite (zoom positive)",
+        ));
+    }
+    let o = Options {
+        size,
+        view,
+        azimuth,
+        elevation,
+        zoom,
+        outline,
+        shadows,
+        perspective,
+        background: [background.0, background.1, background.2],
+    };
+    let img = if let Ok(t) = obj.downcast::<Octree>() {
+        render_model(py, &t.get().model, &o)?
+    } else if let Ok(s) = obj.downcast::<Scene>() {
+        render_scene(py, &s.get().scene, &o)?
+    } else {
+        return Err(PyValueError::new_err("render takes an Octree or a Scene"));
+    };
+    let (w, h) = (img.width, img.height);
+    let flat: Vec<u8> = img.pixels.into_iter().flatten().collect();
+    flat.into_pyarray(py).reshape([h, w, 3])
+}
