@@ -132,8 +132,8 @@ impl Octree {
     fn voxels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
         let t = &self.model.tree;
         let v: Vec<[i64; 3]> = py.allow_threads(|| {
-            let mut v = Vec::with_capacity(t.voxel_count() as usize);
-            v.extend(t.voxels());
+            let mut v = Vec::new();
+            t.voxels_into(&mut v);
             v
         });
         to_array(py, v)

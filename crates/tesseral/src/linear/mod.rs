@@ -8,6 +8,7 @@
 
 mod affine;
 mod build;
+mod enumerate;
 pub(crate) mod grow;
 mod leaf;
 mod node_list;

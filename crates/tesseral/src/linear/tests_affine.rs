@@ -177,3 +177,20 @@ fn quarter_turns_agree_with_the_exact_rotation() {
         assert_eq!(r.voxels().collect::<HashSet<_>>(), want);
     }
 }
+
+#[test]
+fn voxels_into_is_voxels() {
+    let mut rng = Pcg64::seed_from_u64(34);
+    for _ in 0..100 {
+        let depth = rng.random_range(0..7);
+        let (t, _) = random_tree(&mut rng, depth.min(5), 0.02);
+        let mut v = Vec::new();
+        t.voxels_into(&mut v);
+        assert_eq!(v, t.voxels().collect::<Vec<_>>());
+    }
+    // Leaves larger than the table's 16³.
+    let big = LinearOctree::full(6, [-3, 5, 7]).unwrap();
+    let mut v = Vec::new();
+    big.voxels_into(&mut v);
+    assert_eq!(v, big.voxels().collect::<Vec<_>>());
+}

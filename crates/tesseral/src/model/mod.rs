@@ -350,6 +350,11 @@ impl Model {
         )?)
     }
 
+    /// Whether the model has colours, free space or log-odds.
+    fn has_layers(&self) -> bool {
+        self.colors.is_some() || self.free.is_some() || self.log_odds.is_some()
+    }
+
     /// The complement within the space: the white voxels become black. Colours,
     /// free space and log-odds do not carry over (they describe the old voxels).
     #[must_use]
@@ -365,6 +370,15 @@ impl Model {
     /// [`LinearOctree::set_op`].
     pub fn set_op(&self, other: &Self, op: SetOp) -> Result<Self, ModelError> {
         let off = self.frame.offset_to(&other.frame)?;
+        if !self.has_layers() && !other.has_layers() {
+            // Solids only: the trees' own operation, with the same spaces.
+            let tree = if off == [0; 3] {
+                self.tree.set_op(&other.tree, op)?
+            } else {
+                self.tree.set_op(&other.tree.translate(off)?, op)?
+            };
+            return Ok(Self::new(tree).with_frame(self.frame));
+        }
         let b = if off == [0; 3] {
             other.clone()
         } else {
