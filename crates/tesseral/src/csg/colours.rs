@@ -211,7 +211,12 @@ mod tests {
         let extra = "depth 5\nbounds [0, 0, 0] [32, 32, 32]\nunion { box(size = 20) at [12, 12, 12] colour \"red\" sphere(r = 9) at [18, 18, 18] } colour \"blue\"\nsphere(r = 6) at [8, 8, 8]\n";
         let mut scenes = vec![Scene::parse(extra, "extra.tss".as_ref()).unwrap()];
         for entry in std::fs::read_dir(dir).unwrap() {
-            let mut scene = Scene::read(&entry.unwrap().path()).unwrap();
+            // scenes/ also holds octree files (bar.xyz, l-corridor.xyz) for the motion tests.
+            let path = entry.unwrap().path();
+            if path.extension().is_none_or(|e| e != "tss") {
+                continue;
+            }
+            let mut scene = Scene::read(&path).unwrap();
             let old = scene.depth;
             scene.depth = 5;
             scene.voxel *= f64::from(1u32 << (old - 5));
