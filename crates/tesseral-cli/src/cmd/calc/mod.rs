@@ -68,7 +68,7 @@ enum Op {
     },
     /// Tesseral division B / A by the P-adic method: exact on each axis whose divisor
     /// is odd, a 2-adic number with repeating digits when not an integer (such as
-    /// ...[01]1, 1/3 along x).
+    /// ...\[01\]1, 1/3 along x).
     Div {
         /// The dividend: octal code, e.g. 6530.
         #[arg(allow_hyphen_values = true)]
