@@ -283,7 +283,8 @@ fn errors_exit_2_with_one_line() {
         ],
     );
     fails(d, &["mirror", "a.xyz", "-o", "o.xyz"]);
-    fails(d, &["scale", "a.xyz", "--by", "3", "-o", "o.xyz"]);
+    fails(d, &["scale", "a.xyz", "--by", "0", "-o", "o.xyz"]);
+    fails(d, &["scale", "a.xyz", "--by", "1.5", "-o", "o.xyz"]);
     fails(d, &["scale", "a.xyz", "--by", "2^x", "-o", "o.xyz"]);
     let err = fails(d, &["scale", "a.xyz", "--by", "2^20", "-o", "o.xyz"]);
     assert!(err.contains("depth"), "{err}");

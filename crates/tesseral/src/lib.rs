@@ -22,5 +22,14 @@ pub mod pointer;
 pub mod render;
 pub mod rsmc;
 
+// The main types at the crate root, as rstar does: `tesseral::LinearOctree` and
+// friends; the modules stay public for everything else.
+pub use csg::{Scene, SceneError};
+pub use dynamic::DynamicOctree;
+pub use io::{read_model, write_model, FormatError};
+pub use linear::{LinearOctree, OctreeError, SetOp};
+pub use model::{Frame, Model, ModelError};
+pub use pointer::PointerOctree;
+
 /// A voxel (or any lattice point) in world coordinates.
 pub type Voxel = [i64; 3];

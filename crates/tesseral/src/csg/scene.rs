@@ -253,7 +253,7 @@ impl Scene {
 
 /// The closest of `known` to `word` (Levenshtein), when close enough to be a typo.
 #[must_use]
-pub fn closest<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+pub(crate) fn closest<'a>(word: &str, known: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
     let w = word.to_ascii_lowercase();
     let mut best: Option<(usize, &str)> = None;
     for k in known {
