@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use tesseral::linear::rotation_matrix;
+use tesseral::linear::{invert_matrix, rotation_matrix};
 use tesseral::model::Model;
 
 use super::octree;
@@ -165,18 +165,9 @@ pub struct TransformArgs {
 
 /// The inverse of an affine world map, for `--roundtrip`.
 fn inverse_map(m: [[f64; 3]; 3], offset: [f64; 3]) -> Result<([[f64; 3]; 3], [f64; 3])> {
-    let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-        - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-        + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
-    if det.abs() < 1e-12 {
-        bail!("--matrix is singular (determinant {det})");
-    }
-    let c = |i: usize, j: usize| {
-        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
-        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
-        m[r0][c0] * m[r1][c1] - m[r0][c1] * m[r1][c0]
+    let Some(inv) = invert_matrix(m) else {
+        bail!("--matrix is singular or not finite");
     };
-    let inv: [[f64; 3]; 3] = std::array::from_fn(|i| std::array::from_fn(|j| c(j, i) / det));
     let t = std::array::from_fn(|i| -(0..3).map(|j| inv[i][j] * offset[j]).sum::<f64>());
     Ok((inv, t))
 }

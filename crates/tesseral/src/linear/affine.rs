@@ -300,7 +300,10 @@ impl Sampling for Affine {
     }
 }
 
-fn inverse(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
+/// The inverse of a 3 × 3 matrix by cofactors, or `None` when it is singular
+/// (|det| < 1e-12) or not finite.
+#[must_use]
+pub fn invert_matrix(m: [[f64; 3]; 3]) -> Option<[[f64; 3]; 3]> {
     let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
         - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
         + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
@@ -445,7 +448,7 @@ impl LinearOctree {
         if !t.iter().chain(m.iter().flatten()).all(|c| c.is_finite()) {
             return Err(bad());
         }
-        let inv = inverse(m).ok_or_else(bad)?;
+        let inv = invert_matrix(m).ok_or_else(bad)?;
         Self::mapped(self, &Affine { inv, t }, depth, origin)
     }
 }
@@ -544,6 +547,6 @@ pub fn rotation_matrix(axis: [f64; 3], degrees: f64) -> [[f64; 3]; 3] {
 pub(super) mod tests_support {
     /// The inverse the maps use, for the brute-force tests.
     pub fn inverse(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
-        super::inverse(m).expect("regular")
+        super::invert_matrix(m).expect("regular")
     }
 }

@@ -17,7 +17,7 @@ mod resample;
 mod sort;
 mod transform;
 
-pub use affine::{affine_space, rotation_matrix, scale_space, BoxState};
+pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space, BoxState};
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};
