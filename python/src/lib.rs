@@ -10,6 +10,7 @@ mod dynamic;
 mod errors;
 mod motion;
 mod octree;
+mod rsmc;
 mod scene;
 
 #[pymodule]
@@ -25,6 +26,7 @@ fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(motion::collide, m)?)?;
     m.add_function(wrap_pyfunction!(motion::plan, m)?)?;
     m.add_function(wrap_pyfunction!(motion::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(rsmc::rsmc, m)?)?;
     m.add_function(wrap_pyfunction!(calc::encode, m)?)?;
     m.add_function(wrap_pyfunction!(calc::decode, m)?)?;
     m.add_function(wrap_pyfunction!(calc::add, m)?)?;

@@ -16,6 +16,7 @@ from ._tesseral import (
     collide,
     plan,
     render,
+    rsmc,
     simulate,
 )
 from . import _tesseral as _ext
@@ -41,6 +42,7 @@ __all__ = [
     "collide",
     "plan",
     "render",
+    "rsmc",
     "simulate",
     "__version__",
 ]

@@ -9,6 +9,7 @@ from ._tesseral import (
     collide as collide,
     plan as plan,
     render as render,
+    rsmc as rsmc,
     simulate as simulate,
 )
 from . import _tesseral

@@ -1,0 +1,188 @@
+//! `tesseral.rsmc`: Monte Carlo of self-avoiding random surfaces (Libes §6), with the
+//! trajectory returned as numpy arrays.
+
+use numpy::{IntoPyArray, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tesseral::dynamic::DynamicOctree;
+use tesseral::rsmc::{topology, Chain, DenseLattice, Lattice, Params};
+use tesseral::Voxel;
+
+use crate::arrays::{rows, to_array};
+
+/// The largest start shape, in voxels (the CLI's cap).
+const MAX_START_VOXELS: u64 = 1_000_000;
+/// The most rows a trajectory may hold, so that `steps / sample_every` is a budget
+/// checked before the run.
+const MAX_ROWS: u64 = 10_000_000;
+
+/// One sample of the trajectory.
+struct Row {
+    step: u64,
+    area: u64,
+    volume: u64,
+    rg: f64,
+    acceptance: f64,
+}
+
+/// The start shape: `"voxel"`, `"box:AxBxC"`, or an N×3 int64 array of voxels.
+fn start_voxels(start: &Bound<'_, PyAny>) -> PyResult<Vec<Voxel>> {
+    if let Ok(arr) = start.extract::<PyReadonlyArray2<'_, i64>>() {
+        return rows(&arr);
+    }
+    let s: String = start.extract().map_err(|_| {
+        PyValueError::new_err("start: expected \"voxel\", \"box:AxBxC\" or an N×3 int64 array")
+    })?;
+    if s == "voxel" {
+        return Ok(vec![[0, 0, 0]]);
+    }
+    let bad = || PyValueError::new_err(format!("start {s:?}: expected \"voxel\" or \"box:AxBxC\""));
+    let dims = s.strip_prefix("box:").ok_or_else(bad)?;
+    let d: Vec<u64> = dims
+        .split('x')
+        .map(|p| p.parse::<u64>().map_err(|_| bad()))
+        .collect::<PyResult<_>>()?;
+    if d.len() != 3 || d.contains(&0) {
+        return Err(bad());
+    }
+    if d.iter()
+        .try_fold(1u64, |a, &k| a.checked_mul(k))
+        .is_none_or(|n| n > MAX_START_VOXELS)
+    {
+        return Err(PyValueError::new_err(format!(
+            "start {s:?}: more than {MAX_START_VOXELS} voxels"
+        )));
+    }
+    let mut v = Vec::new();
+    for z in 0..d[2] as i64 {
+        for y in 0..d[1] as i64 {
+            for x in 0..d[0] as i64 {
+                v.push([x, y, z]);
+            }
+        }
+    }
+    Ok(v)
+}
+
+/// Runs the chain for `steps` attempted steps, sampling every `sample_every`.
+fn run<L: Lattice>(
+    params: Params,
+    seed: u64,
+    start: &[Voxel],
+    steps: u64,
+    sample_every: u64,
+) -> Result<(Chain<L>, Vec<Row>), String> {
+    let mut chain = Chain::new(L::empty(), params, seed, start).map_err(|e| e.to_string())?;
+    let mut rows = Vec::new();
+    let mut base = (0u64, 0u64);
+    let row = |c: &Chain<L>, base: (u64, u64)| {
+        let k = c.counters();
+        let dn = k.steps - base.0;
+        Row {
+            step: k.steps,
+            area: c.area(),
+            volume: c.volume(),
+            rg: c.radius_of_gyration(),
+            acceptance: if dn == 0 {
+                0.0
+            } else {
+                (k.accepted - base.1) as f64 / dn as f64
+            },
+        }
+    };
+    rows.push(row(&chain, base));
+    while chain.steps() < steps {
+        let s = chain.steps();
+        let target = steps.min((s / sample_every + 1).saturating_mul(sample_every));
+        chain.run(target - s);
+        rows.push(row(&chain, base));
+        base = (chain.steps(), chain.counters().accepted);
+    }
+    topology::check_sphere(&chain.voxels())
+        .map_err(|e| format!("global topology check of the final surface: {e}"))?;
+    Ok((chain, rows))
+}
+
+/// Monte Carlo of a self-avoiding random surface of sphere topology (Libes §6), as
+/// `tesseral rsmc` runs it: weight exp(−β·A − μ·V), Hastings factor unless
+/// `libes=True`. Returns a dict of numpy arrays `step`, `area`, `volume`,
+/// `radius_of_gyration`, `acceptance` (the rate since the previous row), one row per
+/// `sample_every` steps and one at the start, plus `voxels` (the final N×3 solid),
+/// `faces` (its plaquette count), `counters` (a dict) and `seconds`.
+#[pyfunction]
+#[pyo3(signature = (steps = 100_000, beta = 0.0, mu = 0.0, max_area = None, seed = 1,
+    start = None, libes = false, sample_every = 1000, backend = "octree"))]
+#[allow(clippy::too_many_arguments)]
+pub fn rsmc<'py>(
+    py: Python<'py>,
+    steps: u64,
+    beta: f64,
+    mu: f64,
+    max_area: Option<u64>,
+    seed: u64,
+    start: Option<&Bound<'py, PyAny>>,
+    libes: bool,
+    sample_every: u64,
+    backend: &str,
+) -> PyResult<Bound<'py, PyDict>> {
+    if sample_every == 0 {
+        return Err(PyValueError::new_err("sample_every must be at least 1"));
+    }
+    if steps / sample_every > MAX_ROWS {
+        return Err(PyValueError::new_err(format!(
+            "steps / sample_every gives more than {MAX_ROWS} rows; raise sample_every"
+        )));
+    }
+    let start = match start {
+        Some(s) => start_voxels(s)?,
+        None => vec![[0, 0, 0]],
+    };
+    let params = Params {
+        beta,
+        mu,
+        max_area,
+        hastings: !libes,
+    };
+    params
+        .validate()
+        .map_err(|e| PyValueError::new_err(e.to_string()))?;
+    let t0 = std::time::Instant::now();
+    let result = match backend {
+        "octree" => py.allow_threads(|| {
+            run::<DynamicOctree>(params, seed, &start, steps, sample_every)
+                .map(|(c, r)| (c.voxels(), c.counters(), c.area(), r))
+        }),
+        "dense" => py.allow_threads(|| {
+            run::<DenseLattice>(params, seed, &start, steps, sample_every)
+                .map(|(c, r)| (c.voxels(), c.counters(), c.area(), r))
+        }),
+        other => {
+            return Err(PyValueError::new_err(format!(
+                "backend {other:?}: expected \"octree\" or \"dense\""
+            )))
+        }
+    };
+    let (voxels, k, area, rows) = result.map_err(PyValueError::new_err)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    let d = PyDict::new(py);
+    let col = |f: fn(&Row) -> u64| rows.iter().map(f).collect::<Vec<u64>>();
+    d.set_item("step", col(|r| r.step).into_pyarray(py))?;
+    d.set_item("area", col(|r| r.area).into_pyarray(py))?;
+    d.set_item("volume", col(|r| r.volume).into_pyarray(py))?;
+    let colf = |f: fn(&Row) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
+    d.set_item("radius_of_gyration", colf(|r| r.rg).into_pyarray(py))?;
+    d.set_item("acceptance", colf(|r| r.acceptance).into_pyarray(py))?;
+    d.set_item("voxels", to_array(py, voxels)?)?;
+    d.set_item("faces", area)?;
+    let c = PyDict::new(py);
+    c.set_item("steps", k.steps)?;
+    c.set_item("accepted", k.accepted)?;
+    c.set_item("grown", k.grown)?;
+    c.set_item("illegal", k.illegal)?;
+    c.set_item("capped", k.capped)?;
+    c.set_item("refused", k.refused)?;
+    d.set_item("counters", c)?;
+    d.set_item("seconds", seconds)?;
+    Ok(d)
+}
