@@ -82,6 +82,16 @@ fn offset_near(
     [0, 1, 2].map(|a| ca[a] - cb[a] + rng.random_range(-jitter..=jitter))
 }
 
+/// A wall one voxel thick at `x`, 16 × 16 voxels in y and z, in a depth-6 space.
+fn thin_wall(x: i64) -> LinearOctree {
+    LinearOctree::from_voxels(
+        6,
+        [0, 0, 0],
+        (0..16).flat_map(|y| (0..16).map(move |z| [x, y, z])),
+    )
+    .unwrap()
+}
+
 fn seeded(test: &str, seed: u64) -> Pcg64 {
     eprintln!("{test}: seed {seed}");
     Pcg64::seed_from_u64(seed)

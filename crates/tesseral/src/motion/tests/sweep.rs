@@ -65,12 +65,7 @@ fn first_contact_matches_brute_force_and_sampling() {
 #[test]
 fn thin_wall_tunnelling_is_caught_by_the_swept_test() {
     // A wall one voxel thick at x = 20; a 4x4x4 cube crossing it in one 40-voxel step.
-    let wall = LinearOctree::from_voxels(
-        6,
-        [0, 0, 0],
-        (0..16).flat_map(|y| (0..16).map(move |z| [20, y, z])),
-    )
-    .unwrap();
+    let wall = thin_wall(20);
     let cube = LinearOctree::from_voxels(2, [0, 0, 0], (0..64).map(|i| [i % 4, i / 4 % 4, i / 16]))
         .unwrap();
     let start = Placement::at([0, 4, 4]);

@@ -61,12 +61,7 @@ fn assert_same_run(x: &Simulation, y: &Simulation, seed: u64) {
 
 #[test]
 fn world_catches_a_fast_object_tunnelling_through_a_thin_wall() {
-    let wall = LinearOctree::from_voxels(
-        6,
-        [0, 0, 0],
-        (0..16).flat_map(|y| (0..16).map(move |z| [30, y, z])),
-    )
-    .unwrap();
+    let wall = thin_wall(30);
     let mut world = World::new(wall);
     world.objects.push(MovingObject {
         name: "bullet".into(),
