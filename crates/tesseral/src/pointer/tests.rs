@@ -9,6 +9,7 @@ use proptest::prelude::*;
 
 use super::*;
 use crate::linear::tests::shape;
+use crate::linear::{LinearOctree, OctreeError};
 
 fn offset(set: &HashSet<Voxel>, o: Voxel) -> HashSet<Voxel> {
     set.iter()

@@ -1,0 +1,106 @@
+//! Step 1: the boundary squares, found top-down against the tree.
+
+use crate::code;
+use crate::linear::LinearOctree;
+use crate::Voxel;
+
+#[derive(Clone, Copy)]
+pub(super) struct Square {
+    pub(super) a: usize,
+    pub(super) pos: bool,
+    pub(super) c: i64,
+    pub(super) u: i64,
+    pub(super) v: i64,
+    pub(super) s: i64,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Region {
+    Full,
+    Empty,
+    Mixed,
+}
+
+/// Classifies the cube of side `2^k` at `min` (aligned in the tree's space, or wholly
+/// outside it) against the tree.
+fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8) -> Region {
+    let side = tree.side() as i64;
+    let o = tree.origin();
+    let mut rel = [0u32; 3];
+    for a in 0..3 {
+        let r = min[a] - o[a];
+        if r < 0 || r >= side {
+            return Region::Empty;
+        }
+        rel[a] = r as u32;
+    }
+    let c = code::encode(rel[0], rel[1], rel[2]);
+    let len = 1u64 << (3 * u32::from(k));
+    let leaves = tree.leaves();
+    let i = leaves.partition_point(|l| l.code() <= c);
+    if i > 0 && leaves[i - 1].end() > c {
+        return if leaves[i - 1].size_log2() >= k {
+            Region::Full
+        } else {
+            Region::Mixed
+        };
+    }
+    if i < leaves.len() && leaves[i].code() < c + len {
+        Region::Mixed
+    } else {
+        Region::Empty
+    }
+}
+
+pub(super) fn boundary_squares(tree: &LinearOctree) -> Vec<Square> {
+    let mut out = Vec::new();
+    for b in tree.blocks() {
+        let s = b.size();
+        for a in 0..3 {
+            for pos in [false, true] {
+                let mut n = b.min;
+                n[a] += if pos { s } else { -s };
+                let plane = if pos { b.min[a] + s } else { b.min[a] };
+                descend(tree, n, b.size_log2, a, pos, plane, &mut out);
+            }
+        }
+    }
+    out
+}
+
+fn descend(
+    tree: &LinearOctree,
+    cube: Voxel,
+    k: u8,
+    a: usize,
+    pos: bool,
+    plane: i64,
+    out: &mut Vec<Square>,
+) {
+    let (u, v) = ((a + 1) % 3, (a + 2) % 3);
+    match classify_cube(tree, cube, k) {
+        Region::Full => {}
+        Region::Empty => out.push(Square {
+            a,
+            pos,
+            c: plane,
+            u: cube[u],
+            v: cube[v],
+            s: 1 << k,
+        }),
+        Region::Mixed => {
+            let h = 1i64 << (k - 1);
+            for du in 0..2 {
+                for dv in 0..2 {
+                    let mut m = cube;
+                    m[u] += du * h;
+                    m[v] += dv * h;
+                    if !pos {
+                        m[a] += h;
+                    }
+                    descend(tree, m, k - 1, a, pos, plane, out);
+                }
+            }
+        }
+    }
+}
