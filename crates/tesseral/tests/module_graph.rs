@@ -6,7 +6,8 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The source without comment lines and without test code: a file's inline
-/// `#[cfg(test)] mod` ends it, and `tests.rs` files are skipped by the caller.
+/// `#[cfg(test)] mod` ends it, and test files (`tests.rs`, `tests_*.rs`, and
+/// everything in a `tests/` folder) are skipped by the caller.
 fn production_code(text: &str) -> String {
     // An inline test module (`#[cfg(test)] mod tests {`) runs to the end of the
     // file by convention; a declaration (`mod tests;`) is only skipped.
@@ -27,12 +28,14 @@ fn production_code(text: &str) -> String {
 fn edges(dir: &Path, modules: &BTreeSet<String>, own: &str, out: &mut BTreeSet<String>) {
     for entry in std::fs::read_dir(dir).unwrap() {
         let path = entry.unwrap().path();
+        let name = path.file_name().unwrap().to_string_lossy();
         if path.is_dir() {
-            edges(&path, modules, own, out);
+            if name != "tests" {
+                edges(&path, modules, own, out);
+            }
             continue;
         }
-        let name = path.file_name().unwrap().to_string_lossy();
-        if !name.ends_with(".rs") || name == "tests.rs" {
+        if !name.ends_with(".rs") || name == "tests.rs" || name.starts_with("tests_") {
             continue;
         }
         let code = production_code(&std::fs::read_to_string(&path).unwrap());
