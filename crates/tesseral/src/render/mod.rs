@@ -13,8 +13,11 @@
 //! - PNG output through the `png` crate ([`Image::write_png`]), written atomically.
 
 mod cut;
+mod normal;
 mod trace;
 
+#[cfg(test)]
+mod normal_tests;
 #[cfg(test)]
 mod tests;
 
@@ -22,6 +25,7 @@ pub use cut::crop_to_clip;
 pub use trace::{Hit, Ray, RayTree, TraversalStack};
 
 use cut::Cut;
+use normal::NormalCache;
 
 use std::io::Write;
 use std::path::Path;
@@ -530,9 +534,16 @@ fn render_cut(
             let tw = xr[1] - xr[0];
             let mut buf = vec![opts.background; tw * (yr[1] - yr[0])];
             let mut stack = TraversalStack::default();
+            let mut cache = NormalCache::new();
+            let shade = Shade {
+                rt,
+                frame: &frame,
+                surface,
+                opts,
+                cut,
+            };
             trace_block(rt, &frame, opts, xr, yr, &mut stack, |x, y, ray, hit| {
-                buf[(y - yr[0]) * tw + (x - xr[0])] =
-                    shade_pixel(rt, &frame, surface, opts, cut, ray, hit);
+                buf[(y - yr[0]) * tw + (x - xr[0])] = shade.pixel(&mut cache, ray, hit);
             });
             (ti, buf)
         })
@@ -617,145 +628,106 @@ fn pixel_ray(frame: &Frame, w: usize, h: usize, x: usize, y: usize) -> Ray {
     frame.ray(sx, sy)
 }
 
-fn shade_pixel(
-    rt: &RayTree,
-    frame: &Frame,
-    surface: Surface<'_>,
-    opts: &RenderOptions,
-    cut: Option<Cut<'_>>,
-    ray: &Ray,
-    hit: Option<Hit>,
-) -> [u8; 3] {
-    let ground_t = if opts.shadows && ray.dir[2] < -1e-9 {
-        let t = (frame.ground_z - ray.origin[2]) / ray.dir[2];
-        (t > 0.0).then_some(t)
-    } else {
-        None
-    };
-    match hit {
-        Some(h) if ground_t.is_none_or(|g| h.t <= g) => {
-            shade_hit(rt, frame, surface, opts, cut, ray, &h)
-        }
-        _ => match ground_t {
-            Some(g) => shade_ground(rt, frame, opts, ray, g),
-            None => opts.background,
-        },
-    }
+/// What shading a pixel needs besides its ray: the tree, the camera, the surface's
+/// colours and normals, the options and the cut.
+struct Shade<'a> {
+    rt: &'a RayTree,
+    frame: &'a Frame,
+    surface: Surface<'a>,
+    opts: &'a RenderOptions,
+    cut: Option<Cut<'a>>,
 }
 
-fn shade_hit(
-    rt: &RayTree,
-    frame: &Frame,
-    surface: Surface<'_>,
-    opts: &RenderOptions,
-    cut_by: Option<Cut<'_>>,
-    ray: &Ray,
-    h: &Hit,
-) -> [u8; 3] {
-    let p = ray.at(h.t);
-    let mut n = [0.0; 3];
-    n[h.axis] = -ray.dir[h.axis].signum();
-    // Sample the colour half a voxel inside the surface.
-    let inside = add(p, scale(n, -0.5));
-    let cut = cut_by.is_some_and(|c| c.is_cut_face(inside.map(|v| v.floor() as i64), n));
-    let face = n;
-    let smooth = match opts.normals {
-        Normals::Faces => false,
-        Normals::Smooth => true,
-        Normals::Auto => frame.pixel_size(h.t, opts.height) > 0.5,
-    };
-    if smooth && !opts.outline && !cut {
-        let given = surface
-            .normal
-            .and_then(|f| f(p))
-            .filter(|m| dot(*m, face) > 0.05);
-        n = given.unwrap_or_else(|| smooth_normal(rt, inside, face));
-    }
-    // The centre of the voxel hit: the solid's predicate holds there exactly.
-    let centre = inside.map(|c| c.floor() + 0.5);
-    let base = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
-    let base = if cut {
-        // Cut faces: the object's colour, darker, hatched, so the section reads.
-        let stripe = ((p[0] + p[1] + p[2]) / 3.0).rem_euclid(6.0) < 3.0;
-        let k = if stripe { 0.55 } else { 0.7 };
-        base.map(|c| (f64::from(c) * k) as u8)
-    } else {
-        base
-    };
-    let mut light = dot(n, frame.light).max(0.0);
-    if opts.shadows && light > 0.0 {
-        // From a smooth surface, start the shadow ray clear of the voxel staircase.
-        let lift = if smooth { 1.5 } else { 0.0 };
-        let from = add(add(p, scale(face, 1e-3)), scale(n, lift));
-        if rt
-            .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
-            .is_some()
-        {
-            light = 0.0;
+impl Shade<'_> {
+    fn pixel(&self, cache: &mut NormalCache, ray: &Ray, hit: Option<Hit>) -> [u8; 3] {
+        let (rt, frame, opts) = (self.rt, self.frame, self.opts);
+        let ground_t = if opts.shadows && ray.dir[2] < -1e-9 {
+            let t = (frame.ground_z - ray.origin[2]) / ray.dir[2];
+            (t > 0.0).then_some(t)
+        } else {
+            None
+        };
+        match hit {
+            Some(h) if ground_t.is_none_or(|g| h.t <= g) => self.hit(cache, ray, &h),
+            _ => match ground_t {
+                Some(g) => shade_ground(rt, frame, opts, ray, g),
+                None => opts.background,
+            },
         }
     }
-    let mut ambient = 0.42;
-    if opts.ao_samples > 0 {
-        ambient *= ambient_occlusion(rt, frame, p, n, opts.ao_samples, h.t);
-    }
-    // A little light from below the horizon side keeps shadowed faces readable.
-    let fill = 0.12 * dot(n, scale(frame.forward, -1.0)).max(0.0);
-    let k = (ambient + 0.62 * light + fill).min(1.15);
-    let mut rgb = base.map(|c| (f64::from(c) * k).min(255.0));
-    if opts.outline {
-        let size = (1i64 << h.size_log2) as f64;
-        let mut edge = f64::INFINITY;
-        for (ax, (&pa, &ba)) in p.iter().zip(&h.block_min).enumerate() {
-            if ax == h.axis && !cut {
-                continue;
-            }
-            if cut && ax == cut_by.map_or(3, |c| c.clip.axis) {
-                continue;
-            }
-            let u = pa - ba as f64;
-            edge = edge.min(u.abs()).min((size - u).abs());
-        }
-        let width = frame.pixel_size(h.t, opts.height) * 0.75;
-        if edge < width {
-            rgb = rgb.map(|c| c * 0.25);
-        }
-    }
-    rgb.map(|c| c.round() as u8)
-}
 
-/// A smooth normal at the surface voxel holding `inside`: minus the gradient of the
-/// occupancy of its 26 neighbours at distances 1 and 2, blended with the face normal
-/// so flat faces stay flat. Any octree gets it; no solid is needed.
-fn smooth_normal(rt: &RayTree, inside: [f64; 3], face: [f64; 3]) -> [f64; 3] {
-    let v = inside.map(|c| c.floor() as i64);
-    let mut g = [0.0; 3];
-    for step in [1i64, 2] {
-        for dz in -1..=1i64 {
-            for dy in -1..=1i64 {
-                for dx in -1..=1i64 {
-                    if dx == 0 && dy == 0 && dz == 0 {
-                        continue;
-                    }
-                    let o = [dx * step, dy * step, dz * step];
-                    if rt.contains([v[0] + o[0], v[1] + o[1], v[2] + o[2]]) {
-                        let w = 1.0 / ((dx * dx + dy * dy + dz * dz) as f64).sqrt();
-                        g = add(g, scale([dx as f64, dy as f64, dz as f64], w));
-                    }
+    fn hit(&self, cache: &mut NormalCache, ray: &Ray, h: &Hit) -> [u8; 3] {
+        let (rt, frame, surface, opts, cut_by) =
+            (self.rt, self.frame, self.surface, self.opts, self.cut);
+        let p = ray.at(h.t);
+        let mut n = [0.0; 3];
+        n[h.axis] = -ray.dir[h.axis].signum();
+        // Sample the colour half a voxel inside the surface.
+        let inside = add(p, scale(n, -0.5));
+        let cut = cut_by.is_some_and(|c| c.is_cut_face(inside.map(|v| v.floor() as i64), n));
+        let face = n;
+        let smooth = match opts.normals {
+            Normals::Faces => false,
+            Normals::Smooth => true,
+            Normals::Auto => frame.pixel_size(h.t, opts.height) > 0.5,
+        };
+        if smooth && !opts.outline && !cut {
+            let given = surface
+                .normal
+                .and_then(|f| f(p))
+                .filter(|m| dot(*m, face) > 0.05);
+            n = given.unwrap_or_else(|| cache.normal(rt, inside.map(|c| c.floor() as i64), face));
+        }
+        // The centre of the voxel hit: the solid's predicate holds there exactly.
+        let centre = inside.map(|c| c.floor() + 0.5);
+        let base = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
+        let base = if cut {
+            // Cut faces: the object's colour, darker, hatched, so the section reads.
+            let stripe = ((p[0] + p[1] + p[2]) / 3.0).rem_euclid(6.0) < 3.0;
+            let k = if stripe { 0.55 } else { 0.7 };
+            base.map(|c| (f64::from(c) * k) as u8)
+        } else {
+            base
+        };
+        let mut light = dot(n, frame.light).max(0.0);
+        if opts.shadows && light > 0.0 {
+            // From a smooth surface, start the shadow ray clear of the voxel staircase.
+            let lift = if smooth { 1.5 } else { 0.0 };
+            let from = add(add(p, scale(face, 1e-3)), scale(n, lift));
+            if rt
+                .cast(&Ray::new(from, frame.light), 0.0, f64::INFINITY)
+                .is_some()
+            {
+                light = 0.0;
+            }
+        }
+        let mut ambient = 0.42;
+        if opts.ao_samples > 0 {
+            ambient *= ambient_occlusion(rt, frame, p, n, opts.ao_samples, h.t);
+        }
+        // A little light from below the horizon side keeps shadowed faces readable.
+        let fill = 0.12 * dot(n, scale(frame.forward, -1.0)).max(0.0);
+        let k = (ambient + 0.62 * light + fill).min(1.15);
+        let mut rgb = base.map(|c| (f64::from(c) * k).min(255.0));
+        if opts.outline {
+            let size = (1i64 << h.size_log2) as f64;
+            let mut edge = f64::INFINITY;
+            for (ax, (&pa, &ba)) in p.iter().zip(&h.block_min).enumerate() {
+                if ax == h.axis && !cut {
+                    continue;
                 }
+                if cut && ax == cut_by.map_or(3, |c| c.clip.axis) {
+                    continue;
+                }
+                let u = pa - ba as f64;
+                edge = edge.min(u.abs()).min((size - u).abs());
+            }
+            let width = frame.pixel_size(h.t, opts.height) * 0.75;
+            if edge < width {
+                rgb = rgb.map(|c| c * 0.25);
             }
         }
-    }
-    let len = dot(g, g).sqrt();
-    if len < 1e-9 {
-        return face;
-    }
-    let m = add(scale(g, -0.8 / len), scale(face, 0.35));
-    let n = normalize(m);
-    // Never turn further than a right angle from the face actually seen.
-    if dot(n, face) > 0.05 {
-        n
-    } else {
-        face
+        rgb.map(|c| c.round() as u8)
     }
 }
 
