@@ -18,8 +18,6 @@ mod shade;
 mod trace;
 
 #[cfg(test)]
-mod normal_tests;
-#[cfg(test)]
 mod tests;
 
 pub use cut::crop_to_clip;

@@ -1,10 +1,10 @@
 //! The estimated normals against the true ones of spheres and ellipsoids, and the
 //! brick against voxel-by-voxel lookups.
 
-use super::normal::{surface_normal, Brick, MAX_REACH};
-use super::{Ray, RayTree};
+use super::{surface_normal, Brick, MAX_REACH};
 use crate::csg::tests::Rng;
 use crate::csg::{Csg, Shape, Solid};
+use crate::render::{Ray, RayTree};
 
 /// The ways of estimating a normal from a brick, compared in the tests.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -283,7 +283,8 @@ fn ball_moment_matches_voxel_lookups() {
                     }
                 }
             }
-            let got = Brick::around(&rt, c, reach).ball_moment();
+            let got = Brick::ball(&rt, c, reach).ball_moment();
+            assert_eq!(Brick::around(&rt, c, reach).ball_moment(), want);
             assert_eq!(got, want, "trial {trial}: centre {c:?} reach {reach}");
         }
     }

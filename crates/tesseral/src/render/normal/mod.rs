@@ -1,10 +1,13 @@
 //! Normals of a surface known only by its voxels (an octree file): estimated from the
 //! occupancy of a small cube of voxels around the hit, gathered from the octree in one
-//! descent ([`Brick::around`]), so that the estimate follows the solid's surface and
-//! not the staircase of its voxels. See `docs/octrees.md` ("Smooth normals") for the
+//! descent ([`Brick::ball`]), so that the estimate follows the solid's surface and
+//! not the staircase of its voxels. See `docs/shading.md` for the
 //! estimators compared and the measured errors.
 
 use super::trace::{rank, RayTree, Root};
+
+#[cfg(test)]
+mod tests;
 
 /// The largest half-side of a brick, in voxels.
 pub(crate) const MAX_REACH: usize = 5;
@@ -19,14 +22,29 @@ pub(crate) struct Brick {
 }
 
 impl Brick {
-    /// The occupancy of `centre ± reach` (`reach` at most [`MAX_REACH`]): one descent
-    /// of the octree over the nodes that meet the cube; a black block fills its part
-    /// of the cube row by row, whatever its size.
+    /// The occupancy of the cube `centre ± reach` (`reach` at most [`MAX_REACH`]): one
+    /// descent of the octree over the nodes that meet the cube; a black block fills
+    /// its part of the cube row by row, whatever its size.
     ///
     /// # Runtime
     /// O(nodes meeting the cube), about the surface voxels inside it times a small
     /// factor, plus the depth.
+    #[cfg(test)]
     pub(crate) fn around(rt: &RayTree, centre: [i64; 3], reach: usize) -> Brick {
+        Self::gather(rt, centre, reach, i64::MAX)
+    }
+
+    /// As [`Brick::around`], but only the voxels within `reach + ½` of the centre are
+    /// sure to be marked (the nodes that miss that ball are skipped): what
+    /// [`Brick::ball_moment`] reads.
+    pub(crate) fn ball(rt: &RayTree, centre: [i64; 3], reach: usize) -> Brick {
+        let r = reach as i64;
+        Self::gather(rt, centre, reach, r * r + r)
+    }
+
+    /// The voxels of the cube `centre ± reach` in the nodes with a voxel centre within
+    /// `√room` of `centre` (`(r + ½)² = r² + r + ¼`: integers compare with `r² + r`).
+    fn gather(rt: &RayTree, centre: [i64; 3], reach: usize, room: i64) -> Brick {
         assert!(reach <= MAX_REACH, "brick reach {reach} over {MAX_REACH}");
         let mut b = Brick {
             reach,
@@ -38,19 +56,27 @@ impl Brick {
         match rt.root {
             Root::White => {}
             Root::Black => b.paint(lo, hi, rt.origin(), 1i64 << rt.depth()),
-            Root::Gray => b.descend(rt, rt.root_node, rt.origin(), rt.depth(), lo, hi),
+            Root::Gray => {
+                let at = Around {
+                    lo,
+                    hi,
+                    centre,
+                    room,
+                };
+                b.descend(rt, rt.root_node, rt.origin(), rt.depth(), &at);
+            }
         }
         b
     }
 
-    fn descend(&mut self, rt: &RayTree, n: u32, min: [i64; 3], k: u8, lo: [i64; 3], hi: [i64; 3]) {
+    fn descend(&mut self, rt: &RayTree, n: u32, min: [i64; 3], k: u8, at: &Around) {
         let node = rt.nodes[n as usize];
         let half = 1i64 << (k - 1);
         // Which halves of the node the cube meets, per axis: bit 0 low, bit 1 high.
         let mut halves = [0u8; 3];
         for a in 0..3 {
             let mid = min[a] + half;
-            halves[a] = u8::from(lo[a] < mid) | (u8::from(hi[a] >= mid) << 1);
+            halves[a] = u8::from(at.lo[a] < mid) | (u8::from(at.hi[a] >= mid) << 1);
         }
         for label in 0..8u8 {
             let bit = 1u8 << label;
@@ -62,11 +88,23 @@ impl Brick {
                 continue;
             }
             let cmin = [0, 1, 2].map(|a| min[a] + half * i64::from(side[a]));
+            // The squared distance from the centre to the child's nearest voxel.
+            let far = (0..3)
+                .map(|a| {
+                    let d = (cmin[a] - at.centre[a])
+                        .max(at.centre[a] - (cmin[a] + half - 1))
+                        .max(0);
+                    d * d
+                })
+                .sum::<i64>();
+            if far > at.room {
+                continue;
+            }
             if node.black & bit != 0 {
-                self.paint(lo, hi, cmin, half);
+                self.paint(at.lo, at.hi, cmin, half);
             } else {
                 let j = rank(node.gray, bit);
-                self.descend(rt, node.first + j, cmin, k - 1, lo, hi);
+                self.descend(rt, node.first + j, cmin, k - 1, at);
             }
         }
     }
@@ -127,6 +165,15 @@ impl Brick {
     }
 }
 
+/// The region a brick gathers: the cube `lo..=hi` around `centre`, and the squared
+/// distance from the centre within which nodes are visited.
+struct Around {
+    lo: [i64; 3],
+    hi: [i64; 3],
+    centre: [i64; 3],
+    room: i64,
+}
+
 /// For each row pattern of [`MAX_SIDE`] bits: how many bits are set, and the sum of
 /// their indices.
 const ROW_SUMS: [(u8, u8); 1 << MAX_SIDE] = {
@@ -183,7 +230,7 @@ pub(crate) const REACH: usize = 4;
 /// points behind the face seen, the face's own normal.
 #[must_use]
 pub(crate) fn surface_normal(rt: &RayTree, v: [i64; 3], face: [f64; 3]) -> [f64; 3] {
-    let g = Brick::around(rt, v, REACH).ball_moment().map(|c| c as f64);
+    let g = Brick::ball(rt, v, REACH).ball_moment().map(|c| c as f64);
     let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
     let facing = g[0] * face[0] + g[1] * face[1] + g[2] * face[2];
     if len == 0.0 || facing <= 0.0 {
