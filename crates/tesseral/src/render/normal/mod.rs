@@ -134,7 +134,7 @@ impl Brick {
         }
         let side = 2 * self.reach + 1;
         let row = self.rows[(u[1] + r) as usize + side * (u[2] + r) as usize];
-        row >> (u[0] + r) & 1 != 0
+        (row >> (u[0] + r)) & 1 != 0
     }
 
     /// Minus the first moment of the black voxels within the ball of radius
@@ -182,7 +182,7 @@ const ROW_SUMS: [(u8, u8); 1 << MAX_SIDE] = {
     while row < t.len() {
         let (mut count, mut sum, mut i) = (0u8, 0u8, 0);
         while i < MAX_SIDE {
-            if row >> i & 1 != 0 {
+            if (row >> i) & 1 != 0 {
                 count += 1;
                 sum += i as u8;
             }
