@@ -28,10 +28,7 @@ fn mean_difference(reference: &[[u8; 3]], other: &[[u8; 3]]) -> f64 {
     let (mut sum, mut n) = (0.0, 0usize);
     for (a, b) in reference.iter().zip(other) {
         if *a != background {
-            sum += (0..3)
-                .map(|i| f64::from(a[i].abs_diff(b[i])))
-                .sum::<f64>()
-                / 3.0;
+            sum += (0..3).map(|i| f64::from(a[i].abs_diff(b[i]))).sum::<f64>() / 3.0;
             n += 1;
         }
     }
