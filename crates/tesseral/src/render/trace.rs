@@ -8,15 +8,15 @@ use crate::linear::{Leaf, LinearOctree};
 /// and where the gray children's nodes start (they are stored together, in label
 /// order).
 #[derive(Debug, Clone, Copy)]
-struct Node {
-    first: u32,
-    gray: u8,
-    black: u8,
+pub(super) struct Node {
+    pub(super) first: u32,
+    pub(super) gray: u8,
+    pub(super) black: u8,
 }
 
 /// The colour of the root.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Root {
+pub(super) enum Root {
     White,
     Black,
     Gray,
@@ -43,9 +43,9 @@ enum Root {
 pub struct RayTree {
     depth: u8,
     origin: [i64; 3],
-    root: Root,
-    nodes: Vec<Node>,
-    root_node: u32,
+    pub(super) root: Root,
+    pub(super) nodes: Vec<Node>,
+    pub(super) root_node: u32,
     bbox: Option<([i64; 3], [i64; 3])>,
 }
 
@@ -670,7 +670,7 @@ const POPCOUNT: [u8; 256] = {
 
 /// The index of the gray child `bit` among its gray siblings.
 #[inline]
-fn rank(gray: u8, bit: u8) -> u32 {
+pub(super) fn rank(gray: u8, bit: u8) -> u32 {
     u32::from(POPCOUNT[usize::from(gray & (bit - 1))])
 }
 
