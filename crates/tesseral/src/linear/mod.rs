@@ -228,6 +228,12 @@ impl LinearOctree {
         self.leaves.len()
     }
 
+    /// The bytes the leaf list holds on the heap (its capacity, 8 bytes a leaf).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        self.leaves.capacity() * std::mem::size_of::<Leaf>()
+    }
+
     /// Whether no voxel is black.
     #[must_use]
     pub fn is_empty(&self) -> bool {
