@@ -11,6 +11,7 @@ mod build;
 mod enumerate;
 pub(crate) mod grow;
 mod leaf;
+mod merge;
 mod node_list;
 mod ops;
 mod resample;
