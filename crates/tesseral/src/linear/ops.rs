@@ -144,7 +144,7 @@ impl LinearOctree {
     pub fn complement(&self) -> Self {
         let full = [Leaf::new(0, self.depth)];
         let min = split_min_leaves(self.leaves.len());
-        let leaves = merge_cell(
+        let mut leaves = merge_cell(
             SetOp::Difference,
             Part::Leaves(&full),
             Part::Leaves(&self.leaves),
@@ -152,6 +152,7 @@ impl LinearOctree {
             self.depth,
             min,
         );
+        leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }
 
@@ -166,7 +167,7 @@ impl LinearOctree {
             "set_op_same_space on different spaces"
         );
         let min = split_min_leaves(self.leaves.len() + other.leaves.len());
-        let leaves = merge_cell(
+        let mut leaves = merge_cell(
             op,
             Part::Leaves(&self.leaves),
             Part::Leaves(&other.leaves),
@@ -174,6 +175,7 @@ impl LinearOctree {
             self.depth,
             min,
         );
+        leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }
 }
@@ -245,7 +247,10 @@ fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8, min: usize)
             Part::Leaves(l) if !clamp(b) => l,
             _ => &full,
         };
-        let mut out = Vec::with_capacity(sa.len().max(sb.len()) + 8);
+        // Union and intersection keep at most every input leaf; a difference may
+        // cut more and grows. Pages never written are never touched, and the top
+        // level gives back the unused tail.
+        let mut out = Vec::with_capacity(sa.len() + sb.len() + 8);
         match op {
             SetOp::Union => union(sa, sb, &mut out),
             SetOp::Intersection => intersection(sa, sb, &mut out),
