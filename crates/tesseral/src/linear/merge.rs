@@ -80,7 +80,7 @@ fn gallop(s: &[Leaf], keep: impl Fn(Leaf) -> bool) -> usize {
 
 /// How many leaves at the front of `s` end at or before code `at`.
 #[inline]
-fn ending_by(s: &[Leaf], at: u64) -> usize {
+pub(super) fn ending_by(s: &[Leaf], at: u64) -> usize {
     gallop(s, |l| span2(l).1 <= at)
 }
 
@@ -89,7 +89,7 @@ fn ending_by(s: &[Leaf], at: u64) -> usize {
 /// leaf of side `2^k` from `s` has `packed >> 1 = s + (8^k - 1) / 2`, below `end`
 /// exactly when it lies inside.
 #[inline]
-fn inside(s: &[Leaf], end: u64) -> usize {
+pub(super) fn inside(s: &[Leaf], end: u64) -> usize {
     gallop(s, |l| l.packed() >> 1 < end)
 }
 

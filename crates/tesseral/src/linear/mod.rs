@@ -539,4 +539,6 @@ pub(crate) mod tests;
 #[cfg(test)]
 mod tests_affine;
 #[cfg(test)]
+mod tests_merge;
+#[cfg(test)]
 pub(crate) mod tests_ops;
