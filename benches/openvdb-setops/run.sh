@@ -16,8 +16,9 @@
 # pruneGrid (a new canonical tree, what tesseral's call returns). tesseral: LinearOctree::set_op, which
 # returns a new canonical tree (allocation and merging of blocks included).
 # Both pinned to core 0 (taskset), TBB and rayon limited to one thread; best of REPS,
-# each time the thread's CPU time (user + system, page faults included), since the
-# machine is shared and wall time would count other processes' turns on the core.
+# each time the process's CPU time (all threads, user + system, page faults
+# included), since the machine is shared and wall time would count other processes'
+# turns on the core.
 # A last column runs tesseral on two threads (taskset -c 0,1, wall time), for
 # information.
 # Memory: bytes per voxel of the result (OpenVDB memUsage of the pruned result;

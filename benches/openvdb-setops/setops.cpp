@@ -22,11 +22,11 @@
 #include <string>
 #include <vector>
 
-// The calling thread's CPU time in milliseconds: the machine is shared, so wall time
-// would count other processes' turns on the core. TBB runs on this thread alone.
+// The process's CPU time in milliseconds (all threads): the machine is shared, so
+// wall time would count other processes' turns on the core.
 static double cpu_ms() {
     timespec ts;
-    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
     return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
 

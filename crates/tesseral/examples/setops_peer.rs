@@ -2,7 +2,7 @@
 //! operand pairs, writes each operand's leaves for the OpenVDB side (four
 //! little-endian `i32` per leaf: x, y, z of its lowest voxel, log2 of its side), and
 //! times union, intersection and difference on `THREADS` rayon threads (best of
-//! `REPS`; on one thread the thread's CPU time, on more the wall time). The timed call is `LinearOctree::set_op` on two trees in one space: it
+//! `REPS`; on one thread the process's CPU time, on more the wall time). The timed call is `LinearOctree::set_op` on two trees in one space: it
 //! returns a new tree in canonical form (maximal blocks), its allocation included.
 //!
 //! `cargo run --release -p tesseral --example setops_peer -- DIR REPS THREADS SCENES [ONLY]`
@@ -16,15 +16,17 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-/// The calling thread's CPU time in seconds. The machine is shared, so wall time
-/// would count other processes' turns on the core; both sides read this clock.
-fn thread_cpu() -> f64 {
+/// The process's CPU time in seconds (all its threads). The machine is shared, so
+/// wall time would count other processes' turns on the core; both sides read this
+/// clock, and since it sums every thread, no work done off the calling thread is
+/// missed.
+fn process_cpu() -> f64 {
     let mut ts = libc::timespec {
         tv_sec: 0,
         tv_nsec: 0,
     };
     // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
     assert_eq!(rc, 0, "clock_gettime");
     ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }
@@ -181,10 +183,10 @@ fn main() {
             let mut out = None;
             for _ in 0..reps {
                 drop(out.take());
-                // One thread: this thread's CPU time. More: wall time.
-                let (start, t0) = (Instant::now(), thread_cpu());
+                // One thread: the process's CPU time. More: wall time.
+                let (start, t0) = (Instant::now(), process_cpu());
                 let o = a.set_op(b, op).expect("same space");
-                let (wall, cpu) = (start.elapsed().as_secs_f64(), thread_cpu() - t0);
+                let (wall, cpu) = (start.elapsed().as_secs_f64(), process_cpu() - t0);
                 best = best.min(if threads == 1 { cpu } else { wall });
                 out = Some(o);
             }
