@@ -2,11 +2,12 @@
 //! lists (Harakal & Chmúrny §2 combine solids by union, intersection, difference and
 //! negation; this is the linear-octree form of those operations).
 //!
-//! The merge works on *runs*: consecutive leaves whose code ranges touch form one
-//! interval of codes, the two interval lists are swept together, and every output
-//! interval is cut back into maximal aligned blocks greedily. The greedy cut of a
-//! maximal run is exactly the canonical leaf list, so the output needs no second
-//! merging pass. Large inputs are split by octant and merged in parallel with rayon.
+//! The kernels (`merge.rs`) sweep the two leaf lists together: overlapping leaves are
+//! nested, so each step keeps, drops, or cuts the larger around the smaller ones
+//! (gaps cut greedily into maximal blocks, which is canonical), and stretches that
+//! only one operand has are copied or skipped as slices. On one thread the whole
+//! space is one merge; on more, large inputs are split by octant and merged in
+//! parallel with rayon.
 
 // Per-axis loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
