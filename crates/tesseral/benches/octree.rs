@@ -77,6 +77,20 @@ fn set_operations(c: &mut Criterion) {
     g.bench_function("union_unaligned_spaces", |bch| {
         bch.iter(|| black_box(a.union(&b_own).unwrap()))
     });
+    // Issue 17: the same spheres in a depth-9 space, where neither is clipped (the
+    // peer figures come from benches/openvdb-setops/run.sh).
+    let a9 = LinearOctree::from_classifier(9, [0, 0, 0], &ball([128.0; 3], 100.0)).unwrap();
+    let b9 =
+        LinearOctree::from_classifier(9, [0, 0, 0], &ball([178.0, 128.0, 128.0], 100.0)).unwrap();
+    for (name, op) in [
+        ("union_unclipped", SetOp::Union),
+        ("intersection_unclipped", SetOp::Intersection),
+        ("difference_unclipped", SetOp::Difference),
+    ] {
+        g.bench_function(name, |bch| {
+            bch.iter(|| black_box(a9.set_op(&b9, op).unwrap()))
+        });
+    }
     g.finish();
 }
 

@@ -11,6 +11,7 @@ mod build;
 mod enumerate;
 pub(crate) mod grow;
 mod leaf;
+mod merge;
 mod node_list;
 mod ops;
 mod resample;
@@ -226,6 +227,12 @@ impl LinearOctree {
     #[must_use]
     pub fn leaf_count(&self) -> usize {
         self.leaves.len()
+    }
+
+    /// The bytes the leaf list holds on the heap (its capacity, 8 bytes a leaf).
+    #[must_use]
+    pub fn heap_bytes(&self) -> usize {
+        self.leaves.capacity() * std::mem::size_of::<Leaf>()
     }
 
     /// Whether no voxel is black.
@@ -531,5 +538,7 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
 pub(crate) mod tests;
 #[cfg(test)]
 mod tests_affine;
+#[cfg(test)]
+mod tests_merge;
 #[cfg(test)]
 pub(crate) mod tests_ops;

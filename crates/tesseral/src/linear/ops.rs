@@ -2,17 +2,19 @@
 //! lists (Harakal & Chmúrny §2 combine solids by union, intersection, difference and
 //! negation; this is the linear-octree form of those operations).
 //!
-//! The merge works on *runs*: consecutive leaves whose code ranges touch form one
-//! interval of codes, the two interval lists are swept together, and every output
-//! interval is cut back into maximal aligned blocks greedily. The greedy cut of a
-//! maximal run is exactly the canonical leaf list, so the output needs no second
-//! merging pass. Large inputs are split by octant and merged in parallel with rayon.
+//! The kernels (`merge.rs`) sweep the two leaf lists together: overlapping leaves are
+//! nested, so each step keeps, drops, or cuts the larger around the smaller ones
+//! (gaps cut greedily into maximal blocks, which is canonical), and stretches that
+//! only one operand has are copied or skipped as slices. On one thread the whole
+//! space is one merge; on more, large inputs are split by octant and merged in
+//! parallel with rayon.
 
 // Per-axis loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
 use rayon::prelude::*;
 
+use super::merge::{difference, intersection, symmetric_difference, union};
 use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};
 
 /// A Boolean set operation on two solids.
@@ -30,6 +32,16 @@ pub enum SetOp {
 
 /// Below this many leaves (both operands together) a cell is merged on one thread.
 const PARALLEL_MIN_LEAVES: usize = 1 << 14;
+
+/// The least leaf count (both operands) of a cell merged as one task: on one thread
+/// nothing is split (splitting costs a copy of the output per level); on `t`
+/// threads, cells are split until they hold about an eighth of a thread's share.
+fn split_min_leaves(total: usize) -> usize {
+    match rayon::current_num_threads() {
+        1 => usize::MAX,
+        t => PARALLEL_MIN_LEAVES.max(total / (8 * t)),
+    }
+}
 
 impl LinearOctree {
     /// The set operation `op` of `self` and `other`.
@@ -132,13 +144,16 @@ impl LinearOctree {
     #[must_use]
     pub fn complement(&self) -> Self {
         let full = [Leaf::new(0, self.depth)];
-        let leaves = merge_cell(
+        let min = split_min_leaves(self.leaves.len());
+        let mut leaves = merge_cell(
             SetOp::Difference,
             Part::Leaves(&full),
             Part::Leaves(&self.leaves),
             0,
             self.depth,
+            min,
         );
+        leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }
 
@@ -152,13 +167,16 @@ impl LinearOctree {
             self.depth == other.depth && self.origin == other.origin,
             "set_op_same_space on different spaces"
         );
-        let leaves = merge_cell(
+        let min = split_min_leaves(self.leaves.len() + other.leaves.len());
+        let mut leaves = merge_cell(
             op,
             Part::Leaves(&self.leaves),
             Part::Leaves(&other.leaves),
             0,
             self.depth,
+            min,
         );
+        leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }
 }
@@ -212,9 +230,9 @@ impl<'a> Part<'a> {
 }
 
 /// Merges the operands inside cell `(code, k)` and returns the canonical leaves.
-fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf> {
+fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8, min: usize) -> Vec<Leaf> {
     let covering = a.covers(code, k) && b.covers(code, k);
-    if k == 0 || covering || a.len() + b.len() < PARALLEL_MIN_LEAVES {
+    if k == 0 || covering || a.len() + b.len() < min {
         let full = [Leaf::new(code, k)];
         let clamp = |p: Part<'_>| -> bool {
             match p {
@@ -230,7 +248,10 @@ fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf
             Part::Leaves(l) if !clamp(b) => l,
             _ => &full,
         };
-        let mut out = Vec::with_capacity(sa.len().max(sb.len()) + 8);
+        // Union and intersection keep at most every input leaf; a difference may
+        // cut more and grows. Pages never written are never touched, and the top
+        // level gives back the unused tail.
+        let mut out = Vec::with_capacity(sa.len() + sb.len() + 8);
         match op {
             SetOp::Union => union(sa, sb, &mut out),
             SetOp::Intersection => intersection(sa, sb, &mut out),
@@ -243,7 +264,7 @@ fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf
     let child = 1u64 << (3 * u32::from(k - 1));
     let parts: Vec<Vec<Leaf>> = (0..8usize)
         .into_par_iter()
-        .map(|d| merge_cell(op, pa[d], pb[d], code + d as u64 * child, k - 1))
+        .map(|d| merge_cell(op, pa[d], pb[d], code + d as u64 * child, k - 1, min))
         .collect();
     let mut out = Vec::with_capacity(parts.iter().map(Vec::len).sum());
     for (d, part) in parts.into_iter().enumerate() {
@@ -254,211 +275,4 @@ fn merge_cell(op: SetOp, a: Part<'_>, b: Part<'_>, code: u64, k: u8) -> Vec<Leaf
         }
     }
     out
-}
-
-/// The code span `[start, end)` of a leaf, read straight off the packed form:
-/// `m = p ^ (p + 1)` is the size marker plus the zero bit above it.
-#[inline(always)]
-fn span2(leaf: Leaf) -> (u64, u64) {
-    let p = leaf.packed();
-    let m = p ^ (p.wrapping_add(1));
-    let start = (p & !m) >> 1;
-    (start, start + (m >> 1) + 1)
-}
-
-/// Pushes a leaf that follows every leaf in `out`, merging siblings only when the
-/// leaf is the last child (label 7) of its parent: the only time a merge can occur.
-#[inline(always)]
-fn push_m(out: &mut Vec<Leaf>, leaf: Leaf) {
-    let p = leaf.packed();
-    if p.checked_shr(p.trailing_ones() + 1).unwrap_or(0) & 7 == 7 {
-        push_merging(out, leaf);
-    } else {
-        out.push(leaf);
-    }
-}
-
-/// Appends the maximal blocks of the code interval `[s, e)`, greedily (the largest
-/// block aligned at each start that fits), merging as it goes when asked.
-#[inline]
-fn emit_gap(out: &mut Vec<Leaf>, mut s: u64, e: u64, merge: bool) {
-    while s < e {
-        let align = s.trailing_zeros().min(63) / 3;
-        let fit = (63 - (e - s).leading_zeros()) / 3;
-        let k = align.min(fit);
-        let leaf = Leaf::new(s, k as u8);
-        if merge {
-            push_m(out, leaf);
-        } else {
-            out.push(leaf);
-        }
-        s += 1u64 << (3 * k);
-    }
-}
-
-/// Union of two canonical leaf lists. A leaf nested in a larger one is skipped;
-/// siblings coming from both operands may merge.
-fn union(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
-    let (mut i, mut j) = (0, 0);
-    if !a.is_empty() && !b.is_empty() {
-        // The current leaves' spans, reloaded only when a cursor moves.
-        let ((mut xs, mut xe), (mut ys, mut ye)) = (span2(a[0]), span2(b[0]));
-        loop {
-            if xe <= ys {
-                push_m(out, a[i]);
-                i += 1;
-                if i == a.len() {
-                    break;
-                }
-                (xs, xe) = span2(a[i]);
-            } else if ye <= xs {
-                push_m(out, b[j]);
-                j += 1;
-                if j == b.len() {
-                    break;
-                }
-                (ys, ye) = span2(b[j]);
-            } else if xs <= ys && ye <= xe {
-                // b's leaf lies in a's: skip every b leaf inside it.
-                push_m(out, a[i]);
-                i += 1;
-                j += 1;
-                while j < b.len() && span2(b[j]).0 < xe {
-                    j += 1;
-                }
-                if i == a.len() || j == b.len() {
-                    break;
-                }
-                (xs, xe) = span2(a[i]);
-                (ys, ye) = span2(b[j]);
-            } else {
-                push_m(out, b[j]);
-                j += 1;
-                i += 1;
-                while i < a.len() && span2(a[i]).0 < ye {
-                    i += 1;
-                }
-                if i == a.len() || j == b.len() {
-                    break;
-                }
-                (xs, xe) = span2(a[i]);
-                (ys, ye) = span2(b[j]);
-            }
-        }
-    }
-    for &l in a[i..].iter().chain(&b[j..]) {
-        push_m(out, l);
-    }
-}
-
-/// Intersection: of two overlapping (hence nested) leaves the smaller is kept.
-/// No merge can occur: a full parent in both operands is inside a leaf of each.
-fn intersection(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
-    let (mut i, mut j) = (0, 0);
-    if a.is_empty() || b.is_empty() {
-        return;
-    }
-    let ((mut xs, mut xe), (mut ys, mut ye)) = (span2(a[0]), span2(b[0]));
-    loop {
-        if xe <= ys {
-            i += 1;
-            if i == a.len() {
-                return;
-            }
-            (xs, xe) = span2(a[i]);
-        } else if ye <= xs {
-            j += 1;
-            if j == b.len() {
-                return;
-            }
-            (ys, ye) = span2(b[j]);
-        } else if xs <= ys && ye <= xe {
-            out.push(b[j]);
-            j += 1;
-            if j == b.len() {
-                return;
-            }
-            (ys, ye) = span2(b[j]);
-        } else {
-            out.push(a[i]);
-            i += 1;
-            if i == a.len() {
-                return;
-            }
-            (xs, xe) = span2(a[i]);
-        }
-    }
-}
-
-/// Difference: a leaf of `a` is kept whole, dropped, or cut around the leaves of
-/// `b` inside it (the gaps are emitted greedily as maximal blocks, which is
-/// canonical: a full parent of the result lies in one leaf of `a`, in one gap).
-fn difference(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
-    let mut j = 0;
-    for (i, &x) in a.iter().enumerate() {
-        let (xs, xe) = span2(x);
-        while j < b.len() && span2(b[j]).1 <= xs {
-            j += 1;
-        }
-        if j == b.len() {
-            out.extend_from_slice(&a[i..]);
-            return;
-        }
-        let (ys, ye) = span2(b[j]);
-        if ys >= xe {
-            out.push(x);
-        } else if ys <= xs && xe <= ye {
-            // Inside a leaf of b: dropped.
-        } else {
-            let mut pos = xs;
-            while j < b.len() {
-                let (ys, ye) = span2(b[j]);
-                if ys >= xe {
-                    break;
-                }
-                emit_gap(out, pos, ys, false);
-                pos = ye;
-                j += 1;
-            }
-            emit_gap(out, pos, xe, false);
-        }
-    }
-}
-
-/// Symmetric difference: disjoint leaves pass, a nested pair leaves the larger cut
-/// around every leaf of the other operand inside it; siblings may merge.
-fn symmetric_difference(a: &[Leaf], b: &[Leaf], out: &mut Vec<Leaf>) {
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        let ((xs, xe), (ys, ye)) = (span2(a[i]), span2(b[j]));
-        if xe <= ys {
-            push_m(out, a[i]);
-            i += 1;
-        } else if ye <= xs {
-            push_m(out, b[j]);
-            j += 1;
-        } else {
-            // Nested: cut the larger (from `big`) around the leaves of `small`.
-            let (big_end, mut pos, small, k) = if xs <= ys && ye <= xe {
-                i += 1;
-                (xe, xs, b, &mut j)
-            } else {
-                j += 1;
-                (ye, ys, a, &mut i)
-            };
-            while *k < small.len() {
-                let (s, e) = span2(small[*k]);
-                if s >= big_end {
-                    break;
-                }
-                emit_gap(out, pos, s, true);
-                pos = e;
-                *k += 1;
-            }
-            emit_gap(out, pos, big_end, true);
-        }
-    }
-    for &l in a[i..].iter().chain(&b[j..]) {
-        push_m(out, l);
-    }
 }
