@@ -15,7 +15,7 @@ install_peers libopenvdb-dev libboost-dev libtbb-dev
 r="${1:-100}"; deg="${2:-30}"
 g++ -O3 -DNDEBUG -std=c++17 -o "$work/vdb" "$here/transform.cpp" -lopenvdb -ltbb -lpthread
 (cd "$root" && cargo build --release -q -p tesseral --example rotate_sphere)
-vdb="$("$work/vdb" "$r" "$deg")"
+vdb="$(taskset -c 0 "$work/vdb" "$r" "$deg")"
 ours="$(taskset -c 0 "$root/target/release/examples/rotate_sphere" "$r" "$deg")"
 echo "$vdb"; echo "$ours"
 v=$(sed -n 's/.*one thread: \([0-9.]*\) ms.*/\1/p' <<<"$vdb")
