@@ -45,6 +45,18 @@ struct Affine {
     t: [f64; 3],
 }
 
+/// `c.floor() as i64` (saturating, NaN to 0) without a call to `floor`: truncate,
+/// then step down where truncation went up.
+#[inline]
+pub(super) fn floor_i64(c: f64) -> i64 {
+    let i = c as i64;
+    if (i as f64) > c {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
+}
+
 /// Slack added around a preimage box so that float rounding in the box never
 /// disagrees with the single-centre test.
 const SLACK: f64 = 1e-7;
@@ -58,8 +70,7 @@ impl Affine {
 
 impl Sampling for Affine {
     fn preimage(&self, w: Voxel) -> Voxel {
-        self.back(w.map(|c| c as f64 + 0.5))
-            .map(|c| c.floor() as i64)
+        self.back(w.map(|c| c as f64 + 0.5)).map(floor_i64)
     }
     fn preimage_row(&self, w: Voxel, out: &mut [Voxel]) {
         // The very operations of `back`, in its order, with the terms of y and z
@@ -70,7 +81,7 @@ impl Sampling for Affine {
         let bz: [f64; 3] = std::array::from_fn(|i| m[i][2] * dz);
         for (x, o) in out.iter_mut().enumerate() {
             let dx = ((w[0] + x as i64) as f64 + 0.5) - t[0];
-            *o = std::array::from_fn(|i| ((m[i][0] * dx + by[i]) + bz[i]).floor() as i64);
+            *o = std::array::from_fn(|i| floor_i64((m[i][0] * dx + by[i]) + bz[i]));
         }
     }
     fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel) {
@@ -87,8 +98,8 @@ impl Sampling for Affine {
             }
         }
         (
-            lo.map(|c| (c - SLACK).floor() as i64),
-            hi.map(|c| (c + SLACK).floor() as i64),
+            lo.map(|c| floor_i64(c - SLACK)),
+            hi.map(|c| floor_i64(c + SLACK)),
         )
     }
 }
@@ -155,6 +166,22 @@ impl LinearOctree {
         super::check_space(depth, origin)?;
         let leaves = build_mapped(input, map, depth, origin, max_view_bricks);
         Ok(Self::from_parts(depth, origin, leaves))
+    }
+
+    /// [`LinearOctree::affine`] with every query answered by the tree (no dense
+    /// view), to test the builder's other path.
+    #[cfg(test)]
+    pub(super) fn affine_without_view(&self, m: [[f64; 3]; 3], t: [f64; 3]) -> Self {
+        let (depth, origin) = affine_space(self.bbox().expect("not empty"), m, t).unwrap();
+        let inv = invert_matrix(m).unwrap();
+        Self::mapped_with(self, &Affine { inv, t }, depth, origin, 0).unwrap()
+    }
+
+    /// [`LinearOctree::scale_axes`] with no dense view and no fast path.
+    #[cfg(test)]
+    pub(super) fn scale_axes_without_view(&self, k: [i64; 3]) -> Self {
+        let (depth, origin) = scale_space(self.bbox().expect("not empty"), k).unwrap();
+        Self::mapped_with(self, &IntScale(k), depth, origin, 0).unwrap()
     }
 
     /// The tree scaled by the integer `k[a]` along each axis about the lattice origin:

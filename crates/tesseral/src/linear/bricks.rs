@@ -10,10 +10,10 @@
 use super::LinearOctree;
 use crate::Voxel;
 
-/// A brick with no black voxel.
-const EMPTY: u32 = u32::MAX;
-/// A brick whose 512 voxels are black.
-const FULL: u32 = u32::MAX - 1;
+/// A brick with no black voxel: the index of the bitmap of zeros.
+const EMPTY: u32 = 0;
+/// A brick whose 512 voxels are black: the index of the bitmap of ones.
+const FULL: u32 = 1;
 /// One bit in each byte: `x` spans a byte, so a row mask times this repeats it over
 /// the rows `y`.
 const ROWS: u64 = 0x0101_0101_0101_0101;
@@ -27,9 +27,10 @@ pub(super) struct BrickView {
     dims: [usize; 3],
     /// Voxels per axis (`8 · dims`), for the bounds check.
     extent: [u64; 3],
-    /// Per brick, x fastest: `EMPTY`, `FULL`, or an index into `bits`.
+    /// Per brick, x fastest: its bitmap's index in `bits`.
     states: Vec<u32>,
-    /// The bitmaps of the bricks that are neither empty nor full.
+    /// The bitmaps: zeros (`EMPTY`), ones (`FULL`), then one per brick that is
+    /// neither, so a voxel is looked up without a branch on the brick's kind.
     bits: Vec<[u64; 8]>,
 }
 
@@ -60,7 +61,7 @@ impl BrickView {
             dims,
             extent: dims.map(|d| (d as u64) << 3),
             states: vec![EMPTY; count],
-            bits: Vec::new(),
+            bits: vec![[0; 8], [u64::MAX; 8]],
         };
         for leaf in tree.leaves() {
             let c = crate::code::decode(leaf.code());
@@ -95,7 +96,7 @@ impl BrickView {
         // A canonical tree has no brick filled by small leaves; any other is
         // marked full all the same.
         for s in &mut view.states {
-            if *s < FULL && view.bits[*s as usize] == [u64::MAX; 8] {
+            if *s > FULL && view.bits[*s as usize] == [u64::MAX; 8] {
                 *s = FULL;
             }
         }
@@ -122,11 +123,8 @@ impl BrickView {
             return false;
         };
         let i = self.index(r.map(|c| (c >> 3) as usize));
-        match self.states[i] {
-            EMPTY => false,
-            FULL => true,
-            s => self.bits[s as usize][(r[2] & 7) as usize] >> ((r[1] & 7) * 8 + (r[0] & 7)) & 1 == 1,
-        }
+        let words = &self.bits[self.states[i] as usize];
+        words[(r[2] & 7) as usize] >> ((r[1] & 7) * 8 + (r[0] & 7)) & 1 == 1
     }
 
     /// How many bricks the inclusive box `[lo, hi]` (assumed non-empty) meets, at

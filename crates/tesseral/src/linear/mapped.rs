@@ -4,7 +4,8 @@
 //!
 //! An output cell of side `2^k ≥ 8` is classified by the box of input voxels holding
 //! the preimages of its centres: all black makes it black, all white makes it white,
-//! and only the rest is split. A cell of side 4 is decided voxel by voxel: each row of
+//! and only the rest is split. A cell of side 4 is classified the same way when the
+//! view answers cheaply, and otherwise decided voxel by voxel: each row of
 //! four centres is mapped back with the row's constant terms computed once, and each
 //! preimage looked up in a dense view of the input in 8³ bricks ([`BrickView`]), so
 //! the 64 answers come out as one word in tesseral order. Box queries go to the same
@@ -105,9 +106,7 @@ impl<S: Sampling> Mapper<'_, S> {
 
     fn box_state(&self, lo: Voxel, hi: Voxel) -> BoxState {
         match &self.view {
-            Some(v) if BrickView::bricks_in(lo, hi) <= VIEW_QUERY_MAX_BRICKS => {
-                v.box_state(lo, hi)
-            }
+            Some(v) if BrickView::bricks_in(lo, hi) <= VIEW_QUERY_MAX_BRICKS => v.box_state(lo, hi),
             _ => self.input.box_state(lo, hi),
         }
     }
@@ -115,12 +114,21 @@ impl<S: Sampling> Mapper<'_, S> {
     fn build(&self, code: u64, k: u8, out: &mut Vec<Leaf>) {
         let c = crate::code::decode(code);
         let min: Voxel = std::array::from_fn(|a| self.origin[a] + i64::from(c[a]));
-        if k <= LEAF_CELL_LOG2 {
+        if k < LEAF_CELL_LOG2 || (k == LEAF_CELL_LOG2 && self.view.is_none()) {
             self.leaf_cell(code, min, k, out);
             return;
         }
         let max = min.map(|c| c + (1i64 << k) - 1);
         let (lo, hi) = self.map.preimage_box(min, max);
+        if k == LEAF_CELL_LOG2 {
+            // Decided by the view when its preimage box is, else voxel by voxel.
+            match self.box_state(lo, hi) {
+                BoxState::Empty => {}
+                BoxState::Full => out.push(Leaf::new(code, k)),
+                BoxState::Mixed => self.leaf_cell(code, min, k, out),
+            }
+            return;
+        }
         match self.box_state(lo, hi) {
             BoxState::Empty => {}
             BoxState::Full => out.push(Leaf::new(code, k)),
@@ -135,7 +143,9 @@ impl<S: Sampling> Mapper<'_, S> {
                             part
                         })
                         .collect();
-                    out.extend(parts.into_iter().flatten());
+                    for part in &parts {
+                        out.extend_from_slice(part);
+                    }
                 } else {
                     for d in 0..8 {
                         self.build(code + d * cells, k - 1, out);
@@ -156,14 +166,20 @@ impl<S: Sampling> Mapper<'_, S> {
         let mut row = [[0i64; 3]; 4];
         for z in 0..s {
             for y in 0..s {
-                self.map
-                    .preimage_row([min[0], min[1] + y as i64, min[2] + z as i64], &mut row[..s]);
+                self.map.preimage_row(
+                    [min[0], min[1] + y as i64, min[2] + z as i64],
+                    &mut row[..s],
+                );
                 for (x, p) in row[..s].iter().enumerate() {
                     bits |= u64::from(self.black(*p)) << MORTON4[x | y << 2 | z << 4];
                 }
             }
         }
-        let all = if k == 2 { u64::MAX } else { (1u64 << (s * s * s)) - 1 };
+        let all = if k == 2 {
+            u64::MAX
+        } else {
+            (1u64 << (s * s * s)) - 1
+        };
         if bits == all {
             out.push(Leaf::new(code, k));
             return;
