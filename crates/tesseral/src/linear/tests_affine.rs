@@ -265,6 +265,29 @@ fn affine_without_the_view_is_the_same() {
         assert_eq!(with, without);
         let k: [i64; 3] =
             [0; 3].map(|_| rng.random_range(1..4) * if rng.random_bool(0.3) { -1 } else { 1 });
-        assert_eq!(t.scale_axes(k).unwrap(), t.scale_axes_without_view(k));
+        let s = t.scale_axes_without_view(k);
+        s.assert_valid();
+        assert!(
+            t.scale_axes(k).unwrap().same_voxels(&s).unwrap(),
+            "k = {k:?}"
+        );
+    }
+}
+
+#[test]
+fn scaling_by_a_power_of_two_keeps_its_fast_path_and_its_answer() {
+    // Equal positive powers of two go to scale_up; the general builder agrees.
+    let mut rng = Pcg64::seed_from_u64(38);
+    for _ in 0..40 {
+        let depth = rng.random_range(0..5);
+        let (t, _) = random_tree(&mut rng, depth, 0.05);
+        for s in 0..3u8 {
+            let f = 1i64 << s;
+            let fast = t.scale_axes([f; 3]).unwrap();
+            fast.assert_valid();
+            assert_eq!(fast, t.scale_up(s).unwrap(), "the fast path");
+            let general = t.scale_axes_without_view([f; 3]);
+            assert!(fast.same_voxels(&general).unwrap(), "2^{s}");
+        }
     }
 }
