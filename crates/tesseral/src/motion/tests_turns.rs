@@ -175,7 +175,8 @@ fn random_rooms_give_paths_free_everywhere_or_a_reason() {
         for x in -1..=10 {
             for y in -1..=10 {
                 for z in -1..=4 {
-                    let wall = x < 0 || x > 9 || y < 0 || y > 9 || z < 0 || z > 3;
+                    let wall =
+                        !(0..=9).contains(&x) || !(0..=9).contains(&y) || !(0..=3).contains(&z);
                     if wall || rng.random_bool(0.06) {
                         voxels.push([x, y, z]);
                     }
