@@ -132,8 +132,8 @@ impl BrickView {
     #[inline]
     pub(super) fn bricks_in(lo: Voxel, hi: Voxel) -> u128 {
         (0..3)
-            .map(|a| ((i128::from(hi[a]) - i128::from(lo[a])) as u128 >> 3) + 2)
-            .product()
+            .map(|a| ((i128::from(hi[a]) - i128::from(lo[a])).max(0) as u128 >> 3) + 2)
+            .fold(1, u128::saturating_mul)
     }
 
     /// [`LinearOctree::box_state`] of the viewed tree, by the bricks the box meets,

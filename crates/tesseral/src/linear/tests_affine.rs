@@ -215,6 +215,25 @@ fn the_brick_view_answers_as_the_tree() {
             assert_eq!(view.box_state(a, b), t.box_state(a, b), "{a:?}..={b:?}");
         }
     }
+    // The widest boxes: the cost saturates, the answer is the tree's.
+    use super::bricks::BrickView;
+    assert_eq!(
+        BrickView::bricks_in([i64::MIN; 3], [i64::MAX; 3]),
+        u128::MAX
+    );
+    let t = LinearOctree::from_voxels(3, [-4; 3], [[0, 0, 0], [3, 3, 3]]).unwrap();
+    let view = BrickView::new(&t, usize::MAX).unwrap();
+    for (lo, hi) in [
+        ([i64::MIN; 3], [i64::MAX; 3]),
+        ([0; 3], [i64::MAX; 3]),
+        ([i64::MIN; 3], [0; 3]),
+    ] {
+        assert_eq!(
+            view.box_state(lo, hi),
+            t.box_state(lo, hi),
+            "{lo:?}..={hi:?}"
+        );
+    }
     // Too many bricks: no view.
     let t = LinearOctree::from_voxels(10, [0; 3], [[0, 0, 0], [1000, 1000, 1000]]).unwrap();
     assert!(super::bricks::BrickView::new(&t, 1000).is_none());
