@@ -5,7 +5,7 @@ mod common;
 
 use common::{fails, json, ok};
 use tesseral::io::{read_model, write_model};
-use tesseral::linear::{rotation_matrix, LinearOctree};
+use tesseral::linear::{rotation_matrix, scale_space, LinearOctree};
 use tesseral::model::{Frame, Model};
 
 fn ball(dir: &std::path::Path) -> Model {
@@ -51,6 +51,20 @@ fn scale_by_any_integer_per_axis() {
         read_model(&d.join("two.tess")).unwrap().tree.voxel_count(),
         8 * m.tree.voxel_count()
     );
+    // The 2^K fast path gives the general builder's voxels, and the frame follows:
+    // the placement scales about the world origin, the voxel size is kept.
+    ok(
+        d,
+        &["scale", "ball.tess", "--by", "4,4,4", "-o", "four.tess"],
+    );
+    let four = read_model(&d.join("four.tess")).unwrap();
+    let (depth, origin) = scale_space(m.tree.bbox().unwrap(), [4; 3]).unwrap();
+    let general = m.tree.scale_axes_in([4; 3], depth, origin).unwrap();
+    assert!(four.tree.same_voxels(&general).unwrap());
+    assert_eq!(four.frame, Frame::new(0.5, [4.0, 8.0, 0.0]));
+    // Any factor: the same world point stays under the same voxel.
+    let s = read_model(&d.join("s.tess")).unwrap();
+    assert_eq!(s.frame, Frame::new(0.5, [3.0, 2.0, 0.0]));
     ok(d, &["scale", "ball.tess", "--by", "3", "-o", "three.tess"]);
     assert_eq!(
         read_model(&d.join("three.tess"))

@@ -13,228 +13,9 @@
 //! white, and only the rest is split. The work then follows the output's leaves, not
 //! its voxels. A single voxel is decided by its centre exactly.
 
-use rayon::prelude::*;
-
-use super::{push_merging, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
+use super::mapped::{build_mapped, Sampling, MAX_VIEW_BRICKS};
+use super::{LinearOctree, OctreeError, MAX_DEPTH};
 use crate::Voxel;
-
-/// What an inclusive box of voxels holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BoxState {
-    /// No black voxel.
-    Empty,
-    /// Every voxel black.
-    Full,
-    /// Some of each.
-    Mixed,
-}
-
-impl LinearOctree {
-    /// Whether the inclusive box `[lo, hi]` of voxels is all white, all black or
-    /// mixed; voxels outside the space are white. O(log n + boundary nodes), with an
-    /// early exit at the first mixed evidence.
-    ///
-    /// ```
-    /// use tesseral::linear::{BoxState, LinearOctree};
-    /// let t = LinearOctree::from_voxels(2, [0; 3], [[0, 0, 0], [1, 0, 0]]).unwrap();
-    /// assert_eq!(t.box_state([0, 0, 0], [1, 0, 0]), BoxState::Full);
-    /// assert_eq!(t.box_state([0, 0, 0], [2, 0, 0]), BoxState::Mixed);
-    /// assert_eq!(t.box_state([2, 2, 2], [9, 9, 9]), BoxState::Empty);
-    /// ```
-    #[must_use]
-    pub fn box_state(&self, lo: Voxel, hi: Voxel) -> BoxState {
-        if (0..3).any(|a| lo[a] > hi[a]) {
-            return BoxState::Empty;
-        }
-        let o = self.origin();
-        let side = 1i128 << self.depth();
-        let outside = (0..3).any(|a| {
-            i128::from(lo[a]) < i128::from(o[a]) || i128::from(hi[a]) >= i128::from(o[a]) + side
-        });
-        let inside_any = (0..3).all(|a| {
-            i128::from(hi[a]) >= i128::from(o[a]) && i128::from(lo[a]) < i128::from(o[a]) + side
-        });
-        if !inside_any {
-            return BoxState::Empty;
-        }
-        let rel_lo: [u64; 3] = std::array::from_fn(|a| (lo[a].max(o[a]) - o[a]) as u64);
-        let rel_hi: [u64; 3] = std::array::from_fn(|a| {
-            (i128::from(hi[a]).min(i128::from(o[a]) + side - 1) - i128::from(o[a])) as u64
-        });
-        let mut seen = Seen {
-            black: false,
-            white: outside,
-        };
-        // Start at the smallest aligned node holding the box: two binary searches
-        // instead of a walk from the root.
-        let s = (0..3)
-            .map(|a| 64 - (rel_lo[a] ^ rel_hi[a]).leading_zeros())
-            .max()
-            .unwrap_or(0) as u8;
-        let node_min = rel_lo.map(|c| c >> s << s);
-        let node_code =
-            crate::code::encode(node_min[0] as u32, node_min[1] as u32, node_min[2] as u32);
-        let leaves = self.leaves();
-        let first = leaves.partition_point(|l| l.code() <= node_code);
-        if first > 0
-            && leaves[first - 1].contains_code(node_code)
-            && leaves[first - 1].size_log2() >= s
-        {
-            seen.black = true;
-        } else {
-            let start = leaves.partition_point(|l| l.code() < node_code);
-            let end = start
-                + leaves[start..]
-                    .partition_point(|l| l.code() < node_code + (1u64 << (3 * u32::from(s))));
-            visit(
-                &leaves[start..end],
-                node_code,
-                s,
-                node_min,
-                (rel_lo, rel_hi),
-                &mut seen,
-            );
-        }
-        match (seen.black, seen.white) {
-            (false, _) => BoxState::Empty,
-            (true, false) => BoxState::Full,
-            (true, true) => BoxState::Mixed,
-        }
-    }
-}
-
-struct Seen {
-    black: bool,
-    white: bool,
-}
-
-/// Visits the node of `size_log2` at relative corner `min` with first code `code`,
-/// whose leaves are `leaves`, where it meets the box.
-fn visit(
-    leaves: &[super::Leaf],
-    code: u64,
-    size_log2: u8,
-    min: [u64; 3],
-    (lo, hi): ([u64; 3], [u64; 3]),
-    seen: &mut Seen,
-) {
-    if seen.black && seen.white {
-        return;
-    }
-    let side = 1u64 << size_log2;
-    if (0..3).any(|a| min[a] > hi[a] || min[a] + side - 1 < lo[a]) {
-        return;
-    }
-    match leaves.first() {
-        None => {
-            seen.white = true;
-            return;
-        }
-        Some(l) if l.size_log2() >= size_log2 => {
-            seen.black = true;
-            return;
-        }
-        _ => {}
-    }
-    let child = size_log2 - 1;
-    let cells = 1u64 << (3 * u32::from(child));
-    let half = side / 2;
-    for d in 0..8u64 {
-        let cmin = [0, 1, 2].map(|a| min[a] + ((d >> a) & 1) * half);
-        if (0..3).any(|a| cmin[a] > hi[a] || cmin[a] + half - 1 < lo[a]) {
-            continue;
-        }
-        let start = code + d * cells;
-        let from = leaves.partition_point(|l| l.code() < start);
-        let to = from + leaves[from..].partition_point(|l| l.code() < start + cells);
-        visit(&leaves[from..to], start, child, cmin, (lo, hi), seen);
-        if seen.black && seen.white {
-            return;
-        }
-    }
-}
-
-/// A map from output voxels back to input voxels.
-trait Sampling: Sync {
-    /// The input voxel holding the preimage of output voxel `w`'s centre.
-    fn preimage(&self, w: Voxel) -> Voxel;
-    /// An inclusive box of input voxels holding the preimages of the centres of the
-    /// output cell `[min, max]`.
-    fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel);
-}
-
-/// Builds the image of `input` under `map` in the space of `space` top-down: cells
-/// are classified by their preimage boxes, and a 2 × 2 × 2 cell is decided from its
-/// eight centres with one binary search (their codes are close), so no voxel is
-/// looked up twice.
-fn build_mapped<S: Sampling>(
-    input: &LinearOctree,
-    map: &S,
-    space: &LinearOctree,
-    code: u64,
-    k: u8,
-    out: &mut Vec<Leaf>,
-) {
-    let min = space.voxel_of(code);
-    if k == 0 {
-        if input.contains(map.preimage(min)) {
-            out.push(Leaf::new(code, 0));
-        }
-        return;
-    }
-    if k == 1 {
-        let bits = eight_centres(input, map, min);
-        if bits == 0xff {
-            push_merging(out, Leaf::new(code, 1));
-        } else {
-            out.extend(
-                (0..8u64)
-                    .filter(|d| bits >> d & 1 == 1)
-                    .map(|d| Leaf::new(code + d, 0)),
-            );
-        }
-        return;
-    }
-    let max = min.map(|c| c + (1i64 << k) - 1);
-    let (lo, hi) = map.preimage_box(min, max);
-    match input.box_state(lo, hi) {
-        BoxState::Empty => {}
-        BoxState::Full => out.push(Leaf::new(code, k)),
-        BoxState::Mixed => {
-            let cells = 1u64 << (3 * u32::from(k - 1));
-            if k >= PARALLEL_MIN_SIZE_LOG2 {
-                let parts: Vec<Vec<Leaf>> = (0..8u64)
-                    .into_par_iter()
-                    .map(|d| {
-                        let mut part = Vec::new();
-                        build_mapped(input, map, space, code + d * cells, k - 1, &mut part);
-                        part
-                    })
-                    .collect();
-                out.extend(parts.into_iter().flatten());
-            } else {
-                for d in 0..8 {
-                    build_mapped(input, map, space, code + d * cells, k - 1, out);
-                }
-            }
-            if let Some(last) = out.pop() {
-                push_merging(out, last);
-            }
-        }
-    }
-}
-
-/// Below this cell size (log2) the recursion stays on one thread.
-const PARALLEL_MIN_SIZE_LOG2: u8 = 5;
-
-/// Bit `d` set when the centre of voxel `min + d` (child label `d`) maps into a
-/// black voxel.
-fn eight_centres<S: Sampling>(input: &LinearOctree, map: &S, min: Voxel) -> u8 {
-    (0..8u8).fold(0, |bits, d| {
-        let w = [0, 1, 2].map(|a| min[a] + i64::from((d >> a) & 1));
-        bits | (u8::from(input.contains(map.preimage(w))) << d)
-    })
-}
 
 /// Scaling by an integer per axis: `w ↦ floor((2w + 1) / 2k)`, exact.
 struct IntScale([i64; 3]);
@@ -264,6 +45,15 @@ struct Affine {
     t: [f64; 3],
 }
 
+/// `c.floor() as i64` (saturating, NaN to 0) without a call to `floor`: truncate,
+/// then step down where truncation went up.
+#[inline]
+pub(super) fn floor_i64(c: f64) -> i64 {
+    let i = c as i64;
+    // Without a branch: for negative coordinates it would be taken half the time.
+    i.saturating_sub(i64::from((i as f64) > c))
+}
+
 /// Slack added around a preimage box so that float rounding in the box never
 /// disagrees with the single-centre test.
 const SLACK: f64 = 1e-7;
@@ -277,8 +67,19 @@ impl Affine {
 
 impl Sampling for Affine {
     fn preimage(&self, w: Voxel) -> Voxel {
-        self.back(w.map(|c| c as f64 + 0.5))
-            .map(|c| c.floor() as i64)
+        self.back(w.map(|c| c as f64 + 0.5)).map(floor_i64)
+    }
+    fn preimage_row(&self, w: Voxel, out: &mut [Voxel]) {
+        // The very operations of `back`, in its order, with the terms of y and z
+        // computed once for the row: the answers are those of `preimage`.
+        let (m, t) = (&self.inv, &self.t);
+        let (dy, dz) = ((w[1] as f64 + 0.5) - t[1], (w[2] as f64 + 0.5) - t[2]);
+        let by: [f64; 3] = std::array::from_fn(|i| m[i][1] * dy);
+        let bz: [f64; 3] = std::array::from_fn(|i| m[i][2] * dz);
+        for (x, o) in out.iter_mut().enumerate() {
+            let dx = ((w[0] + x as i64) as f64 + 0.5) - t[0];
+            *o = std::array::from_fn(|i| floor_i64((m[i][0] * dx + by[i]) + bz[i]));
+        }
     }
     fn preimage_box(&self, min: Voxel, max: Voxel) -> (Voxel, Voxel) {
         let c = self.back(min.map(|c| c as f64 + 0.5));
@@ -294,8 +95,8 @@ impl Sampling for Affine {
             }
         }
         (
-            lo.map(|c| (c - SLACK).floor() as i64),
-            hi.map(|c| (c + SLACK).floor() as i64),
+            lo.map(|c| floor_i64(c - SLACK)),
+            hi.map(|c| floor_i64(c + SLACK)),
         )
     }
 }
@@ -347,11 +148,37 @@ impl LinearOctree {
         depth: u8,
         origin: Voxel,
     ) -> Result<Self, OctreeError> {
+        Self::mapped_with(input, map, depth, origin, MAX_VIEW_BRICKS)
+    }
+
+    /// [`LinearOctree::mapped`] with a dense view of the input of at most
+    /// `max_view_bricks` bricks (0: none, every query goes to the tree).
+    fn mapped_with<S: Sampling>(
+        input: &Self,
+        map: &S,
+        depth: u8,
+        origin: Voxel,
+        max_view_bricks: usize,
+    ) -> Result<Self, OctreeError> {
         super::check_space(depth, origin)?;
-        let space = Self::from_parts(depth, origin, Vec::new());
-        let mut leaves = Vec::new();
-        build_mapped(input, map, &space, 0, depth, &mut leaves);
+        let leaves = build_mapped(input, map, depth, origin, max_view_bricks);
         Ok(Self::from_parts(depth, origin, leaves))
+    }
+
+    /// [`LinearOctree::affine`] with every query answered by the tree (no dense
+    /// view), to test the builder's other path.
+    #[cfg(test)]
+    pub(super) fn affine_without_view(&self, m: [[f64; 3]; 3], t: [f64; 3]) -> Self {
+        let (depth, origin) = affine_space(self.bbox().expect("not empty"), m, t).unwrap();
+        let inv = invert_matrix(m).unwrap();
+        Self::mapped_with(self, &Affine { inv, t }, depth, origin, 0).unwrap()
+    }
+
+    /// [`LinearOctree::scale_axes`] with no dense view and no fast path.
+    #[cfg(test)]
+    pub(super) fn scale_axes_without_view(&self, k: [i64; 3]) -> Self {
+        let (depth, origin) = scale_space(self.bbox().expect("not empty"), k).unwrap();
+        Self::mapped_with(self, &IntScale(k), depth, origin, 0).unwrap()
     }
 
     /// The tree scaled by the integer `k[a]` along each axis about the lattice origin:

@@ -7,10 +7,13 @@
 //! Two equal solids in the same space therefore have equal leaf lists.
 
 mod affine;
+mod box_state;
+mod bricks;
 mod build;
 mod enumerate;
 pub(crate) mod grow;
 mod leaf;
+mod mapped;
 mod merge;
 mod node_list;
 mod ops;
@@ -18,7 +21,8 @@ mod resample;
 mod sort;
 mod transform;
 
-pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space, BoxState};
+pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space};
+pub use box_state::BoxState;
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};

@@ -194,3 +194,119 @@ fn voxels_into_is_voxels() {
     big.voxels_into(&mut v);
     assert_eq!(v, big.voxels().collect::<Vec<_>>());
 }
+
+#[test]
+fn the_brick_view_answers_as_the_tree() {
+    let mut rng = Pcg64::seed_from_u64(35);
+    for _ in 0..150 {
+        // Up to 32³, so that leaves of side 8 and 16 occur.
+        let depth = rng.random_range(0..6);
+        let (t, set) = random_tree(&mut rng, depth, 0.02);
+        let view = super::bricks::BrickView::new(&t, usize::MAX).expect("small view");
+        let o = t.origin();
+        let side = 1i64 << t.depth();
+        for _ in 0..300 {
+            let v: Voxel = [0; 3].map(|a| o[a] + rng.random_range(-9..side + 9));
+            assert_eq!(view.contains(v), set.contains(&v), "{v:?}");
+        }
+        for _ in 0..30 {
+            let a: Voxel = [0; 3].map(|i| o[i] + rng.random_range(-9..side + 3));
+            let b: Voxel = [0; 3].map(|i| a[i] + rng.random_range(-1..20));
+            assert_eq!(view.box_state(a, b), t.box_state(a, b), "{a:?}..={b:?}");
+        }
+    }
+    // The widest boxes: the cost saturates, the answer is the tree's.
+    use super::bricks::BrickView;
+    assert_eq!(
+        BrickView::bricks_in([i64::MIN; 3], [i64::MAX; 3]),
+        u128::MAX
+    );
+    let t = LinearOctree::from_voxels(3, [-4; 3], [[0, 0, 0], [3, 3, 3]]).unwrap();
+    let view = BrickView::new(&t, usize::MAX).unwrap();
+    for (lo, hi) in [
+        ([i64::MIN; 3], [i64::MAX; 3]),
+        ([0; 3], [i64::MAX; 3]),
+        ([i64::MIN; 3], [0; 3]),
+    ] {
+        assert_eq!(
+            view.box_state(lo, hi),
+            t.box_state(lo, hi),
+            "{lo:?}..={hi:?}"
+        );
+    }
+    // Too many bricks: no view.
+    let t = LinearOctree::from_voxels(10, [0; 3], [[0, 0, 0], [1000, 1000, 1000]]).unwrap();
+    assert!(super::bricks::BrickView::new(&t, 1000).is_none());
+}
+
+#[test]
+fn floor_without_the_call_is_floor() {
+    let mut rng = Pcg64::seed_from_u64(36);
+    let special = [
+        0.0,
+        -0.0,
+        0.5,
+        -0.5,
+        1.0,
+        -1.0,
+        -1e-300,
+        1e-300,
+        2f64.powi(52) + 1.0,
+        -(2f64.powi(52)) - 1.0,
+        2f64.powi(63),
+        -(2f64.powi(63)),
+        -(2f64.powi(63)) - 4096.0,
+        1e300,
+        -1e300,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+        f64::NAN,
+    ];
+    let random = (0..10_000).map(|_| rng.random_range(-1e6..1e6) * f64::from(rng.random_bool(0.5)));
+    for c in special.into_iter().chain(random) {
+        assert_eq!(super::affine::floor_i64(c), c.floor() as i64, "{c}");
+    }
+}
+
+#[test]
+fn affine_without_the_view_is_the_same() {
+    // The builder's other path (an input too sparse for a view) against the view's.
+    let mut rng = Pcg64::seed_from_u64(37);
+    for _ in 0..60 {
+        let depth = rng.random_range(1..5);
+        let (t, _) = random_tree(&mut rng, depth, 0.05);
+        let axis: [f64; 3] = [0; 3].map(|_| rng.random_range(-1.0..1.0));
+        let m = rotation_matrix(axis, rng.random_range(-180.0..180.0));
+        let off: [f64; 3] = [0; 3].map(|_| rng.random_range(-5.0..5.0));
+        let with = t.affine(m, off).unwrap();
+        let without = t.affine_without_view(m, off);
+        without.assert_valid();
+        assert_eq!(with, without);
+        let k: [i64; 3] =
+            [0; 3].map(|_| rng.random_range(1..4) * if rng.random_bool(0.3) { -1 } else { 1 });
+        let s = t.scale_axes_without_view(k);
+        s.assert_valid();
+        assert!(
+            t.scale_axes(k).unwrap().same_voxels(&s).unwrap(),
+            "k = {k:?}"
+        );
+    }
+}
+
+#[test]
+fn scaling_by_a_power_of_two_keeps_its_fast_path_and_its_answer() {
+    // Equal positive powers of two go to scale_up; the general builder agrees.
+    let mut rng = Pcg64::seed_from_u64(38);
+    for _ in 0..40 {
+        let depth = rng.random_range(0..5);
+        let (t, _) = random_tree(&mut rng, depth, 0.05);
+        for s in 0..3u8 {
+            let f = 1i64 << s;
+            let fast = t.scale_axes([f; 3]).unwrap();
+            fast.assert_valid();
+            assert_eq!(fast, t.scale_up(s).unwrap(), "the fast path");
+            let general = t.scale_axes_without_view([f; 3]);
+            assert!(fast.same_voxels(&general).unwrap(), "2^{s}");
+        }
+    }
+}
