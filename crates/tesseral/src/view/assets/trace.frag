@@ -38,6 +38,13 @@ uint entry(uint i) {
   return texelFetch(uTree, ivec2(int(i & 4095u), int(i >> 12u)), 0).r;
 }
 
+// The set bits of an 8-bit mask (GLSL ES 3.00 has no bitCount).
+uint popcount8(uint x) {
+  x = x - ((x >> 1u) & 0x55u);
+  x = (x & 0x33u) + ((x >> 2u) & 0x33u);
+  return (x + (x >> 4u)) & 0x0fu;
+}
+
 // The cell holding voxel v: its colour (or -1 when white), lowest voxel and size.
 int lookupCell(ivec3 v, out ivec3 cmin, out int s) {
   s = uDepth;
@@ -57,7 +64,7 @@ int lookupCell(ivec3 v, out ivec3 cmin, out int s) {
       cmin = (v >> s) << s;
       return -1;
     }
-    e = entry((e >> 8u) + uint(bitCount(mask & ((1u << d) - 1u))));
+    e = entry((e >> 8u) + popcount8(mask & ((1u << d) - 1u)));
   }
   return -1;
 }

@@ -587,6 +587,12 @@ window.tesseral = {
     return countInBox(f, lo, hi);
   },
   draw,
+  // Fixes the canvas at w x h CSS pixels (tests compare it with a PNG of that size).
+  setSize: (w, h) => {
+    canvas.style.width = w + "px";
+    canvas.style.height = h + "px";
+    draw();
+  },
   snapshot: () => {
     draw();
     return canvas.toDataURL("image/png");
