@@ -56,17 +56,20 @@ pub fn run(args: Args) -> Result<()> {
     if output::is_stdio(&args.output) {
         bail!("--output: write the page to a file (name.html), not standard output");
     }
-    let colour = Colour::parse(&args.colour)
-        .map(|c| c.0)
-        .with_context(|| format!("--colour {:?}: expected a colour name or #rrggbb", args.colour))?;
+    let colour = Colour::parse(&args.colour).map(|c| c.0).with_context(|| {
+        format!(
+            "--colour {:?}: expected a colour name or #rrggbb",
+            args.colour
+        )
+    })?;
     let start = Instant::now();
     let model = octree::read_model(&args.input, &args.budget, &Default::default())?;
     let load_ms = start.elapsed().as_secs_f64() * 1e3;
     let start = Instant::now();
-    let title = args
-        .input
-        .file_name()
-        .map_or_else(|| args.input.display().to_string(), |n| n.to_string_lossy().into_owned());
+    let title = args.input.file_name().map_or_else(
+        || args.input.display().to_string(),
+        |n| n.to_string_lossy().into_owned(),
+    );
     let mut page = Page::new(&title, model.frame);
     let colouring = match &model.colors {
         Some(layer) => Colouring::Layer(layer, colour),
@@ -113,7 +116,11 @@ fn too_large(args: &PageArgs, why: &str) -> anyhow::Error {
 /// # Errors
 /// Under `--exact`, an error naming the limit and the depth that would fit.
 pub fn reduced_note(page: &mut Page, args: &PageArgs, frames: &[PageFrame]) -> Result<()> {
-    let Some(worst) = frames.iter().filter(|f| f.levels < f.depth).min_by_key(|f| f.levels) else {
+    let Some(worst) = frames
+        .iter()
+        .filter(|f| f.levels < f.depth)
+        .min_by_key(|f| f.levels)
+    else {
         return Ok(());
     };
     if args.exact {

@@ -21,9 +21,8 @@ pub const ENTRY_BYTES: f64 = 16.0 / 3.0;
 
 /// The page's size without its data: the HTML, CSS, JavaScript and GLSL, plus room
 /// for the metadata.
-pub const PAGE_OVERHEAD: u64 = (HTML.len() + CSS.len() + JS.len() + VERT.len() + FRAG.len())
-    as u64
-    + 16 * 1024;
+pub const PAGE_OVERHEAD: u64 =
+    (HTML.len() + CSS.len() + JS.len() + VERT.len() + FRAG.len()) as u64 + 16 * 1024;
 
 /// One tree of a page (an animation has several).
 #[derive(Debug, Clone, PartialEq, Serialize)]

@@ -138,7 +138,10 @@ fn rays_match_the_renderers_traversal() {
                     };
                     let p = [0, 1, 2].map(|a| from[a] + dir[a] * t);
                     let whole = p.iter().filter(|c| (*c - c.round()).abs() < 1e-9).count();
-                    assert!(whole >= 2, "renderer {w:?}, packed {g:?}, from {from:?} dir {dir:?}");
+                    assert!(
+                        whole >= 2,
+                        "renderer {w:?}, packed {g:?}, from {from:?} dir {dir:?}"
+                    );
                     if let Some(g) = g {
                         assert!(set.contains(&[0, 1, 2].map(|a| origin[a] + g.voxel[a])));
                     }
@@ -219,8 +222,8 @@ fn layer_colours_reach_every_voxel() {
         let leaves =
             coloured_leaves(&tree, Colouring::Layer(&layer, fallback), &mut palette).unwrap();
         // The pieces cover exactly the tree.
-        let again = LinearOctree::from_sorted_leaves(depth, origin, leaves.iter().map(|l| l.0))
-            .unwrap();
+        let again =
+            LinearOctree::from_sorted_leaves(depth, origin, leaves.iter().map(|l| l.0)).unwrap();
         assert_eq!(again, tree);
         let mut entries = Vec::new();
         let packed = PackedTree::build(&mut entries, depth, &leaves, MAX_ENTRIES).unwrap();
@@ -260,7 +263,9 @@ fn a_budget_gives_a_coarser_tree_black_where_any_voxel_is() {
                     let cell = lookup(&entries, &packed, [x, y, z]);
                     let c = [x, y, z].map(|v| v / unit * unit);
                     let any = (0..unit).any(|i| {
-                        (0..unit).any(|j| (0..unit).any(|k| set.contains(&[c[0] + i, c[1] + j, c[2] + k])))
+                        (0..unit).any(|j| {
+                            (0..unit).any(|k| set.contains(&[c[0] + i, c[1] + j, c[2] + k]))
+                        })
                     });
                     assert_eq!(cell.colour.is_some(), any, "{x} {y} {z} unit {unit}");
                 }
@@ -274,15 +279,24 @@ fn a_page_is_self_contained_and_within_its_budget() {
     let mut rng = Rng(0x5eed_0006);
     let set = random_voxels(&mut rng, 5, [0; 3]);
     let tree = LinearOctree::from_voxels(5, [0; 3], set.iter().copied()).unwrap();
-    let mut page = Page::new("a </script> test", crate::model::Frame::new(0.5, [1.0, 2.0, 3.0]));
+    let mut page = Page::new(
+        "a </script> test",
+        crate::model::Frame::new(0.5, [1.0, 2.0, 3.0]),
+    );
     let budget = page.entry_budget(64 << 20);
     page.add(&tree, Colouring::Fixed([200, 100, 50]), "only", budget)
         .unwrap();
     let html = page.html();
     assert!(!html.contains("http://") && !html.contains("https://"));
-    assert_eq!(html.matches("</script>").count(), html.matches("<script").count());
+    assert_eq!(
+        html.matches("</script>").count(),
+        html.matches("<script").count()
+    );
     assert!(html.contains("\"voxel_size\":0.5"));
-    assert!(html.len() as u64 <= PAGE_OVERHEAD + (page.entries().len() as f64 * ENTRY_BYTES) as u64 + 64);
+    assert!(
+        html.len() as u64
+            <= PAGE_OVERHEAD + (page.entries().len() as f64 * ENTRY_BYTES) as u64 + 64
+    );
     // A budget too small for the top level is refused, naming the numbers.
     let mut small = Page::new("x", crate::model::Frame::new(1.0, [0.0; 3]));
     let err = small.add(&tree, Colouring::Fixed([1, 1, 1]), "x", 1);
