@@ -170,3 +170,110 @@ fn bad_input_is_refused_with_a_clear_error() {
     assert_eq!(out.status.code(), Some(2));
     assert_eq!(std::fs::read(d.join("in.html")).unwrap(), before);
 }
+
+fn write_xyz(dir: &Path, name: &str, voxels: impl IntoIterator<Item = [i64; 3]>) {
+    let text: String = voxels
+        .into_iter()
+        .map(|v| format!("{} {} {}\n", v[0], v[1], v[2]))
+        .collect();
+    std::fs::write(dir.join(name), text).unwrap();
+}
+
+fn cube(n: i64) -> Vec<[i64; 3]> {
+    (0..n)
+        .flat_map(|x| (0..n).flat_map(move |y| (0..n).map(move |z| [x, y, z])))
+        .collect()
+}
+
+#[test]
+fn simulate_view_plays_every_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write_xyz(
+        d,
+        "wall.xyz",
+        (0..16).flat_map(|y| (0..16).map(move |z| [30, y, z])),
+    );
+    write_xyz(d, "box.xyz", cube(3));
+    let world = r#"{
+      "environment": "wall.xyz", "time_step": 1, "steps": 3,
+      "objects": [ { "name": "crate", "octree": "box.xyz", "start": [20, 4, 4], "velocity": [4, 0, 0] } ]
+    }"#;
+    std::fs::write(d.join("world.json"), world).unwrap();
+    ok(d, &["simulate", "world.json", "--view", "sim.html"]);
+    let data = page_data(&d.join("sim.html"));
+    self_contained(&d.join("sim.html"));
+    let frames = data["frames"].as_array().unwrap();
+    assert_eq!(frames.len(), 4);
+    assert_eq!(frames[2]["label"], "step 2, t = 2");
+    // The wall and the crate: 256 + 27 voxels (they do not overlap until step 3).
+    assert_eq!(frames[0]["voxels"], 256 + 27);
+    // Two colours: the environment's and the crate's (red once in contact).
+    let palette = base64::engine::general_purpose::STANDARD
+        .decode(data["palette"].as_str().unwrap())
+        .unwrap();
+    assert!(palette.len() >= 6);
+    // A named view and a page together; two pages are refused; the world is never
+    // overwritten.
+    ok(
+        d,
+        &[
+            "simulate",
+            "world.json",
+            "--view",
+            "top",
+            "--view",
+            "b.html",
+        ],
+    );
+    fails(
+        d,
+        &[
+            "simulate",
+            "world.json",
+            "--view",
+            "a.html",
+            "--view",
+            "b.html",
+        ],
+        "--view",
+    );
+    fails(d, &["simulate", "world.json", "--view", "nope"], "nope");
+}
+
+#[test]
+fn rsmc_view_plays_the_samples() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let args = [
+        "rsmc",
+        "--steps",
+        "3000",
+        "--sample-every",
+        "1000",
+        "-o",
+        "run",
+        "--view",
+        "r.html",
+        "--no-picture",
+    ];
+    ok(d, &args);
+    let data = page_data(&d.join("r.html"));
+    let frames = data["frames"].as_array().unwrap();
+    let labels: Vec<&str> = frames
+        .iter()
+        .map(|f| f["label"].as_str().unwrap())
+        .collect();
+    assert_eq!(labels.len(), 4, "{labels:?}");
+    assert!(
+        labels[0].starts_with("step 0, area 6, volume 1"),
+        "{labels:?}"
+    );
+    assert!(labels[3].starts_with("step 3000,"), "{labels:?}");
+    assert_eq!(frames[0]["voxels"], 1);
+    fails(
+        d,
+        &["rsmc", "--steps", "10", "-o", "run2", "--view", "r.png"],
+        "--view",
+    );
+}

@@ -82,6 +82,12 @@ pub struct Args {
     /// Print one JSON summary object at the end instead of text.
     #[arg(long)]
     json: bool,
+    /// Write an interactive viewer page (`.html`) that plays the surface at every
+    /// row of series.csv with a time slider (see `tesseral view`).
+    #[arg(long, value_name = "FILE")]
+    view: Option<PathBuf>,
+    #[command(flatten)]
+    page: super::view::PageArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
@@ -406,6 +412,46 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         s.checked_div(every)
             .map_or(u64::MAX, |q| (q + 1).saturating_mul(every))
     };
+    if let Some(page) = &args.view {
+        super::output::guard("--view", page, &["html"], &[&cp_path, &csv_path])?;
+    }
+    let mut anim = args.view.as_ref().map(|p| {
+        let title = p
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        let count = args.steps.saturating_sub(chain.steps()) / sample_every.max(1) + 2;
+        super::view::Animation::new(
+            &title,
+            tesseral::Frame::new(1.0, [0.0; 3]),
+            args.page,
+            count,
+        )
+    });
+    let mut viewed = 0u64;
+    let mut view_frame =
+        |chain: &Chain<L>, anim: &mut Option<super::view::Animation>| -> Result<()> {
+            let Some(a) = anim.as_mut() else {
+                return Ok(());
+            };
+            if a.wants(viewed) {
+                let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
+                    .context("building the octree to view")?;
+                let label = format!(
+                    "step {}, area {}, volume {}",
+                    chain.steps(),
+                    chain.area(),
+                    chain.volume()
+                );
+                a.add(
+                    &tree,
+                    tesseral::view::Colouring::Fixed(tesseral::render::DEFAULT_COLOUR),
+                    &label,
+                )?;
+            }
+            viewed += 1;
+            Ok(())
+        };
+    view_frame(&chain, &mut anim)?;
     let t0 = Instant::now();
     while chain.steps() < args.steps {
         let s = chain.steps();
@@ -422,6 +468,9 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             rows.push(row(&chain, base));
             base = (s, chain.counters().accepted);
             bar.set_message(format!("area {}", chain.area()));
+            if s < args.steps {
+                view_frame(&chain, &mut anim)?;
+            }
         }
         if args.check_every > 0 && s % args.check_every == 0 {
             topology::check_sphere(&chain.voxels())
@@ -438,6 +487,23 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     }
     let report = topology::check_sphere(&chain.voxels())
         .context("global topology check of the final surface")?;
+    // The last surface always, whichever samples the page keeps.
+    if let (Some(mut a), Some(path)) = (anim, &args.view) {
+        let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
+            .context("building the octree to view")?;
+        let label = format!(
+            "step {}, area {}, volume {}",
+            chain.steps(),
+            chain.area(),
+            chain.volume()
+        );
+        a.add(
+            &tree,
+            tesseral::view::Colouring::Fixed(tesseral::render::DEFAULT_COLOUR),
+            &label,
+        )?;
+        a.finish(path)?;
+    }
     save(&mut chain, &rows, base)?;
     let points: Vec<(f64, f64)> = rows
         .iter()

@@ -164,3 +164,78 @@ pub fn write_page(page: &Page, path: &Path, args: &PageArgs) -> Result<u64> {
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(bytes)
 }
+
+/// The most frames an animation page holds; longer runs keep every k-th step.
+pub const MAX_FRAMES: u64 = 240;
+
+/// An animation page in the making (`simulate --view`, `rsmc --view`): frames are
+/// added as the run produces them, each within its share of `--max-page`.
+pub struct Animation {
+    page: Page,
+    args: PageArgs,
+    every: u64,
+    expected: u64,
+    added: u64,
+    shown: Vec<PageFrame>,
+}
+
+impl Animation {
+    /// A page for a run of `count` frames (steps, sweeps).
+    pub fn new(title: &str, frame: tesseral::Frame, args: PageArgs, count: u64) -> Self {
+        let every = count.div_ceil(MAX_FRAMES).max(1);
+        let mut page = Page::new(title, frame);
+        if every > 1 {
+            page.note(&format!(
+                "{count} frames: every {every}th is shown (at most {MAX_FRAMES})."
+            ));
+        }
+        Self {
+            page,
+            args,
+            every,
+            expected: count.div_ceil(every),
+            added: 0,
+            shown: Vec::new(),
+        }
+    }
+
+    /// Whether frame `index` (from 0) goes into the page.
+    pub fn wants(&self, index: u64) -> bool {
+        index % self.every == 0
+    }
+
+    /// Adds the next frame kept, with its label.
+    ///
+    /// # Errors
+    /// When not even its top level fits its share of the page.
+    pub fn add(
+        &mut self,
+        tree: &tesseral::LinearOctree,
+        colouring: Colouring<'_>,
+        label: &str,
+    ) -> Result<()> {
+        let left = self.expected.saturating_sub(self.added).max(1);
+        let share = self.page.entry_budget(self.args.max_page) / left as usize;
+        let f = self
+            .page
+            .add(tree, colouring, label, share)
+            .map_err(|e| too_large(&self.args, &e.to_string()))?
+            .clone();
+        self.shown.push(f);
+        self.added += 1;
+        Ok(())
+    }
+
+    /// Writes the page (after the notes on any frame shown coarser); returns its size.
+    ///
+    /// # Errors
+    /// Under `--exact` when a frame was shown coarser; the write's errors.
+    pub fn finish(mut self, path: &Path) -> Result<u64> {
+        if self.shown.is_empty() {
+            bail!("{}: no frame to show", path.display());
+        }
+        let shown = std::mem::take(&mut self.shown);
+        reduced_note(&mut self.page, &self.args, &shown)?;
+        write_page(&self.page, path, &self.args)
+    }
+}
