@@ -80,7 +80,7 @@ pub fn run(args: Args) -> Result<()> {
         .add(&model.tree, colouring, &title, budget)
         .map_err(|e| too_large(&args.page, &e.to_string()))?
         .clone();
-    reduced_note(&mut page, &args.page, &[frame.clone()])?;
+    reduced_note(&mut page, &args.page, std::slice::from_ref(&frame))?;
     let pack_ms = start.elapsed().as_secs_f64() * 1e3;
     let bytes = write_page(&page, &args.output, &args.page)?;
     if args.json {

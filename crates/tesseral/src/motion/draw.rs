@@ -92,6 +92,9 @@ pub fn render_frame(
     ))
 }
 
+/// A part of a picture and its colour.
+pub type ColouredRegion = ([u8; 3], LinearOctree);
+
 /// One step of a world as coloured parts, for the viewer's animations: the joined
 /// octree, and disjoint regions of it with the colours [`render_frame`] gives them
 /// (an object in contact red; the environment is what no region holds, drawn in
@@ -102,7 +105,7 @@ pub fn render_frame(
 pub fn frame_regions(
     world: &World,
     frame: &Frame,
-) -> Result<(LinearOctree, Vec<([u8; 3], LinearOctree)>), OctreeError> {
+) -> Result<(LinearOctree, Vec<ColouredRegion>), OctreeError> {
     let touching: HashSet<usize> = frame
         .overlaps
         .iter()
