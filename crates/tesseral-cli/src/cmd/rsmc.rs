@@ -14,6 +14,8 @@ use tesseral::render::{self, RenderOptions};
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
+use super::view::Animation;
+
 /// Arguments of `tesseral rsmc`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -415,43 +417,21 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     if let Some(page) = &args.view {
         super::output::guard("--view", page, &["html"], &[&cp_path, &csv_path])?;
     }
-    let mut anim = args.view.as_ref().map(|p| {
-        let title = p
-            .file_stem()
-            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-        let count = args.steps.saturating_sub(chain.steps()) / sample_every.max(1) + 2;
-        super::view::Animation::new(
-            &title,
-            tesseral::Frame::new(1.0, [0.0; 3]),
-            args.page,
-            count,
-        )
-    });
-    let mut viewed = 0u64;
-    let mut view_frame =
-        |chain: &Chain<L>, anim: &mut Option<super::view::Animation>| -> Result<()> {
-            let Some(a) = anim.as_mut() else {
-                return Ok(());
-            };
-            if a.wants(viewed) {
-                let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
-                    .context("building the octree to view")?;
-                let label = format!(
-                    "step {}, area {}, volume {}",
-                    chain.steps(),
-                    chain.area(),
-                    chain.volume()
-                );
-                a.add(
-                    &tree,
-                    tesseral::view::Colouring::Fixed(tesseral::render::DEFAULT_COLOUR),
-                    &label,
-                )?;
-            }
-            viewed += 1;
-            Ok(())
-        };
-    view_frame(&chain, &mut anim)?;
+    let count = args.steps.saturating_sub(chain.steps()) / sample_every.max(1) + 2;
+    let unit = tesseral::Frame::new(1.0, [0.0; 3]);
+    let mut anim = (args.view.as_ref()).map(|p| Animation::for_file(p, unit, args.page, count));
+    let surface = |c: &Chain<L>| {
+        let label = format!(
+            "step {}, area {}, volume {}",
+            c.steps(),
+            c.area(),
+            c.volume()
+        );
+        (c.voxels(), label)
+    };
+    if let Some(a) = anim.as_mut() {
+        a.offer_voxels(false, || surface(&chain))?;
+    }
     let t0 = Instant::now();
     while chain.steps() < args.steps {
         let s = chain.steps();
@@ -468,8 +448,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             rows.push(row(&chain, base));
             base = (s, chain.counters().accepted);
             bar.set_message(format!("area {}", chain.area()));
-            if s < args.steps {
-                view_frame(&chain, &mut anim)?;
+            if let Some(a) = anim.as_mut().filter(|_| s < args.steps) {
+                a.offer_voxels(false, || surface(&chain))?;
             }
         }
         if args.check_every > 0 && s % args.check_every == 0 {
@@ -489,19 +469,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         .context("global topology check of the final surface")?;
     // The last surface always, whichever samples the page keeps.
     if let (Some(mut a), Some(path)) = (anim, &args.view) {
-        let tree = LinearOctree::from_voxels_fitted(&chain.voxels())
-            .context("building the octree to view")?;
-        let label = format!(
-            "step {}, area {}, volume {}",
-            chain.steps(),
-            chain.area(),
-            chain.volume()
-        );
-        a.add(
-            &tree,
-            tesseral::view::Colouring::Fixed(tesseral::render::DEFAULT_COLOUR),
-            &label,
-        )?;
+        a.offer_voxels(true, || surface(&chain))?;
         a.finish(path)?;
     }
     save(&mut chain, &rows, base)?;

@@ -186,12 +186,9 @@ pub fn run(args: Args) -> Result<()> {
     }
     let mut failure = None;
     let boxes = args.json || args.frames.is_some();
-    let mut anim = view_page.as_ref().map(|p| {
-        let title = p
-            .file_stem()
-            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
-        super::view::Animation::new(&title, wf.frame, args.page, wf.steps.saturating_add(1))
-    });
+    let count = wf.steps.saturating_add(1);
+    let mut anim = (view_page.as_ref())
+        .map(|p| super::view::Animation::for_file(p, wf.frame, args.page, count));
     world
         .simulate_each(wf.time_step, wf.steps, boxes, |step| {
             let done = report

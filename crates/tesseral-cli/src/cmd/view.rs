@@ -176,10 +176,20 @@ pub struct Animation {
     every: u64,
     expected: u64,
     added: u64,
+    offered: u64,
     shown: Vec<PageFrame>,
 }
 
 impl Animation {
+    /// A page to write at `path` (titled by its name) for a run of about `count`
+    /// frames.
+    pub fn for_file(path: &Path, frame: tesseral::Frame, args: PageArgs, count: u64) -> Self {
+        let title = path
+            .file_stem()
+            .map_or_else(String::new, |s| s.to_string_lossy().into_owned());
+        Self::new(&title, frame, args, count)
+    }
+
     /// A page for a run of `count` frames (steps, sweeps).
     pub fn new(title: &str, frame: tesseral::Frame, args: PageArgs, count: u64) -> Self {
         let every = count.div_ceil(MAX_FRAMES).max(1);
@@ -195,6 +205,7 @@ impl Animation {
             every,
             expected: count.div_ceil(every),
             added: 0,
+            offered: 0,
             shown: Vec::new(),
         }
     }
@@ -202,6 +213,28 @@ impl Animation {
     /// Whether frame `index` (from 0) goes into the page.
     pub fn wants(&self, index: u64) -> bool {
         index % self.every == 0
+    }
+
+    /// Offers the next frame of a run as voxels in one colour, with its label; it
+    /// is kept when its turn comes, or when it is the `last`.
+    ///
+    /// # Errors
+    /// As [`Animation::add`].
+    pub fn offer_voxels(
+        &mut self,
+        last: bool,
+        frame: impl FnOnce() -> (Vec<tesseral::Voxel>, String),
+    ) -> Result<()> {
+        let index = self.offered;
+        self.offered += 1;
+        if !(last || self.wants(index)) {
+            return Ok(());
+        }
+        let (voxels, label) = frame();
+        let tree = tesseral::LinearOctree::from_voxels_fitted(&voxels)
+            .context("building the octree to view")?;
+        let colour = Colouring::Fixed(tesseral::render::DEFAULT_COLOUR);
+        self.add(&tree, colour, &label)
     }
 
     /// Adds the next frame kept, with its label.

@@ -87,13 +87,10 @@ impl Palette {
 }
 
 /// How a tree's black leaves get their colours.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, Debug)]
 pub enum Colouring<'a> {
     /// One colour for all.
     Fixed([u8; 3]),
-    /// The colour at the centre of each leaf (voxel coordinates), e.g. a scene's
-    /// [`crate::csg::Csg::colour_at`].
-    At(&'a (dyn Fn([f64; 3]) -> [u8; 3] + Sync)),
     /// A file's stored colours, in the tree's space; voxels without one get the
     /// fallback colour. Leaves are split where the colours change, so every voxel
     /// shows its own colour.
@@ -114,18 +111,6 @@ pub fn coloured_leaves(
         Colouring::Fixed(rgb) => {
             let i = palette.index(rgb)?;
             Ok(tree.leaves().iter().map(|&l| (l, i)).collect())
-        }
-        Colouring::At(f) => {
-            let origin = tree.origin().map(|c| c as f64);
-            tree.blocks()
-                .zip(tree.leaves())
-                .map(|(b, &l)| {
-                    let half = b.size() as f64 / 2.0;
-                    let centre = b.min.map(|c| c as f64 + half);
-                    debug_assert!(centre.iter().zip(origin).all(|(c, o)| *c >= o));
-                    Ok((l, palette.index(f(centre))?))
-                })
-                .collect()
         }
         Colouring::Layer(layer, fallback) => {
             let stored = layer.leaves();

@@ -12,6 +12,7 @@ use crate::Voxel;
 
 const HTML: &str = include_str!("assets/page.html");
 const CSS: &str = include_str!("assets/page.css");
+const TREE_JS: &str = include_str!("assets/tree.js");
 const JS: &str = include_str!("assets/viewer.js");
 const VERT: &str = include_str!("assets/quad.vert");
 const FRAG: &str = include_str!("assets/trace.frag");
@@ -176,6 +177,7 @@ impl Page {
             .replace("{{CSS}}", CSS)
             .replace("{{VERT}}", VERT)
             .replace("{{FRAG}}", FRAG)
+            .replace("{{TREE_JS}}", TREE_JS)
             .replace("{{JS}}", JS)
             .replace("{{DATA}}", &json)
     }
