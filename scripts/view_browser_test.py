@@ -6,7 +6,7 @@ the showcase page (size, load time, frame time at 1024x1024).
 
 Checks:
 - first_frame_matches_render: the page's first picture against `tesseral render`
-  from the same camera (--no-shadows --normals faces): silhouette IoU >= 0.97, and
+  from the same camera (the four named views, and perspective) (--no-shadows --normals faces): silhouette IoU >= 0.97, and
   the colours of pixels both cover within a tolerance;
 - drag_turns_the_view: a scripted mouse drag changes the camera and the picture;
 - cut_removes_what_it_should: with the cut plane z < C, every voxel under the
@@ -123,16 +123,19 @@ def check(name):
 
 
 @check("first_frame_matches_render")
-def first_frame_matches_render(driver, work, scene, view, size):
+def first_frame_matches_render(driver, work, scene, view, size, perspective=False):
     w, h = size
     ref = os.path.join(work, f"ref-{view}.png")
+    extra = ["--perspective"] if perspective else []
     tesseral("render", scene, "-o", ref, "--size", f"{w}x{h}", "--view", view,
-             "--no-shadows", "--normals", "faces")
+             "--no-shadows", "--normals", "faces", *extra)
     cpu = np.array(Image.open(ref).convert("RGB")).astype(int)
     page = os.path.join(work, "first.html")
     tesseral("view", scene, "-o", page)
     open_page(driver, page, w, h)
     driver.execute_script(f"tesseral.setView('{view}')")
+    if perspective:
+        driver.execute_script("tesseral.set({perspective: true})")
     gpu = snapshot(driver)
     assert gpu.shape == cpu.shape, f"{gpu.shape} vs {cpu.shape}"
     Image.fromarray(gpu.astype(np.uint8)).save(os.path.join(work, f"page-{view}.png"))
@@ -144,6 +147,7 @@ def first_frame_matches_render(driver, work, scene, view, size):
     diff = np.abs(cpu[both] - gpu[both]).max(axis=1)
     close = (diff <= 12).mean()
     assert close >= 0.95, f"only {close:.3f} of pixels within 12 levels"
+    view += " perspective" if perspective else ""
     return f"{scene} {view}: IoU {score:.4f}, {close:.3f} of pixels within 12 levels, median {np.median(diff)}"
 
 
@@ -321,6 +325,7 @@ def main():
             for view in ["iso", "front", "top", "side"]:
                 first_frame_matches_render(driver, work, tank, view, (640, 480))
             first_frame_matches_render(driver, work, box_scene, "iso", (400, 400))
+            first_frame_matches_render(driver, work, tank, "iso", (480, 360), True)
             drag_turns_the_view(driver, work, tank)
             cut_removes_what_it_should(driver, work, box_scene)
             info_panel_counts(driver, work, tank)
