@@ -21,6 +21,7 @@ pub mod motion;
 pub mod pointer;
 pub mod render;
 pub mod rsmc;
+pub mod view;
 
 // The main types at the crate root, as rstar does: `tesseral::LinearOctree` and
 // friends; the modules stay public for everything else.

@@ -5,7 +5,7 @@
 /// The groups, in the order shown. Every subcommand belongs to exactly one (a test
 /// checks it), so a new command cannot be left out of the help.
 pub const GROUPS: &[(&str, &[&str])] = &[
-    ("Build and view", &["build", "render", "info"]),
+    ("Build and view", &["build", "render", "view", "info"]),
     ("Formats", &["convert"]),
     (
         "Octree operations",

@@ -21,3 +21,4 @@ pub mod simulate;
 pub mod stdio;
 pub mod tables;
 pub mod transform;
+pub mod view;

@@ -14,6 +14,8 @@ use tesseral::render::{self, RenderOptions};
 use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
 use tesseral::Voxel;
 
+use super::view::Animation;
+
 /// Arguments of `tesseral rsmc`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -82,6 +84,12 @@ pub struct Args {
     /// Print one JSON summary object at the end instead of text.
     #[arg(long)]
     json: bool,
+    /// Write an interactive viewer page (`.html`) that plays the surface at every
+    /// row of series.csv with a time slider (see `tesseral view`).
+    #[arg(long, value_name = "FILE")]
+    view: Option<PathBuf>,
+    #[command(flatten)]
+    page: super::view::PageArgs,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum, Serialize, Deserialize)]
@@ -406,6 +414,24 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         s.checked_div(every)
             .map_or(u64::MAX, |q| (q + 1).saturating_mul(every))
     };
+    if let Some(page) = &args.view {
+        super::output::guard("--view", page, &["html"], &[&cp_path, &csv_path])?;
+    }
+    let count = args.steps.saturating_sub(chain.steps()) / sample_every.max(1) + 2;
+    let unit = tesseral::Frame::new(1.0, [0.0; 3]);
+    let mut anim = (args.view.as_ref()).map(|p| Animation::for_file(p, unit, args.page, count));
+    let surface = |c: &Chain<L>| {
+        let label = format!(
+            "step {}, area {}, volume {}",
+            c.steps(),
+            c.area(),
+            c.volume()
+        );
+        (c.voxels(), label)
+    };
+    if let Some(a) = anim.as_mut() {
+        a.offer_voxels(false, || surface(&chain))?;
+    }
     let t0 = Instant::now();
     while chain.steps() < args.steps {
         let s = chain.steps();
@@ -422,6 +448,9 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             rows.push(row(&chain, base));
             base = (s, chain.counters().accepted);
             bar.set_message(format!("area {}", chain.area()));
+            if let Some(a) = anim.as_mut().filter(|_| s < args.steps) {
+                a.offer_voxels(false, || surface(&chain))?;
+            }
         }
         if args.check_every > 0 && s % args.check_every == 0 {
             topology::check_sphere(&chain.voxels())
@@ -438,6 +467,11 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     }
     let report = topology::check_sphere(&chain.voxels())
         .context("global topology check of the final surface")?;
+    // The last surface always, whichever samples the page keeps.
+    if let (Some(mut a), Some(path)) = (anim, &args.view) {
+        a.offer_voxels(true, || surface(&chain))?;
+        a.finish(path)?;
+    }
     save(&mut chain, &rows, base)?;
     let points: Vec<(f64, f64)> = rows
         .iter()

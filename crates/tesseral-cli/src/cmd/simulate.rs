@@ -26,9 +26,11 @@ pub struct Args {
     /// steps magenta.
     #[arg(long, value_name = "DIR")]
     frames: Option<PathBuf>,
-    /// The view of the frames: iso, front, top or side.
-    #[arg(long, default_value = "iso", value_parser = parse_view)]
-    view: View,
+    /// The view of the frames: iso, front, top or side; or a page `FILE.html` to
+    /// write, an interactive viewer that plays the steps with a time slider (see
+    /// `tesseral view`). Give it twice for both.
+    #[arg(long, default_value = "iso", value_parser = parse_view_arg, action = clap::ArgAction::Append)]
+    view: Vec<ViewArg>,
     /// The frames' size, WIDTHxHEIGHT (with --frames). [default: 480x360]
     #[arg(long, requires = "frames", value_parser = output::parse_size)]
     size: Option<Size>,
@@ -38,6 +40,8 @@ pub struct Args {
     /// The frames' height in pixels (older spelling; use --size).
     #[arg(long, hide = true, requires = "frames", conflicts_with = "size", value_parser = clap::value_parser!(u32).range(16..=4096))]
     height: Option<u32>,
+    #[command(flatten)]
+    page: super::view::PageArgs,
     #[command(flatten)]
     limits: Limits,
     #[command(flatten)]
@@ -88,6 +92,20 @@ fn plural(n: u64, noun: &str) -> String {
     }
 }
 
+/// A `--view` value: a named view for the pictures, or a page to write.
+#[derive(Clone, Debug)]
+enum ViewArg {
+    Named(View),
+    Page(PathBuf),
+}
+
+fn parse_view_arg(s: &str) -> Result<ViewArg, String> {
+    if tesseral::io::extension(Path::new(s)) == "html" {
+        return Ok(ViewArg::Page(PathBuf::from(s)));
+    }
+    parse_view(s).map(ViewArg::Named)
+}
+
 fn parse_view(s: &str) -> Result<View, String> {
     View::parse(s).ok_or_else(|| format!("unknown view {s:?} (known: iso, front, top, side)"))
 }
@@ -100,6 +118,18 @@ pub fn run(args: Args) -> Result<()> {
                 dir.display()
             );
         }
+    }
+    let mut named = None;
+    let mut view_page = None;
+    for v in &args.view {
+        match v {
+            ViewArg::Named(n) if named.is_none() => named = Some(*n),
+            ViewArg::Page(p) if view_page.is_none() => view_page = Some(p.clone()),
+            _ => bail!("--view: give at most one named view and one page (.html)"),
+        }
+    }
+    if let Some(page) = &view_page {
+        output::guard("--view", page, &["html"], &[&args.world])?;
     }
     let cap = args.budget.leaf_cap() as u64;
     let wf = match read_world_limited(&args.world, cap, args.allow_outside) {
@@ -123,7 +153,7 @@ pub fn run(args: Args) -> Result<()> {
     let opts = RenderOptions {
         width: size.width,
         height: size.height,
-        camera: Camera::view(args.view),
+        camera: Camera::view(named.unwrap_or(View::Iso)),
         ..RenderOptions::default()
     };
     let show = args.frames.is_some() && std::io::IsTerminal::is_terminal(&std::io::stderr());
@@ -156,12 +186,21 @@ pub fn run(args: Args) -> Result<()> {
     }
     let mut failure = None;
     let boxes = args.json || args.frames.is_some();
+    let count = wf.steps.saturating_add(1);
+    let mut anim = (view_page.as_ref())
+        .map(|p| super::view::Animation::for_file(p, wf.frame, args.page, count));
     world
         .simulate_each(wf.time_step, wf.steps, boxes, |step| {
-            let done = report.step(&step).and_then(|()| match &args.frames {
-                Some(dir) => write_frame(dir, world, &step, &opts),
-                None => Ok(()),
-            });
+            let done = report
+                .step(&step)
+                .and_then(|()| match &args.frames {
+                    Some(dir) => write_frame(dir, world, &step, &opts),
+                    None => Ok(()),
+                })
+                .and_then(|()| match anim.as_mut() {
+                    Some(a) if a.wants(step.frame.step) => view_frame(a, world, &step),
+                    _ => Ok(()),
+                });
             bar.inc(1);
             match done {
                 Ok(()) => ControlFlow::Continue(()),
@@ -175,6 +214,9 @@ pub fn run(args: Args) -> Result<()> {
     bar.finish_and_clear();
     if let Some(e) = failure {
         return Err(e);
+    }
+    if let (Some(a), Some(path)) = (anim, &view_page) {
+        a.finish(path)?;
     }
     if args.json {
         let contacts = std::mem::take(&mut report.contacts_json);
@@ -324,4 +366,24 @@ fn write_frame(
     let path = dir.join(format!("frame_{:05}.png", f.step));
     img.write_png(&path)
         .with_context(|| format!("writing {}", path.display()))
+}
+
+/// Adds one step to the viewer page: objects in their colours, the environment grey.
+fn view_frame(
+    anim: &mut super::view::Animation,
+    world: &tesseral::motion::World,
+    step: &Step,
+) -> Result<()> {
+    let f = &step.frame;
+    let (all, regions) = tesseral::motion::frame_regions(world, f)
+        .with_context(|| format!("joining step {}", f.step))?;
+    let layer = tesseral::model::Layer::from_regions(
+        all.depth(),
+        all.origin(),
+        regions
+            .into_iter()
+            .map(|(c, t)| ([c[0], c[1], c[2], 255], t)),
+    )?;
+    let colouring = tesseral::view::Colouring::Layer(&layer, tesseral::motion::ENVIRONMENT_COLOUR);
+    anim.add(&all, colouring, &format!("step {}, t = {}", f.step, f.time))
 }

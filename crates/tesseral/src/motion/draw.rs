@@ -92,6 +92,44 @@ pub fn render_frame(
     ))
 }
 
+/// A part of a picture and its colour.
+pub type ColouredRegion = ([u8; 3], LinearOctree);
+
+/// One step of a world as coloured parts, for the viewer's animations: the joined
+/// octree, and disjoint regions of it with the colours [`render_frame`] gives them
+/// (an object in contact red; the environment is what no region holds, drawn in
+/// [`ENVIRONMENT_COLOUR`]; the boxes of contacts are not marked).
+///
+/// # Errors
+/// [`OctreeError`] when the joined octree would be too deep.
+pub fn frame_regions(
+    world: &World,
+    frame: &Frame,
+) -> Result<(LinearOctree, Vec<ColouredRegion>), OctreeError> {
+    let touching: HashSet<usize> = frame
+        .overlaps
+        .iter()
+        .map(|&(_, j, _)| j)
+        .chain(frame.overlaps.iter().filter_map(|o| o.0))
+        .collect();
+    let mut all = world.environment.clone();
+    let mut regions = Vec::with_capacity(world.objects.len() + 1);
+    for (k, (o, off)) in world.objects.iter().zip(&frame.offsets).enumerate() {
+        let t = rotated(&o.tree, o.rotation).translate(*off)?;
+        let joined = all.union(&t)?;
+        // Voxels shared with what came before keep their first colour.
+        let own = t.difference(&all)?;
+        let colour = if touching.contains(&k) {
+            CONTACT_COLOUR
+        } else {
+            OBJECT_COLOURS[k % OBJECT_COLOURS.len()]
+        };
+        regions.push((colour, own));
+        all = joined;
+    }
+    Ok((all, regions))
+}
+
 /// Renders a planned path: the environment in grey, the object at the start in
 /// green and at the goal in blue, and the track of the centre of the object's box
 /// along `waypoints` (if any) in yellow.

@@ -30,8 +30,8 @@ mod world;
 mod world_file;
 
 pub use draw::{
-    render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS, PATH_COLOUR,
-    SWEPT_COLOUR,
+    frame_regions, render_frame, render_plan, CONTACT_COLOUR, ENVIRONMENT_COLOUR, OBJECT_COLOURS,
+    PATH_COLOUR, SWEPT_COLOUR,
 };
 pub use interfere::{
     clearance, clearance_at, clearance_squared, interference, interference_placed, intersects,
