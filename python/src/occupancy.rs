@@ -87,8 +87,11 @@ impl OccupancyMap {
     ) -> PyResult<Bound<'py, PyArray1<f32>>> {
         let c = rows(&cells)?;
         let m = &self.map;
-        let out: Vec<f32> =
-            py.allow_threads(|| c.iter().map(|&v| m.log_odds(v).unwrap_or(f32::NAN)).collect());
+        let out: Vec<f32> = py.allow_threads(|| {
+            c.iter()
+                .map(|&v| m.log_odds(v).unwrap_or(f32::NAN))
+                .collect()
+        });
         Ok(out.into_pyarray(py))
     }
 
