@@ -18,6 +18,7 @@ pub mod linear;
 pub mod mesh;
 pub mod model;
 pub mod motion;
+pub mod occupancy;
 pub mod pointer;
 pub mod render;
 pub mod rsmc;
@@ -29,6 +30,7 @@ pub use dynamic::DynamicOctree;
 pub use io::{read_model, write_model, FormatError};
 pub use linear::{LinearOctree, OctreeError, SetOp};
 pub use model::{Frame, Model, ModelError};
+pub use occupancy::OccupancyMap;
 pub use pointer::PointerOctree;
 
 /// A voxel (or any lattice point) in world coordinates.

@@ -1,0 +1,223 @@
+//! Occupancy maps built from range scans, with OctoMap's semantics.
+//!
+//! A cell is *unknown*, *free* or *occupied*; a known cell keeps a log-odds value,
+//! updated by OctoMap's sensor model ([`SensorModel::octomap`]) and clamped.
+//! [`OccupancyMap::insert_scan`] follows OctoMap's `insertPointCloud`: cell `i` spans
+//! `[i·res, (i+1)·res)`; the cells a segment from the sensor origin to a point
+//! crosses are missed and the point's cell is hit; a cell both hit and missed in one
+//! scan is only hit; each cell is updated at most once per scan; a point beyond the
+//! maximum range clears its ray up to that range and records no hit; NaN and
+//! infinite points are skipped and counted.
+//!
+//! # Layout
+//! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
+//! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]); a block
+//! is either *uniform* (all 512 cells clamped to the same value: one entry, as
+//! OctoMap prunes) or *mixed* (512 log-odds in `i16` fixed point, 1 KiB, in a
+//! pool). Unknown blocks are not stored. See `ARCHITECTURE.md` for why.
+//!
+//! ```
+//! use tesseral::occupancy::{CellState, OccupancyMap, SensorModel};
+//! let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+//! let stats = map.insert_scan([0.05, 0.05, 0.05], &[[1.05, 0.05, 0.05]], None);
+//! assert_eq!((stats.rays, stats.hits, stats.misses), (1, 1, 10));
+//! assert_eq!(map.state([10, 0, 0]), CellState::Occupied);
+//! assert_eq!(map.state([3, 0, 0]), CellState::Free);
+//! assert_eq!(map.state([11, 0, 0]), CellState::Unknown);
+//! map.assert_valid();
+//! ```
+
+mod convert;
+mod ray;
+mod scan;
+mod sensor;
+mod store;
+#[cfg(test)]
+mod tests;
+
+pub use sensor::{log_odds, probability, Pose, SensorModel};
+
+use sensor::{Fixed, UNKNOWN};
+use store::Store;
+
+/// What can go wrong building or converting a map.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum OccupancyError {
+    /// The resolution is not a positive finite number.
+    #[error("resolution {0} must be a positive finite number")]
+    Resolution(f64),
+    /// A sensor-model parameter is out of range.
+    #[error("sensor model: {0}")]
+    Sensor(String),
+    /// A model cannot be read as a map (its frame, or its extent).
+    #[error("model: {0}")]
+    Model(String),
+    /// The octree operation failed.
+    #[error(transparent)]
+    Octree(#[from] crate::linear::OctreeError),
+}
+
+/// What one scan did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ScanStats {
+    /// Points given.
+    pub points: u64,
+    /// Rays cast (points that are finite).
+    pub rays: u64,
+    /// Points skipped because a coordinate is NaN or infinite.
+    pub skipped: u64,
+    /// Cells updated as hits (each once).
+    pub hits: u64,
+    /// Cells updated as misses (each once, none of them hit).
+    pub misses: u64,
+}
+
+/// A cell's state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum CellState {
+    /// Never observed.
+    Unknown,
+    /// Known, log-odds below the threshold.
+    Free,
+    /// Known, log-odds at or above the threshold.
+    Occupied,
+}
+
+/// An unbounded occupancy map: see the [module docs](self).
+#[derive(Clone)]
+pub struct OccupancyMap {
+    resolution: f64,
+    sensor: SensorModel,
+    fixed: Fixed,
+    store: Store,
+}
+
+impl std::fmt::Debug for OccupancyMap {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("OccupancyMap")
+            .field("resolution", &self.resolution)
+            .field("sensor", &self.sensor)
+            .field("blocks", &self.store.block_count())
+            .finish()
+    }
+}
+
+impl OccupancyMap {
+    /// An empty map with cells of side `resolution` (world units).
+    ///
+    /// # Errors
+    /// [`OccupancyError::Resolution`] unless `resolution` is positive and finite.
+    pub fn new(resolution: f64, sensor: SensorModel) -> Result<Self, OccupancyError> {
+        if !(resolution.is_finite() && resolution > 0.0) {
+            return Err(OccupancyError::Resolution(resolution));
+        }
+        Ok(Self {
+            resolution,
+            sensor,
+            fixed: Fixed::new(&sensor),
+            store: Store::default(),
+        })
+    }
+
+    /// The side of a cell, in world units.
+    #[must_use]
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// The sensor model.
+    #[must_use]
+    pub fn sensor(&self) -> &SensorModel {
+        &self.sensor
+    }
+
+    /// The cell holding a world point (OctoMap's `coordToKey`: `floor(p / res)`,
+    /// computed as `p × (1 / res)`).
+    #[must_use]
+    pub fn cell_of(&self, p: [f64; 3]) -> [i64; 3] {
+        let inv = 1.0 / self.resolution;
+        p.map(|c| (c * inv).floor() as i64)
+    }
+
+    /// A cell's state.
+    ///
+    /// # Runtime
+    /// O(1): one hash probe and one load.
+    #[must_use]
+    pub fn state(&self, cell: [i64; 3]) -> CellState {
+        match self.store.get(cell) {
+            UNKNOWN => CellState::Unknown,
+            v if v >= self.fixed.threshold => CellState::Occupied,
+            _ => CellState::Free,
+        }
+    }
+
+    /// A known cell's log-odds (a multiple of the fixed-point step).
+    #[must_use]
+    pub fn log_odds(&self, cell: [i64; 3]) -> Option<f32> {
+        match self.store.get(cell) {
+            UNKNOWN => None,
+            v => Some(self.fixed.to_f32(v)),
+        }
+    }
+
+    /// Sets a cell's log-odds (clamped), or forgets it with `None`.
+    pub fn set_log_odds(&mut self, cell: [i64; 3], l: Option<f32>) {
+        let v = l.map_or(UNKNOWN, |l| self.fixed.quantise(l));
+        self.store.set(cell, v, self.fixed);
+    }
+
+    /// The number of occupied cells.
+    #[must_use]
+    pub fn occupied_count(&self) -> u64 {
+        let t = self.fixed.threshold;
+        self.store.count(|v| v != UNKNOWN && v >= t)
+    }
+
+    /// The number of free cells.
+    #[must_use]
+    pub fn free_count(&self) -> u64 {
+        let t = self.fixed.threshold;
+        self.store.count(|v| v != UNKNOWN && v < t)
+    }
+
+    /// The number of stored entries: one per uniform block, one per known cell of a
+    /// mixed block (what OctoMap's leaf count is after pruning, at block grain).
+    #[must_use]
+    pub fn leaf_count(&self) -> u64 {
+        self.store.leaf_count()
+    }
+
+    /// The number of 8×8×8 blocks stored (uniform and mixed).
+    #[must_use]
+    pub fn block_count(&self) -> usize {
+        self.store.block_count()
+    }
+
+    /// Bytes held by the map (capacities, not lengths).
+    #[must_use]
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of::<Self>() + self.store.bytes()
+    }
+
+    /// Every known cell and its log-odds, sorted by cell.
+    #[must_use]
+    pub fn cells(&self) -> Vec<([i64; 3], f32)> {
+        let mut out: Vec<([i64; 3], f32)> = Vec::new();
+        self.store
+            .for_each(|c, v| out.push((c, self.fixed.to_f32(v))));
+        out.sort_unstable_by_key(|&(c, _)| c);
+        out
+    }
+
+    /// Checks the invariants: every uniform block is clamped, no mixed block is
+    /// uniformly clamped or all unknown, every value lies in the clamps, the pool's
+    /// free list and the index agree.
+    ///
+    /// # Panics
+    /// When an invariant is broken.
+    pub fn assert_valid(&self) {
+        self.store.assert_valid(self.fixed);
+    }
+}
