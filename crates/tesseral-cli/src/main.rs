@@ -53,6 +53,8 @@ enum Command {
     Render(cmd::render::Args),
     /// Builds a scene's octree and writes it to a file.
     Build(cmd::build::Args),
+    /// Builds an occupancy map from range scans (OctoMap .graph/.log, .xyz, .ply, .pcd).
+    Map(cmd::map::Args),
     /// Prints a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(cmd::shell::CompletionsArgs),
     /// Prints the man page (roff; view it with `tesseral man | man -l -`).
@@ -85,6 +87,7 @@ fn main() -> ExitCode {
         Command::Complement(args) => cmd::transform::complement(args),
         Command::Render(args) => cmd::render::run(args),
         Command::Build(args) => cmd::build::run(args),
+        Command::Map(args) => cmd::map::run(args),
         Command::Completions(args) => cmd::shell::completions(&args, Cli::command()),
         Command::Man(args) => cmd::shell::man(&args, Cli::command()),
     };
