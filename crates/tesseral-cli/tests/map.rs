@@ -537,7 +537,10 @@ fn the_map_is_a_model_with_its_frame() {
     // The world box is in metres: the room's walls at x = -2 and 3 are in it.
     let lo = info["world_min"][0].as_f64().unwrap();
     let hi = info["world_max"][0].as_f64().unwrap();
-    assert!((-2.5..=-2.0).contains(&lo) && (3.0..4.0).contains(&hi), "{info}");
+    assert!(
+        (-2.5..=-2.0).contains(&lo) && (3.0..4.0).contains(&hi),
+        "{info}"
+    );
     // Standard output takes the map with --format.
     let out = run(
         d,
