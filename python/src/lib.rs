@@ -9,6 +9,7 @@ mod calc;
 mod dynamic;
 mod errors;
 mod motion;
+mod occupancy;
 mod octree;
 mod scene;
 
@@ -21,6 +22,7 @@ fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<octree::Octree>()?;
     m.add_class::<scene::Scene>()?;
     m.add_class::<dynamic::DynamicOctree>()?;
+    m.add_class::<occupancy::OccupancyMap>()?;
     m.add_function(wrap_pyfunction!(scene::render, m)?)?;
     m.add_function(wrap_pyfunction!(motion::collide, m)?)?;
     m.add_function(wrap_pyfunction!(motion::plan, m)?)?;

@@ -8,6 +8,7 @@ the GIL. See docs/python.md in the repository for every function with an example
 from ._tesseral import (
     DynamicOctree,
     FormatError,
+    OccupancyMap,
     Octree,
     OctreeError,
     Scene,
@@ -33,6 +34,7 @@ class calc:
 __all__ = [
     "DynamicOctree",
     "FormatError",
+    "OccupancyMap",
     "Octree",
     "OctreeError",
     "Scene",

@@ -1,6 +1,7 @@
 from ._tesseral import (
     DynamicOctree as DynamicOctree,
     FormatError as FormatError,
+    OccupancyMap as OccupancyMap,
     Octree as Octree,
     OctreeError as OctreeError,
     Scene as Scene,

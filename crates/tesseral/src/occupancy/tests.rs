@@ -456,3 +456,47 @@ fn models_round_trip() {
     assert_eq!(back.cells(), map.cells());
     let _ = UNKNOWN;
 }
+
+/// The scan half of the 10^8-operation soak (issue 19 §4): scans from wandering
+/// origins until 10^8 cell updates are made, `assert_valid` after each, and every
+/// 25th scan checked against the naive model on a sample of its rays.
+#[test]
+#[ignore = "soak: minutes; run with --ignored"]
+fn soak_scan_insertion() {
+    let mut rng = Pcg64::seed_from_u64(19);
+    let res = 0.05;
+    let mut map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+    let mut updates = 0u64;
+    let mut scan = 0;
+    while updates < 100_000_000 {
+        let origin = [0, 1, 2].map(|_| rng.random_range(-20.0..20.0));
+        let points: Vec<[f64; 3]> = (0..20_000)
+            .map(|_| [0, 1, 2].map(|a| origin[a] + rng.random_range(-6.0..6.0)))
+            .collect();
+        let max_range = if scan % 2 == 0 { Some(5.0) } else { None };
+        if scan % 25 == 0 {
+            // A small scan through both: the map must change as the naive model says.
+            let few = &points[..50];
+            let mut naive = Naive {
+                cells: HashMap::new(),
+                f: map.fixed,
+                res,
+            };
+            let before: HashMap<Cell, i32> = {
+                let mut m = HashMap::new();
+                map.store.for_each(|c, v| {
+                    m.insert(c, i32::from(v));
+                });
+                m
+            };
+            naive.cells = before;
+            let got = map.insert_scan(origin, few, max_range);
+            assert_eq!(got, naive.scan(origin, few, max_range));
+            check_same(&map, &naive);
+        }
+        let s = map.insert_scan(origin, &points, max_range);
+        updates += s.hits + s.misses;
+        map.assert_valid();
+        scan += 1;
+    }
+}

@@ -5,7 +5,7 @@ use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
 use super::legality::{face_set, legal_join, ALL27};
-use super::{step_dir, topology, Lattice, RsmcError};
+use super::{step, topology, Lattice, RsmcError};
 use crate::Voxel;
 
 /// Version of the [`Checkpoint`] layout.
@@ -243,7 +243,7 @@ impl<L: Lattice> Chain<L> {
         let p = if shrink {
             face.voxel
         } else {
-            step_dir(face.voxel, face.dir)
+            step(face.voxel, face.dir)
         };
         let nb = self.lattice.neighbourhood(p);
         let joins = if shrink { !nb & ALL27 } else { nb };
@@ -355,7 +355,7 @@ impl<L: Lattice> Chain<L> {
         }
         while let Some(v) = stack.pop() {
             for d in 0..6 {
-                let n = step_dir(v, d);
+                let n = step(v, d);
                 if self.lattice.contains(n) && seen.insert(n) {
                     stack.push(n);
                 }
@@ -368,7 +368,7 @@ impl<L: Lattice> Chain<L> {
 
     /// The surface's faces, in face-list order.
     #[must_use]
-    pub fn faces(&self) -> Vec<super::Plaquette> {
+    pub fn faces(&self) -> Vec<super::Face> {
         (0..self.lattice.face_count())
             .map(|i| self.lattice.face(i))
             .collect()

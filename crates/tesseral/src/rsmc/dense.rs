@@ -1,6 +1,6 @@
 //! The dense-array lattice: the baseline and test oracle for RS/MC.
 
-use super::{step_dir, Lattice, Plaquette};
+use super::{step, Face, Lattice};
 use crate::Voxel;
 
 /// Cells of margin kept white around every black voxel, so that the 3×3×3 block of
@@ -43,7 +43,7 @@ pub struct DenseLattice {
     /// direction, or `NONE`.
     slots: Vec<[u32; 6]>,
     free_slots: Vec<u32>,
-    faces: Vec<Plaquette>,
+    faces: Vec<Face>,
     count: u64,
 }
 
@@ -82,7 +82,7 @@ impl DenseLattice {
         self.cells.capacity() * 5
             + self.slots.capacity() * 24
             + self.free_slots.capacity() * 4
-            + self.faces.capacity() * std::mem::size_of::<Plaquette>()
+            + self.faces.capacity() * std::mem::size_of::<Face>()
     }
 
     #[inline]
@@ -183,7 +183,7 @@ impl DenseLattice {
     #[inline]
     fn push_face(&mut self, slot: usize, v: Voxel, dir: u8) {
         self.slots[slot][dir as usize] = self.faces.len() as u32;
-        self.faces.push(Plaquette { voxel: v, dir });
+        self.faces.push(Face { voxel: v, dir });
     }
 
     #[inline]
@@ -221,14 +221,14 @@ impl DenseLattice {
             assert!(!used[s], "slot {s} used twice");
             used[s] = true;
             for d in 0..6u8 {
-                let n = step_dir(v, d);
+                let n = step(v, d);
                 let fi = self.slots[s][d as usize];
                 if self.contains(n) {
                     assert_eq!(fi, NONE, "hidden face {v:?} dir {d} is listed");
                 } else {
                     exposed += 1;
                     assert!((fi as usize) < self.faces.len(), "face {v:?} {d} missing");
-                    assert_eq!(self.faces[fi as usize], Plaquette { voxel: v, dir: d });
+                    assert_eq!(self.faces[fi as usize], Face { voxel: v, dir: d });
                 }
             }
         }
@@ -270,7 +270,7 @@ impl Lattice for DenseLattice {
         self.occ[i] = 1;
         self.count += 1;
         for d in 0..6u8 {
-            let n = step_dir(v, d);
+            let n = step(v, d);
             match self.slot(n) {
                 Some(ns) => self.remove_face(ns, d ^ 1),
                 None => self.push_face(slot, v, d),
@@ -286,7 +286,7 @@ impl Lattice for DenseLattice {
         }
         let slot = (self.cells[i] - 1) as usize;
         for d in 0..6u8 {
-            let n = step_dir(v, d);
+            let n = step(v, d);
             match self.slot(n) {
                 Some(ns) => self.push_face(ns, n, d ^ 1),
                 None => self.remove_face(slot, d),
@@ -314,7 +314,7 @@ impl Lattice for DenseLattice {
     }
 
     #[inline]
-    fn face(&self, i: usize) -> Plaquette {
+    fn face(&self, i: usize) -> Face {
         self.faces[i]
     }
 

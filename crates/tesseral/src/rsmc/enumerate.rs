@@ -132,7 +132,7 @@ pub fn sphere_counts(max_area: u64) -> Result<Vec<u64>, RsmcError> {
         let mut area = 0;
         for v in &s {
             for d in 0..6 {
-                if !set.contains(&super::step_dir(*v, d)) {
+                if !set.contains(&super::step(*v, d)) {
                     area += 1;
                 }
             }

@@ -2,8 +2,8 @@
 //! lattice points shared, faces wound counter-clockwise seen from outside.
 //!
 //! ```
-//! use tesseral::rsmc::{mesh, Plaquette};
-//! let faces: Vec<Plaquette> = (0..6).map(|dir| Plaquette { voxel: [0, 0, 0], dir }).collect();
+//! use tesseral::rsmc::{mesh, Face};
+//! let faces: Vec<Face> = (0..6).map(|dir| Face { voxel: [0, 0, 0], dir }).collect();
 //! let mut obj = Vec::new();
 //! mesh::write_obj(&faces, &mut obj).unwrap();
 //! let text = String::from_utf8(obj).unwrap();
@@ -14,12 +14,12 @@
 use std::collections::HashMap;
 use std::io::{self, Write};
 
-use super::Plaquette;
+use super::Face;
 use crate::Voxel;
 
 /// The four corners of a plaquette, counter-clockwise seen from outside.
 #[must_use]
-pub fn corners(f: Plaquette) -> [Voxel; 4] {
+pub fn corners(f: Face) -> [Voxel; 4] {
     let axis = (f.dir / 2) as usize;
     let positive = f.dir & 1 == 1;
     let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
@@ -41,7 +41,7 @@ pub fn corners(f: Plaquette) -> [Voxel; 4] {
 
 /// Shared vertices and quads (indices into the vertices) of the faces. O(F).
 #[must_use]
-pub fn indexed(faces: &[Plaquette]) -> (Vec<Voxel>, Vec<[u32; 4]>) {
+pub fn indexed(faces: &[Face]) -> (Vec<Voxel>, Vec<[u32; 4]>) {
     let mut index: HashMap<Voxel, u32> = HashMap::with_capacity(faces.len());
     let mut vertices = Vec::new();
     let mut quads = Vec::with_capacity(faces.len());
@@ -62,7 +62,7 @@ pub fn indexed(faces: &[Plaquette]) -> (Vec<Voxel>, Vec<[u32; 4]>) {
 ///
 /// # Errors
 /// Errors of the writer.
-pub fn write_obj<W: Write>(faces: &[Plaquette], mut w: W) -> io::Result<()> {
+pub fn write_obj<W: Write>(faces: &[Face], mut w: W) -> io::Result<()> {
     let (vertices, quads) = indexed(faces);
     writeln!(w, "# tesseral rsmc surface: {} plaquettes", faces.len())?;
     for v in &vertices {
@@ -78,7 +78,7 @@ pub fn write_obj<W: Write>(faces: &[Plaquette], mut w: W) -> io::Result<()> {
 ///
 /// # Errors
 /// Errors of the writer.
-pub fn write_ply<W: Write>(faces: &[Plaquette], mut w: W) -> io::Result<()> {
+pub fn write_ply<W: Write>(faces: &[Face], mut w: W) -> io::Result<()> {
     let (vertices, quads) = indexed(faces);
     writeln!(w, "ply\nformat ascii 1.0\ncomment tesseral rsmc surface")?;
     writeln!(
@@ -106,8 +106,8 @@ mod tests {
 
     #[test]
     fn cube_is_closed_and_outward() {
-        let faces: Vec<Plaquette> = (0..6)
-            .map(|dir| Plaquette {
+        let faces: Vec<Face> = (0..6)
+            .map(|dir| Face {
                 voxel: [2, 3, 4],
                 dir,
             })

@@ -43,15 +43,9 @@ pub use dense::{DenseLattice, MAX_CELLS};
 
 use crate::Voxel;
 
-/// One plaquette of the surface: the face of black voxel `voxel` that points in
-/// direction `dir` (0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Plaquette {
-    /// The black voxel that owns the face.
-    pub voxel: Voxel,
-    /// The direction the face points to, out of the voxel.
-    pub dir: u8,
-}
+/// One plaquette of the surface is a [`Face`] of the dynamic octree: the lattice has
+/// one vocabulary.
+pub use crate::dynamic::Face;
 
 /// Unit steps of the six face directions, in the order 0 = −x, 1 = +x, 2 = −y,
 /// 3 = +y, 4 = −z, 5 = +z. The opposite of direction `d` is `d ^ 1`.
@@ -64,13 +58,7 @@ pub const DIRS: [[i64; 3]; 6] = [
     [0, 0, 1],
 ];
 
-/// The neighbour of `v` in direction `dir`.
-#[inline]
-#[must_use]
-pub fn step_dir(v: Voxel, dir: u8) -> Voxel {
-    let d = DIRS[dir as usize];
-    [v[0] + d[0], v[1] + d[1], v[2] + d[2]]
-}
+pub use crate::dynamic::step;
 
 /// The lattice operations the chain needs: a set of black voxels with the list of
 /// exposed faces.
@@ -100,7 +88,7 @@ pub trait Lattice {
     /// The number of exposed faces (the area `A`).
     fn face_count(&self) -> usize;
     /// The `i`-th face of the face list; `i < face_count()`.
-    fn face(&self, i: usize) -> Plaquette;
+    fn face(&self, i: usize) -> Face;
     /// The 27-bit occupancy of the 3×3×3 block around `v`: bit
     /// `(dx+1) + 3(dy+1) + 9(dz+1)`.
     fn neighbourhood(&self, v: Voxel) -> u32;

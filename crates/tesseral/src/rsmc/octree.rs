@@ -2,7 +2,7 @@
 //! unbounded growth. Its face list follows the same order rule as
 //! [`DenseLattice`](super::DenseLattice), so the two give identical trajectories.
 
-use super::{Lattice, Plaquette};
+use super::{Face, Lattice};
 use crate::dynamic::DynamicOctree;
 use crate::Voxel;
 
@@ -31,9 +31,9 @@ impl Lattice for DynamicOctree {
         DynamicOctree::face_count(self)
     }
     #[inline]
-    fn face(&self, i: usize) -> Plaquette {
+    fn face(&self, i: usize) -> Face {
         let f = DynamicOctree::face(self, i);
-        Plaquette {
+        Face {
             voxel: f.voxel,
             dir: f.dir,
         }

@@ -12,16 +12,16 @@ use super::*;
 #[derive(Default)]
 pub(crate) struct NaiveLattice {
     set: HashSet<Voxel>,
-    faces: Vec<Plaquette>,
-    at: HashMap<Plaquette, usize>,
+    faces: Vec<Face>,
+    at: HashMap<Face, usize>,
 }
 
 impl NaiveLattice {
-    fn push(&mut self, f: Plaquette) {
+    fn push(&mut self, f: Face) {
         self.at.insert(f, self.faces.len());
         self.faces.push(f);
     }
-    fn take(&mut self, f: Plaquette) {
+    fn take(&mut self, f: Face) {
         let i = self.at.remove(&f).expect("listed face");
         self.faces.swap_remove(i);
         if i < self.faces.len() {
@@ -39,14 +39,14 @@ impl Lattice for NaiveLattice {
             return false;
         }
         for d in 0..6u8 {
-            let n = step_dir(v, d);
+            let n = step(v, d);
             if self.set.contains(&n) {
-                self.take(Plaquette {
+                self.take(Face {
                     voxel: n,
                     dir: d ^ 1,
                 });
             } else {
-                self.push(Plaquette { voxel: v, dir: d });
+                self.push(Face { voxel: v, dir: d });
             }
         }
         true
@@ -56,14 +56,14 @@ impl Lattice for NaiveLattice {
             return false;
         }
         for d in 0..6u8 {
-            let n = step_dir(v, d);
+            let n = step(v, d);
             if self.set.contains(&n) {
-                self.push(Plaquette {
+                self.push(Face {
                     voxel: n,
                     dir: d ^ 1,
                 });
             } else {
-                self.take(Plaquette { voxel: v, dir: d });
+                self.take(Face { voxel: v, dir: d });
             }
         }
         true
@@ -77,7 +77,7 @@ impl Lattice for NaiveLattice {
     fn face_count(&self) -> usize {
         self.faces.len()
     }
-    fn face(&self, i: usize) -> Plaquette {
+    fn face(&self, i: usize) -> Face {
         self.faces[i]
     }
     fn neighbourhood(&self, v: Voxel) -> u32 {
@@ -302,7 +302,7 @@ fn detailed_balance_with_volume_weight() {
         let set: HashSet<Voxel> = s.iter().copied().collect();
         let area = s
             .iter()
-            .map(|&v| (0..6).filter(|&d| !set.contains(&step_dir(v, d))).count() as u64)
+            .map(|&v| (0..6).filter(|&d| !set.contains(&step(v, d))).count() as u64)
             .sum::<u64>();
         counts[key(area, s.len() as u64)] += 1;
     }

@@ -13,7 +13,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{step_dir, DIRS};
+use super::{step, DIRS};
 use crate::Voxel;
 
 /// The counts of the surface's cell complex.
@@ -113,7 +113,7 @@ pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
     seen.insert(voxels[0]);
     while let Some(v) = stack.pop() {
         for d in 0..6 {
-            let n = step_dir(v, d);
+            let n = step(v, d);
             if set.contains(&n) && seen.insert(n) {
                 stack.push(n);
             }
@@ -193,7 +193,7 @@ pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
     let mut vertex_faces: HashMap<Voxel, Vec<[Voxel; 4]>> = HashMap::new();
     for v in &set {
         for d in 0..6u8 {
-            if set.contains(&step_dir(*v, d)) {
+            if set.contains(&step(*v, d)) {
                 continue;
             }
             faces += 1;

@@ -1,0 +1,121 @@
+//! `tesseral.OccupancyMap`: an occupancy map fed whole scans (N×3 float arrays).
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tesseral::occupancy::{CellState, OccupancyMap as Map, SensorModel};
+
+use crate::arrays::rows;
+
+/// An unbounded occupancy map (unknown / free / occupied cells with log-odds), built
+/// from range scans with OctoMap's `insertPointCloud` semantics and sensor model.
+#[pyclass(module = "tesseral")]
+pub struct OccupancyMap {
+    map: Map,
+}
+
+fn value_error(e: impl std::fmt::Display) -> PyErr {
+    PyValueError::new_err(e.to_string())
+}
+
+#[pymethods]
+impl OccupancyMap {
+    #[new]
+    #[pyo3(signature = (resolution, prob_hit = 0.7, prob_miss = 0.4, clamp = (0.1192, 0.971), threshold = 0.5))]
+    fn new(
+        resolution: f64,
+        prob_hit: f64,
+        prob_miss: f64,
+        clamp: (f64, f64),
+        threshold: f64,
+    ) -> PyResult<Self> {
+        let sensor = SensorModel::from_probabilities(prob_hit, prob_miss, clamp, threshold)
+            .map_err(value_error)?;
+        Ok(Self {
+            map: Map::new(resolution, sensor).map_err(value_error)?,
+        })
+    }
+
+    /// Inserts one scan: `points` is N×3 (world units), `origin` the sensor position.
+    /// Returns the scan's counts: points, rays, skipped (NaN/inf), hits, misses.
+    #[pyo3(signature = (origin, points, max_range = None))]
+    fn insert_scan<'py>(
+        &mut self,
+        py: Python<'py>,
+        origin: [f64; 3],
+        points: PyReadonlyArray2<'_, f64>,
+        max_range: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pts = rows(&points)?;
+        let m = &mut self.map;
+        let s = py.allow_threads(|| m.insert_scan(origin, &pts, max_range));
+        let d = PyDict::new(py);
+        d.set_item("points", s.points)?;
+        d.set_item("rays", s.rays)?;
+        d.set_item("skipped", s.skipped)?;
+        d.set_item("hits", s.hits)?;
+        d.set_item("misses", s.misses)?;
+        Ok(d)
+    }
+
+    /// The state of each cell of an N×3 int64 array: 0 unknown, 1 free, 2 occupied.
+    fn state<'py>(
+        &self,
+        py: Python<'py>,
+        cells: PyReadonlyArray2<'_, i64>,
+    ) -> PyResult<Bound<'py, PyArray1<u8>>> {
+        let c = rows(&cells)?;
+        let m = &self.map;
+        let out: Vec<u8> = py.allow_threads(|| {
+            c.iter()
+                .map(|&v| match m.state(v) {
+                    CellState::Unknown => 0,
+                    CellState::Free => 1,
+                    CellState::Occupied => 2,
+                })
+                .collect()
+        });
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The log-odds of each cell of an N×3 int64 array (NaN where unknown).
+    fn log_odds<'py>(
+        &self,
+        py: Python<'py>,
+        cells: PyReadonlyArray2<'_, i64>,
+    ) -> PyResult<Bound<'py, PyArray1<f32>>> {
+        let c = rows(&cells)?;
+        let m = &self.map;
+        let out: Vec<f32> =
+            py.allow_threads(|| c.iter().map(|&v| m.log_odds(v).unwrap_or(f32::NAN)).collect());
+        Ok(out.into_pyarray(py))
+    }
+
+    /// The cell holding each point of an N×3 float array, N×3 int64.
+    fn cells_of<'py>(
+        &self,
+        py: Python<'py>,
+        points: PyReadonlyArray2<'_, f64>,
+    ) -> PyResult<Bound<'py, numpy::PyArray2<i64>>> {
+        let p = rows(&points)?;
+        crate::arrays::to_array(py, p.iter().map(|&q| self.map.cell_of(q)).collect())
+    }
+
+    /// The side of a cell, in world units.
+    #[getter]
+    fn resolution(&self) -> f64 {
+        self.map.resolution()
+    }
+
+    /// Counts: occupied, free, leaves, blocks, bytes.
+    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        d.set_item("occupied", self.map.occupied_count())?;
+        d.set_item("free", self.map.free_count())?;
+        d.set_item("leaves", self.map.leaf_count())?;
+        d.set_item("blocks", self.map.block_count())?;
+        d.set_item("bytes", self.map.bytes())?;
+        Ok(d)
+    }
+}

@@ -1,0 +1,55 @@
+"""The occupancy map: scans in, cell states out, against a small model."""
+
+import numpy as np
+import pytest
+
+import tesseral as t
+
+
+def test_a_ray_misses_its_cells_and_hits_its_end():
+    m = t.OccupancyMap(0.1)
+    s = m.insert_scan((0.05, 0.05, 0.05), np.array([[1.05, 0.05, 0.05]]))
+    assert s == {"points": 1, "rays": 1, "skipped": 0, "hits": 1, "misses": 10}
+    cells = np.array([[10, 0, 0], [3, 0, 0], [11, 0, 0]], dtype=np.int64)
+    assert list(m.state(cells)) == [2, 1, 0]
+    lo = m.log_odds(cells)
+    assert lo[0] == pytest.approx(0.847, abs=1e-3)
+    assert lo[1] == pytest.approx(-0.405, abs=1e-3)
+    assert np.isnan(lo[2])
+
+
+def test_max_range_clears_without_a_hit_and_nan_points_are_skipped():
+    m = t.OccupancyMap(0.1)
+    pts = np.array([[5.05, 0.05, 0.05], [np.nan, 0.0, 0.0]])
+    s = m.insert_scan((0.05, 0.05, 0.05), pts, max_range=1.0)
+    assert s["skipped"] == 1 and s["hits"] == 0 and s["misses"] == 10
+    st = m.stats()
+    assert st["occupied"] == 0 and st["free"] == 10
+    assert list(m.cells_of(np.array([[5.05, 0.05, 0.05]]))[0]) == [50, 0, 0]
+
+
+def test_repeated_scans_match_a_counting_model():
+    rng = np.random.default_rng(4)
+    m = t.OccupancyMap(0.25, prob_hit=0.7, prob_miss=0.4)
+    # Rays along +x from one origin: cells crossed are exactly those before the end.
+    hits, misses = {}, {}
+    for _ in range(6):
+        ends = rng.integers(1, 12, size=20)
+        ys = rng.integers(0, 4, size=20)
+        pts = np.stack([ends * 0.25 + 0.1, ys * 0.25 + 0.1, np.full(20, 0.1)], axis=1)
+        for y in range(4):
+            sel = ys == y
+            if not sel.any():
+                continue
+            m.insert_scan((0.1, y * 0.25 + 0.1, 0.1), pts[sel])
+            hit = set(int(e) for e in ends[sel])
+            miss = set(range(0, max(hit))) - hit
+            for x in hit:
+                hits[(x, y)] = hits.get((x, y), 0) + 1
+            for x in miss:
+                misses[(x, y)] = misses.get((x, y), 0) + 1
+    assert m.stats()["occupied"] + m.stats()["free"] == len(set(hits) | set(misses))
+    with pytest.raises(ValueError):
+        t.OccupancyMap(0.0)
+    with pytest.raises(ValueError):
+        t.OccupancyMap(0.1, prob_hit=0.3)
