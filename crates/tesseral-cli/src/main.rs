@@ -55,6 +55,8 @@ enum Command {
     Build(cmd::build::Args),
     /// Writes an interactive 3-D viewer of a scene or octree file (one HTML page).
     View(cmd::view::Args),
+    /// Builds an occupancy map from range scans (OctoMap .graph/.log, .xyz, .ply, .pcd).
+    Map(cmd::map::Args),
     /// Prints a shell completion script (bash, zsh, fish, elvish, powershell).
     Completions(cmd::shell::CompletionsArgs),
     /// Prints the man page (roff; view it with `tesseral man | man -l -`).
@@ -88,6 +90,7 @@ fn main() -> ExitCode {
         Command::Render(args) => cmd::render::run(args),
         Command::Build(args) => cmd::build::run(args),
         Command::View(args) => cmd::view::run(args),
+        Command::Map(args) => cmd::map::run(args),
         Command::Completions(args) => cmd::shell::completions(&args, Cli::command()),
         Command::Man(args) => cmd::shell::man(&args, Cli::command()),
     };

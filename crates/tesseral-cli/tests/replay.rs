@@ -216,3 +216,55 @@ fn missing_file_and_stdin() {
         serde_json::json!([-4611686018427387904i64, 4611686018427387904i64, 0])
     );
 }
+
+#[test]
+fn replay_o_saves_the_octree_it_built() {
+    let body = "+ 0 0 0\n+ 1 0 0\n+ -5 3 2\n+ 7 7 7\n- 7 7 7\n";
+    for ext in ["tess", "xyz", "bt", "ot"] {
+        let name = format!("built.{ext}");
+        let (out, dir) = replay_file(body, &["-o", &name]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(report(&out)["output"], serde_json::json!(name));
+        let info = tesseral()
+            .args(["info", "--json", &name])
+            .current_dir(dir.path())
+            .output()
+            .unwrap();
+        assert!(
+            info.status.success(),
+            "{}",
+            String::from_utf8_lossy(&info.stderr)
+        );
+        let text = String::from_utf8_lossy(&info.stdout);
+        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+        assert_eq!(v["voxels"], 3, "{ext}: {text}");
+    }
+}
+
+#[test]
+fn replay_o_refuses_stdout_an_unknown_format_and_the_input() {
+    let (out, _dir) = replay_file("+ 0 0 0\n", &["-o", "-"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("standard output holds the queries"));
+    let (out, dir) = replay_file("+ 0 0 0\n", &["-o", "x.jpg"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("does not write .jpg"));
+    assert!(!dir.path().join("x.jpg").exists());
+    let (out, dir) = replay_file("+ 0 0 0\n", &["-o", "ops.txt"]);
+    assert!(!out.status.success());
+    let _ = dir;
+    // A map beyond OctoMap's keys is refused in .bt, kept in .tess.
+    let (out, _dir) = replay_file("+ 40000 0 0\n+ 40001 0 0\n", &["-o", "far.bt"]);
+    assert!(!out.status.success());
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("−32768..32767"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (out, _dir) = replay_file("+ 40000 0 0\n+ 40001 0 0\n", &["-o", "far.tess"]);
+    assert!(out.status.success());
+}

@@ -336,6 +336,74 @@ fn fuzz_ply() {
     fuzz("ply", |b| parse_mesh(b, "ply"), &seeds, CASES / 2);
 }
 
+/// The committed seeds of a scan fuzz target.
+fn scan_seeds(target: &str) -> Vec<Vec<u8>> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../fuzz/corpus")
+        .join(target);
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.unwrap().path())
+        .collect();
+    files.sort();
+    files.iter().map(|f| std::fs::read(f).unwrap()).collect()
+}
+
+#[test]
+fn fuzz_scans() {
+    use tesseral::io::scan::{parse, ScanFormat};
+    let formats: [(&str, Parser); 5] = [
+        ("scan_graph", |b| parse(b, ScanFormat::Graph).is_ok()),
+        ("scan_log", |b| parse(b, ScanFormat::Log).is_ok()),
+        ("scan_xyz", |b| parse(b, ScanFormat::Xyz).is_ok()),
+        ("scan_ply", |b| parse(b, ScanFormat::Ply).is_ok()),
+        ("scan_pcd", |b| parse(b, ScanFormat::Pcd).is_ok()),
+    ];
+    for (name, parser) in formats {
+        fuzz(name, parser, &scan_seeds(name), CASES / 2);
+    }
+}
+
+#[test]
+fn hostile_scan_headers_are_refused_cheaply() {
+    use tesseral::io::scan::{parse, ScanFormat};
+    let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let mut graph = u32::MAX.to_le_bytes().to_vec();
+    graph.extend_from_slice(&[0; 80]);
+    let mut points = 1u32.to_le_bytes().to_vec();
+    points.extend_from_slice(&u32::MAX.to_le_bytes());
+    points.extend_from_slice(&[0; 80]);
+    let pcd = |data: &str| {
+        format!("VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 4000000000\nDATA {data}\n1 2 3\n").into_bytes()
+    };
+    let cases: Vec<(&str, Parser, Vec<u8>)> = vec![
+        (
+            "graph nodes",
+            |b| parse(b, ScanFormat::Graph).is_ok(),
+            graph,
+        ),
+        (
+            "graph points",
+            |b| parse(b, ScanFormat::Graph).is_ok(),
+            points,
+        ),
+        (
+            "pcd ascii",
+            |b| parse(b, ScanFormat::Pcd).is_ok(),
+            pcd("ascii"),
+        ),
+        (
+            "pcd binary",
+            |b| parse(b, ScanFormat::Pcd).is_ok(),
+            pcd("binary"),
+        ),
+    ];
+    for (name, parse, input) in cases {
+        run_one(name, parse, &input, 0, 0);
+        assert!(!parse(&input), "{name}: hostile input accepted");
+    }
+}
+
 #[test]
 fn hostile_headers_are_refused_cheaply() {
     let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());

@@ -21,6 +21,7 @@ pub const GROUPS: &[(&str, &[&str])] = &[
     ),
     ("Motion", &["collide", "simulate", "plan"]),
     ("Dynamic octrees and Monte Carlo", &["replay", "rsmc"]),
+    ("Maps from sensors", &["map"]),
     ("Tesseral arithmetic", &["calc", "tables"]),
     ("Shell", &["completions", "man", "help"]),
 ];

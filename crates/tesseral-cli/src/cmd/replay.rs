@@ -6,6 +6,8 @@
 //! (prints `1` or `0` on its own line, in order), `#` starts a comment; blank lines
 //! are skipped. At the end one JSON object is printed with the keys `voxels`, `faces`,
 //! `root_size_log2`, `root_min`, `expansions`, `contractions`, `nodes`, `bytes`.
+//! With `-o FILE` the octree built is saved (any format `convert` writes, voxel size
+//! 1), through the output-safety layer; the report then also has `output`.
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, IsTerminal, Read, Write};
@@ -29,10 +31,28 @@ pub struct Args {
     /// so that every command takes --json.
     #[arg(long)]
     json: bool,
+    /// Save the octree built to this file (.tess, .bt, .ot, .xyz, ...: any format
+    /// `convert` writes). Standard output holds the queries and the report, so `-`
+    /// is refused.
+    #[arg(short, long, value_name = "FILE")]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    limits: super::output::Limits,
 }
 
 pub fn run(args: Args) -> Result<()> {
     let name = args.ops.display().to_string();
+    if let Some(out) = &args.output {
+        if super::output::is_stdio(out) {
+            bail!("--output -: standard output holds the queries and the report; give a file");
+        }
+        super::output::guard(
+            "--output",
+            out,
+            &super::output::octree_formats(),
+            &[&args.ops],
+        )?;
+    }
     let (input, len): (Box<dyn Read>, Option<u64>) = if name == "-" {
         (Box::new(io::stdin().lock()), None)
     } else {
@@ -106,7 +126,23 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let report = serde_json::json!({
+    if let Some(path) = &args.output {
+        let depth = u8::try_from(tree.root_size_log2()).unwrap_or(u8::MAX);
+        let lin = tree
+            .to_linear(depth, tree.root_min())
+            .with_context(|| format!("{}: the octree does not fit a file", path.display()))?;
+        let out_args = super::octree::OutArgs {
+            limits: args.limits,
+            format: None,
+        };
+        super::octree::save(
+            path,
+            &tesseral::model::Model::new(lin),
+            &out_args,
+            &Default::default(),
+        )?;
+    }
+    let mut report = serde_json::json!({
         "voxels": tree.voxel_count(),
         "faces": tree.exposed_faces(),
         "root_size_log2": tree.root_size_log2(),
@@ -116,6 +152,9 @@ pub fn run(args: Args) -> Result<()> {
         "nodes": tree.node_count(),
         "bytes": tree.bytes(),
     });
+    if let Some(path) = &args.output {
+        report["output"] = serde_json::json!(path);
+    }
     writeln!(out, "{report}").context("writing to stdout")?;
     out.flush().context("writing to stdout")?;
     Ok(())

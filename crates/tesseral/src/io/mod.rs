@@ -17,6 +17,9 @@
 //! | `.bt`, `.ot` | OctoMap binary and full occupancy trees | [`octomap`] |
 //! | `.stl`, `.obj`, `.ply` | meshes, voxelized on read, meshed on write | [`crate::mesh`] |
 //! | `.glb` | glTF binary mesh (write only) | [`crate::mesh`] |
+//!
+//! Range scans for occupancy mapping (`.graph`, `.log`, `.xyz`, `.ply`, `.pcd`, with
+//! sensor poses) are read by [`scan`].
 
 mod atomic;
 pub mod binvox;
@@ -26,6 +29,7 @@ pub mod mesh;
 pub mod native;
 pub mod octomap;
 mod reframe;
+pub mod scan;
 mod sniff;
 pub mod vox;
 pub mod xyz;

@@ -26,6 +26,8 @@
 
 use std::path::Path;
 
+#[cfg(test)]
+mod range_tests;
 mod write;
 
 pub use write::{encode_bt, encode_ot, write_file, FREE_LOG_ODDS};

@@ -1,0 +1,242 @@
+//! `tesseral map SCANS... -o MAP`: builds an occupancy map from range scans, as
+//! OctoMap's `graph2tree` does, and writes it in any format a model can be written
+//! to (`.bt` maximum likelihood, `.ot` with log-odds, `.tess` with the full range).
+//!
+//! Scans come from OctoMap scan graphs (`.graph`) and logs (`.log`), which carry a
+//! pose per scan, and from point clouds (`.xyz`, `.ply`, `.pcd`), placed with
+//! `--origin` (the sensor position; the points are world coordinates) or `--pose`
+//! (the points are in the sensor frame, moved by the pose). A PCD's `VIEWPOINT` is
+//! its sensor origin unless either is given. Each scan is one
+//! `tesseral::occupancy::OccupancyMap::insert_scan` call.
+//!
+//! With `--json` one object is printed with exactly the keys `scans`, `points`,
+//! `rays`, `occupied`, `free`, `leaves`, `bytes`, `seconds` (the insertion time,
+//! reading and writing excluded, as `graph2tree` reports it) and `rays_per_second`.
+
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use tesseral::io::scan::{self, PointFrame, ScanFormat, ScanRecord};
+use tesseral::occupancy::{OccupancyMap, Pose, SensorModel};
+
+use super::octree::{self, OutArgs};
+
+/// Arguments of `tesseral map`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Scan files: .graph, .log (OctoMap, with poses), .xyz, .ply, .pcd (clouds).
+    #[arg(required = true, value_name = "SCANS")]
+    pub scans: Vec<PathBuf>,
+    /// The map file: .bt, .ot, .tess or any format `convert` writes.
+    #[arg(short, long, value_name = "MAP")]
+    pub output: PathBuf,
+    /// The side of a map cell, in the scans' units (metres).
+    #[arg(long, value_name = "METRES", allow_hyphen_values = true)]
+    pub resolution: f64,
+    /// Rays longer than this are cut: free up to the range, no hit recorded.
+    #[arg(long, value_name = "M", allow_hyphen_values = true)]
+    pub max_range: Option<f64>,
+    /// The probability that a measured end point is occupied (OctoMap: 0.7).
+    #[arg(long, value_name = "P", default_value_t = 0.7)]
+    pub prob_hit: f64,
+    /// The probability that a cell a ray crosses is occupied (OctoMap: 0.4).
+    #[arg(long, value_name = "P", default_value_t = 0.4)]
+    pub prob_miss: f64,
+    /// The probabilities log-odds are clamped to (OctoMap: 0.1192,0.971).
+    #[arg(long, value_name = "LO,HI", default_value = "0.1192,0.971", value_parser = parse_clamp)]
+    pub clamp: (f64, f64),
+    /// A cell is occupied above this probability (OctoMap: 0.5).
+    #[arg(long, value_name = "P", default_value_t = 0.5)]
+    pub threshold: f64,
+    /// The sensor position for point clouds (their points are world coordinates).
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_floats::<3>, allow_hyphen_values = true, conflicts_with = "pose")]
+    pub origin: Option<[f64; 3]>,
+    /// The sensor pose for point clouds (their points are in the sensor frame):
+    /// translation, then roll, pitch, yaw in radians (OctoMap's convention).
+    #[arg(long, value_name = "X,Y,Z,ROLL,PITCH,YAW", value_parser = parse_floats::<6>, allow_hyphen_values = true)]
+    pub pose: Option<[f64; 6]>,
+    /// Print the report as one JSON object.
+    #[arg(long)]
+    pub json: bool,
+    #[command(flatten)]
+    pub out: OutArgs,
+}
+
+/// Parses `N` comma-separated finite numbers.
+fn parse_floats<const N: usize>(s: &str) -> Result<[f64; N], String> {
+    let parts: Vec<&str> = s.split(',').collect();
+    if parts.len() != N {
+        return Err(format!("`{s}`: expected {N} comma-separated numbers"));
+    }
+    let mut v = [0.0; N];
+    for (x, p) in v.iter_mut().zip(parts) {
+        *x = p
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|x| x.is_finite())
+            .ok_or_else(|| format!("`{p}` is not a finite number"))?;
+    }
+    Ok(v)
+}
+
+fn parse_clamp(s: &str) -> Result<(f64, f64), String> {
+    parse_floats::<2>(s).map(|[a, b]| (a, b))
+}
+
+/// Totals over all scans.
+#[derive(Default)]
+struct Totals {
+    scans: u64,
+    points: u64,
+    rays: u64,
+    seconds: f64,
+}
+
+/// Runs the command.
+pub fn run(args: Args) -> Result<()> {
+    let inputs: Vec<&Path> = args.scans.iter().map(PathBuf::as_path).collect();
+    octree::guard(&args.output, &inputs, &args.out)?;
+    if super::output::is_stdio(&args.output) && args.json {
+        bail!("--json: standard output already holds the map (-o -)");
+    }
+    let mut formats = Vec::with_capacity(args.scans.len());
+    for path in &args.scans {
+        let Some(f) = ScanFormat::from_extension(&tesseral::io::extension(path)) else {
+            bail!(
+                "{}: not a scan file (scan formats: {})",
+                path.display(),
+                scan::SCAN_EXTENSIONS
+            );
+        };
+        if f.has_poses() && (args.origin.is_some() || args.pose.is_some()) {
+            let flag = if args.origin.is_some() {
+                "--origin"
+            } else {
+                "--pose"
+            };
+            bail!(
+                "{flag} places point clouds (.xyz, .ply, .pcd); {} carries a pose for each scan",
+                path.display()
+            );
+        }
+        formats.push(f);
+    }
+    if !(args.resolution.is_finite() && args.resolution > 0.0) {
+        bail!(
+            "--resolution {}: must be a positive number",
+            args.resolution
+        );
+    }
+    if let Some(m) = args.max_range {
+        if !(m.is_finite() && m > 0.0) {
+            bail!("--max-range {m}: must be a positive number");
+        }
+    }
+    let sensor =
+        SensorModel::from_probabilities(args.prob_hit, args.prob_miss, args.clamp, args.threshold)
+            .context("--prob-hit, --prob-miss, --clamp, --threshold")?;
+    let mut map = OccupancyMap::new(args.resolution, sensor)?;
+
+    let bar = if std::io::stderr().is_terminal() {
+        let b = indicatif::ProgressBar::new(0);
+        b.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} scans {msg}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        b
+    } else {
+        indicatif::ProgressBar::hidden()
+    };
+    let mut t = Totals::default();
+    for path in &args.scans {
+        let scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        bar.inc_length(scans.len() as u64);
+        bar.set_message(path.display().to_string());
+        for s in &scans {
+            insert(&mut map, s, &args, &mut t);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+
+    let model = map
+        .to_model()
+        .with_context(|| format!("{}: the map cannot be made a model", args.output.display()))?;
+    octree::save(&args.output, &model, &args.out, &Default::default())?;
+    let rate = if t.seconds > 0.0 {
+        t.rays as f64 / t.seconds
+    } else {
+        0.0
+    };
+    if args.json {
+        let v = serde_json::json!({
+            "scans": t.scans,
+            "points": t.points,
+            "rays": t.rays,
+            "occupied": map.occupied_count(),
+            "free": map.free_count(),
+            "leaves": map.leaf_count(),
+            "bytes": map.bytes(),
+            "seconds": t.seconds,
+            "rays_per_second": rate,
+        });
+        crate::outln!("{v}")?;
+    } else {
+        let line = format!(
+            "wrote {}: {} scans, {} points, {} rays in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {} leaves, {} bytes",
+            args.output.display(),
+            t.scans,
+            t.points,
+            t.rays,
+            t.seconds,
+            rate / 1e6,
+            map.occupied_count(),
+            map.free_count(),
+            map.leaf_count(),
+            map.bytes()
+        );
+        if super::output::is_stdio(&args.output) {
+            eprintln!("{line}");
+        } else {
+            crate::outln!("{line}")?;
+        }
+    }
+    Ok(())
+}
+
+/// Inserts one scan, placed by its own pose or by `--origin` / `--pose`.
+fn insert(map: &mut OccupancyMap, s: &ScanRecord, args: &Args, t: &mut Totals) {
+    let start = Instant::now();
+    let stats = if let Some(o) = args.origin {
+        map.insert_scan(o, &s.points, args.max_range)
+    } else if let Some([x, y, z, roll, pitch, yaw]) = args.pose {
+        let pose = Pose {
+            translation: [x, y, z],
+            roll,
+            pitch,
+            yaw,
+        };
+        map.insert_scan_posed(&pose, &s.points, args.max_range)
+    } else {
+        match s.frame {
+            PointFrame::World => map.insert_scan(s.translation, &s.points, args.max_range),
+            PointFrame::Sensor => {
+                let [roll, pitch, yaw] = s.rpy;
+                let pose = Pose {
+                    translation: s.translation,
+                    roll,
+                    pitch,
+                    yaw,
+                };
+                map.insert_scan_posed(&pose, &s.points, args.max_range)
+            }
+        }
+    };
+    t.seconds += start.elapsed().as_secs_f64();
+    t.scans += 1;
+    t.points += stats.points;
+    t.rays += stats.rays;
+}
