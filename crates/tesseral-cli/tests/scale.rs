@@ -93,3 +93,50 @@ fn streamed_build_budgets_and_refusals() {
     );
     assert!(v["leaves"].as_u64().unwrap() > 100);
 }
+
+/// `build --parts K` writes a dataset directory; `info`, `convert`, `op` and
+/// `render` read it as one model, equal voxel for voxel to the plain build.
+#[test]
+fn partitioned_datasets_read_as_one_model() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("showcase.tss");
+    let s = scene.to_str().unwrap();
+    let v = json(
+        d,
+        &[
+            "build", s, "--parts", "3", "-o", "ds", "--depth", "7", "--json",
+        ],
+    );
+    assert_eq!(v["parts"], 3);
+    assert!(d.join("ds/manifest.json").is_file() && d.join("ds/part-00002.tess").is_file());
+    let m = json(d, &["build", s, "-o", "m.tess", "--depth", "7", "--json"]);
+    assert_eq!(v["voxels"], m["voxels"]);
+    let info = json(d, &["info", "ds", "--json"]);
+    assert_eq!(info["voxels"], m["voxels"]);
+    assert_eq!(info["leaves"], m["leaves"]);
+    ok(d, &["convert", "ds", "ds.xyz"]);
+    ok(d, &["convert", "m.tess", "m.xyz"]);
+    assert_eq!(
+        fs::read_to_string(d.join("ds.xyz")).unwrap(),
+        fs::read_to_string(d.join("m.xyz")).unwrap()
+    );
+    ok(d, &["op", "difference", "ds", "m.tess", "-o", "empty.xyz"]);
+    let empty = fs::read_to_string(d.join("empty.xyz")).unwrap();
+    assert!(empty.lines().all(|l| l.starts_with('#')), "{empty}");
+    ok(d, &["render", "ds", "-o", "ds.png", "--size", "64x48"]);
+    assert!(d.join("ds.png").is_file());
+    // A damaged part is named; a non-dataset directory is refused as an output.
+    let part = d.join("ds/part-00001.tess");
+    let mut bytes = fs::read(&part).unwrap();
+    bytes[60] ^= 0x10;
+    fs::write(&part, bytes).unwrap();
+    fails(d, &["info", "ds"], "part-00001.tess");
+    fs::create_dir(d.join("full")).unwrap();
+    fs::write(d.join("full/x.txt"), "x").unwrap();
+    fails(
+        d,
+        &["build", s, "--parts", "2", "-o", "full"],
+        "not a dataset",
+    );
+}

@@ -18,6 +18,7 @@ pub mod linear;
 pub mod mesh;
 pub mod model;
 pub mod motion;
+pub mod partition;
 pub mod pointer;
 pub mod render;
 pub mod rsmc;

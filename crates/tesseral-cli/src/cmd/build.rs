@@ -28,6 +28,11 @@ pub struct Args {
     /// streams without it. Colours are not written by a streaming build.
     #[arg(long)]
     stream: bool,
+    /// Build into a partitioned dataset of K parts of about equal work: OUTPUT is a
+    /// directory of `.tess` parts and a `manifest.json` (see docs/scale.md), each
+    /// part streamed as with --stream.
+    #[arg(long, value_name = "K")]
+    parts: Option<usize>,
     /// Build at this depth instead of the scene's: the same space, voxels 2^k times
     /// smaller or larger.
     #[arg(long, value_name = "D")]
@@ -39,6 +44,9 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(k) = args.parts {
+        return run_parts(&args, k);
+    }
     octree::guard(&args.output, &[&args.scene], &args.limits)?;
     if super::output::is_stdio(&args.output) && args.json {
         anyhow::bail!("--json: standard output already holds the octree (-o -)");
@@ -120,6 +128,30 @@ fn run_streamed(args: &Args, scene: &Scene) -> Result<()> {
             "estimated_leaves": s.estimate,
             "memory_estimate": s.memory_estimate,
             "cells": s.cells,
+        });
+        crate::outln!("{out}")?;
+    }
+    Ok(())
+}
+
+fn run_parts(args: &Args, k: usize) -> Result<()> {
+    let mut scene = Scene::read(&args.scene)?;
+    if let Some(d) = args.depth {
+        scene = scene.with_depth(d)?;
+    }
+    let start = Instant::now();
+    let parts = stream::build_parts(&args.scene, &scene, &args.output, k, &args.budget)?;
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    if args.json {
+        let out = serde_json::json!({
+            "scene": args.scene,
+            "output": args.output,
+            "depth": scene.depth,
+            "parts": parts.len(),
+            "leaves": parts.iter().map(|p| p.leaves).sum::<u64>(),
+            "voxels": parts.iter().map(|p| p.voxels).sum::<u64>(),
+            "part_leaves": parts.iter().map(|p| p.leaves).collect::<Vec<_>>(),
+            "build_ms": build_ms,
         });
         crate::outln!("{out}")?;
     }

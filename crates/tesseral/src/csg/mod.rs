@@ -39,7 +39,8 @@ pub use colours::colour_parts;
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};
 pub use scene::{Scene, SceneError};
 pub use shape::Shape;
-pub use stream::{StreamPlan, StreamProgress, StreamSummary, STREAM_CELL_LOG2};
+pub(crate) use stream::clip_leaf;
+pub use stream::{StreamPlan, StreamProgress, STREAM_CELL_LOG2};
 
 use crate::linear::OctreeError;
 

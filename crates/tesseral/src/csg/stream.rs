@@ -52,15 +52,7 @@ pub struct StreamPlan {
     cells: u64,
     depth: u8,
     origin: Voxel,
-}
-
-/// What a streaming build wrote.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct StreamSummary {
-    /// Leaves in the file (merged).
-    pub leaves: u64,
-    /// Black voxels.
-    pub voxels: u64,
+    cell_log2: u8,
 }
 
 impl Csg {
@@ -78,6 +70,21 @@ impl Csg {
         origin: Voxel,
         range: Range<u64>,
     ) -> Result<StreamPlan, CsgError> {
+        self.stream_plan_cells(depth, origin, range, STREAM_CELL_LOG2)
+    }
+
+    /// As [`Csg::stream_plan`], with work cells of `2^cell_log2` voxels per axis
+    /// (finer cells sample where the surface lies more finely).
+    ///
+    /// # Errors
+    /// As [`Csg::stream_plan`].
+    pub fn stream_plan_cells(
+        &self,
+        depth: u8,
+        origin: Voxel,
+        range: Range<u64>,
+        cell_log2: u8,
+    ) -> Result<StreamPlan, CsgError> {
         LinearOctree::empty(depth, origin)?;
         let mut plan = StreamPlan {
             items: Vec::new(),
@@ -85,6 +92,7 @@ impl Csg {
             cells: 0,
             depth,
             origin,
+            cell_log2,
         };
         self.plan_cell(0, origin, depth, &mut plan);
         Ok(plan)
@@ -97,7 +105,7 @@ impl Csg {
             return;
         }
         let contained = lo <= code && end <= hi;
-        if k <= STREAM_CELL_LOG2 {
+        if k <= plan.cell_log2 {
             plan.items.push(Item::Cell {
                 code,
                 min,
@@ -242,36 +250,35 @@ impl StreamPlan {
         rayon::current_num_threads() * 2
     }
 
-    /// Runs the plan into a `.tess` file (version 2) written to `w`, with `frame`:
-    /// [`StreamPlan::run`] feeding a [`crate::io::TessWriter`].
-    ///
-    /// # Errors
-    /// Any I/O error of `w`.
-    pub fn write_tess(
-        &self,
-        csg: &Csg,
-        frame: crate::model::Frame,
-        w: &mut dyn std::io::Write,
-        window: usize,
-        progress: &mut dyn FnMut(StreamProgress),
-    ) -> std::io::Result<StreamSummary> {
-        let mut tw = crate::io::TessWriter::new(w, self.depth, self.origin)?;
-        let mut voxels = 0u64;
-        self.run::<std::io::Error>(
-            csg,
-            window,
-            &mut |ls| {
-                for &l in ls {
-                    voxels += l.voxel_count();
-                    tw.push(l)?;
-                }
-                Ok(())
-            },
-            progress,
-        )?;
-        let leaves = tw.leaf_count();
-        tw.finish(frame)?;
-        Ok(StreamSummary { leaves, voxels })
+    /// The depth of the plan's space.
+    #[must_use]
+    pub fn depth(&self) -> u8 {
+        self.depth
+    }
+
+    /// The lowest voxel of the plan's space.
+    #[must_use]
+    pub fn origin(&self) -> Voxel {
+        self.origin
+    }
+
+    /// The code range the plan covers.
+    #[must_use]
+    pub fn range(&self) -> Range<u64> {
+        self.range.clone()
+    }
+
+    /// The code ranges of the work cells, in order: a sample of where the surface
+    /// lies, used to cut the space into balanced partitions.
+    #[must_use]
+    pub fn cell_ranges(&self) -> Vec<Range<u64>> {
+        self.items
+            .iter()
+            .filter_map(|i| match *i {
+                Item::Cell { code, k, .. } => Some(code..code + (1u64 << (3 * u32::from(k)))),
+                Item::Leaf(_) => None,
+            })
+            .collect()
     }
 
     /// The number of work cells.

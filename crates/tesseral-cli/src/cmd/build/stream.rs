@@ -62,14 +62,21 @@ pub fn build_streamed(
         );
     }
     let bar = progress_bar(plan.cell_count(), estimate);
-    let mut summary = tesseral::csg::StreamSummary::default();
+    let mut summary = tesseral::partition::StreamSummary::default();
     let written = tesseral::io::write_atomic(out, |w| {
-        summary = plan.write_tess(&csg, scene.frame(), w, window, &mut |p: StreamProgress| {
-            if let Some(b) = &bar {
-                b.set_position(p.cells_done);
-                b.set_message(format!("{} leaves", p.leaves));
-            }
-        })?;
+        summary = tesseral::partition::write_plan_tess(
+            &plan,
+            &csg,
+            scene.frame(),
+            w,
+            window,
+            &mut |p: StreamProgress| {
+                if let Some(b) = &bar {
+                    b.set_position(p.cells_done);
+                    b.set_message(format!("{} leaves", p.leaves));
+                }
+            },
+        )?;
         Ok(())
     });
     if let Some(b) = &bar {
@@ -99,4 +106,44 @@ fn progress_bar(cells: u64, estimate: u64) -> Option<indicatif::ProgressBar> {
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
     Some(bar)
+}
+
+/// Builds `scene` into the dataset directory `dir` as `k` parts (each streamed),
+/// after the same memory check as a streamed build.
+pub fn build_parts(
+    path: &Path,
+    scene: &Scene,
+    dir: &Path,
+    k: usize,
+    budget: &Budget,
+) -> Result<Vec<tesseral::partition::ManifestPart>> {
+    let what = format!("{} at depth {}", path.display(), scene.depth);
+    if k == 0 {
+        anyhow::bail!("--parts 0: give at least one part");
+    }
+    if dir.exists() && !tesseral::partition::is_dataset(dir) {
+        let empty = dir.is_dir() && std::fs::read_dir(dir)?.next().is_none();
+        if !empty {
+            anyhow::bail!(
+                "--output {}: exists and is not a dataset directory (no manifest.json); give a new or empty directory",
+                dir.display()
+            );
+        }
+    }
+    let estimate = scene.estimate_leaves_streamed()?;
+    let (_, plan) = scene.stream_plan(0..u64::MAX)?;
+    let window = StreamPlan::default_window();
+    budget.check_memory(
+        &what,
+        stream_memory(estimate, plan.cell_count(), window),
+        " or lower the depth",
+    )?;
+    drop(plan);
+    Ok(tesseral::partition::build_scene_dataset(
+        scene,
+        dir,
+        k,
+        window,
+        &mut |_, _| {},
+    )?)
 }
