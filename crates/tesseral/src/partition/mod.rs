@@ -21,11 +21,13 @@ use crate::linear::{push_merging, Leaf, LinearOctree, OctreeError, SetOp};
 use crate::Voxel;
 
 pub mod dataset;
+mod merge;
 mod stream;
 
 pub use dataset::{
     is_dataset, read_dataset, read_dataset_model, write_dataset, Manifest, ManifestPart, MANIFEST,
 };
+pub use merge::stream_set_op;
 pub use stream::{build_scene_dataset, write_plan_tess, StreamSummary};
 
 /// Errors of partitioned octrees and datasets.

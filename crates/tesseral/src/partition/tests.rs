@@ -209,3 +209,46 @@ fn a_scene_builds_straight_into_a_dataset() {
         whole.voxel_count()
     );
 }
+
+#[test]
+fn streamed_set_operations_of_files_equal_the_in_memory_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(19);
+    for i in 0..40 {
+        let depth = rng.random_range(1..=5);
+        let a = random_tree(&mut rng, depth);
+        let b = random_tree(&mut rng, depth);
+        let (pa, pb) = (
+            dir.path().join(format!("a{i}.tess")),
+            dir.path().join(format!("b{i}.tess")),
+        );
+        for (p, t) in [(&pa, &a), (&pb, &b)] {
+            let mut w = crate::io::TessWriter::new(Vec::new(), depth, [0; 3])
+                .unwrap()
+                .with_chunk_leaves(1 + i % 4);
+            for &l in t.leaves() {
+                w.push(l).unwrap();
+            }
+            std::fs::write(p, w.finish(Frame::default()).unwrap()).unwrap();
+        }
+        let (fa, fb) = (
+            crate::io::TessFile::open(&pa).unwrap(),
+            crate::io::TessFile::open(&pb).unwrap(),
+        );
+        for op in [
+            SetOp::Union,
+            SetOp::Intersection,
+            SetOp::Difference,
+            SetOp::SymmetricDifference,
+        ] {
+            let mut out = Vec::new();
+            let s = stream_set_op(&fa, &fb, op, Frame::default(), &mut out).unwrap();
+            let got = crate::io::native::decode(&out).unwrap().tree;
+            got.assert_valid();
+            let want = a.set_op_same_space(&b, op);
+            assert_eq!(voxels(&got), voxels(&want), "{op:?}");
+            assert_eq!(got.leaf_count(), want.leaf_count(), "{op:?}");
+            assert_eq!(s.voxels, want.voxel_count());
+        }
+    }
+}
