@@ -19,6 +19,7 @@ pub mod mesh;
 pub mod model;
 pub mod motion;
 pub mod occupancy;
+pub mod partition;
 pub mod pointer;
 pub mod render;
 pub mod rsmc;

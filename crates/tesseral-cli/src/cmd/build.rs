@@ -9,6 +9,8 @@ use tesseral::csg::Scene;
 use super::budget::Budget;
 use super::octree;
 
+mod stream;
+
 /// Arguments of `tesseral build`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -20,6 +22,21 @@ pub struct Args {
     /// Print the size and timing as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Stream the leaves straight to the `.tess` output, a few cells at a time, with
+    /// memory flat in the depth (checked against `--memory` before the work; the
+    /// leaf limit does not apply). A `.tess` build estimated over the leaf limit
+    /// streams without it. Colours are not written by a streaming build.
+    #[arg(long)]
+    stream: bool,
+    /// Build into a partitioned dataset of K parts of about equal work: OUTPUT is a
+    /// directory of `.tess` parts and a `manifest.json` (see docs/scale.md), each
+    /// part streamed as with --stream.
+    #[arg(long, value_name = "K")]
+    parts: Option<usize>,
+    /// Build at this depth instead of the scene's: the same space, voxels 2^k times
+    /// smaller or larger.
+    #[arg(long, value_name = "D")]
+    depth: Option<u8>,
     #[command(flatten)]
     limits: octree::OutArgs,
     #[command(flatten)]
@@ -27,13 +44,41 @@ pub struct Args {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if let Some(k) = args.parts {
+        return run_parts(&args, k);
+    }
     octree::guard(&args.output, &[&args.scene], &args.limits)?;
     if super::output::is_stdio(&args.output) && args.json {
         anyhow::bail!("--json: standard output already holds the octree (-o -)");
     }
-    let scene = Scene::read(&args.scene)?;
+    let mut scene = Scene::read(&args.scene)?;
+    if let Some(d) = args.depth {
+        scene = scene.with_depth(d)?;
+    }
+    let is_tess =
+        !super::output::is_stdio(&args.output) && args.limits.format_of(&args.output) == "tess";
+    if args.stream && !is_tess {
+        anyhow::bail!(
+            "--stream: only a .tess file can be written while building (not {})",
+            args.output.display()
+        );
+    }
+    if args.stream {
+        return run_streamed(&args, &scene);
+    }
     let start = Instant::now();
-    let model = args.budget.build_scene_model(&args.scene)?;
+    let tree = args.budget.build_scene(&args.scene, &scene).map_err(|e| {
+        if is_tess {
+            anyhow::anyhow!("{e}; or build straight to the .tess file with --stream")
+        } else {
+            e
+        }
+    })?;
+    let colors = scene.colour_layer(&tree, args.budget.leaf_cap())?;
+    let model = tesseral::model::Model {
+        colors,
+        ..tesseral::model::Model::new(tree).with_frame(scene.frame())
+    };
     let build_ms = start.elapsed().as_secs_f64() * 1e3;
     octree::save(&args.output, &model, &args.limits, &Default::default())
         .with_context(|| format!("writing {}", args.output.display()))?;
@@ -51,6 +96,62 @@ pub fn run(args: Args) -> Result<()> {
             "leaves_by_depth": tree.leaves_by_depth(),
             "build_ms": build_ms,
             "colors": model.colors.as_ref().map(|c| c.region_count()),
+        });
+        crate::outln!("{out}")?;
+    }
+    Ok(())
+}
+
+fn run_streamed(args: &Args, scene: &Scene) -> Result<()> {
+    let start = Instant::now();
+    let s = stream::build_streamed(
+        &args.scene,
+        scene,
+        &args.output,
+        &args.budget,
+        args.limits.limits.max_output,
+    )?;
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    if args.json {
+        let out = serde_json::json!({
+            "scene": args.scene,
+            "output": args.output,
+            "depth": scene.depth,
+            "voxel_size": scene.voxel,
+            "bounds_min": scene.bounds_min,
+            "objects": scene.objects,
+            "leaves": s.leaves,
+            "voxels": s.voxels,
+            "build_ms": build_ms,
+            "colors": null,
+            "streamed": true,
+            "estimated_leaves": s.estimate,
+            "memory_estimate": s.memory_estimate,
+            "cells": s.cells,
+        });
+        crate::outln!("{out}")?;
+    }
+    Ok(())
+}
+
+fn run_parts(args: &Args, k: usize) -> Result<()> {
+    let mut scene = Scene::read(&args.scene)?;
+    if let Some(d) = args.depth {
+        scene = scene.with_depth(d)?;
+    }
+    let start = Instant::now();
+    let parts = stream::build_parts(&args.scene, &scene, &args.output, k, &args.budget)?;
+    let build_ms = start.elapsed().as_secs_f64() * 1e3;
+    if args.json {
+        let out = serde_json::json!({
+            "scene": args.scene,
+            "output": args.output,
+            "depth": scene.depth,
+            "parts": parts.len(),
+            "leaves": parts.iter().map(|p| p.leaves).sum::<u64>(),
+            "voxels": parts.iter().map(|p| p.voxels).sum::<u64>(),
+            "part_leaves": parts.iter().map(|p| p.leaves).collect::<Vec<_>>(),
+            "build_ms": build_ms,
         });
         crate::outln!("{out}")?;
     }

@@ -26,6 +26,10 @@ pub fn read_model(
     if tesseral::io::extension(path) == "tss" {
         return budget.build_scene_model(path);
     }
+    if tesseral::partition::is_dataset(path) {
+        // A partitioned dataset (a directory with manifest.json) reads as one model.
+        return tesseral::partition::read_dataset_model(path).map_err(|e| anyhow::anyhow!("{e}"));
+    }
     // The library's message already names the file and its cause; keep it as one
     // line rather than repeating the cause from the error chain.
     tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))

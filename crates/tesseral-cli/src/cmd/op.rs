@@ -42,14 +42,17 @@ pub struct Args {
 
 pub fn run(args: Args) -> Result<()> {
     octree::guard(&args.output, &[&args.a, &args.b], &args.limits)?;
-    let a = octree::read(&args.a)?;
-    let b = octree::read(&args.b)?;
     let op = match args.op {
         OpArg::Union => SetOp::Union,
         OpArg::Intersection => SetOp::Intersection,
         OpArg::Difference => SetOp::Difference,
         OpArg::Xor => SetOp::SymmetricDifference,
     };
+    if let Some(done) = streamed(&args, op)? {
+        return done;
+    }
+    let a = octree::read(&args.a)?;
+    let b = octree::read(&args.b)?;
     let r = a.set_op(&b, op).with_context(|| {
         format!(
             "combining {} ({}) and {} ({})",
@@ -70,4 +73,53 @@ pub fn run(args: Args) -> Result<()> {
         extra: serde_json::json!({ "op": name }),
     };
     octree::write(&args.output, &r, &args.limits, report)
+}
+
+/// Two `.tess` files of one space and frame without colours, free space or
+/// log-odds, into a `.tess` file: a merge of the two sorted streams, one chunk of
+/// each held at a time. `None` when the inputs need the in-memory path.
+fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
+    use tesseral::io::TessFile;
+    let tess = |p: &std::path::Path| {
+        !super::output::is_stdio(p) && p.is_file() && tesseral::io::extension(p) == "tess"
+    };
+    let out_tess =
+        !super::output::is_stdio(&args.output) && tesseral::io::extension(&args.output) == "tess";
+    if !(tess(&args.a) && tess(&args.b) && out_tess) {
+        return Ok(None);
+    }
+    let a = TessFile::open(&args.a)?;
+    let b = TessFile::open(&args.b)?;
+    if !(a.is_streamed() && b.is_streamed())
+        || a.has_layers()
+        || b.has_layers()
+        || (a.depth(), a.origin(), a.frame()) != (b.depth(), b.origin(), b.frame())
+    {
+        return Ok(None);
+    }
+    let mut summary = tesseral::partition::StreamSummary::default();
+    tesseral::io::write_atomic(&args.output, |w| {
+        summary = tesseral::partition::stream_set_op(&a, &b, op, a.frame(), w)
+            .map_err(std::io::Error::other)?;
+        Ok(())
+    })
+    .with_context(|| format!("writing {}", args.output.display()))?;
+    if args.json {
+        let out = serde_json::json!({
+            "output": args.output,
+            "voxels": summary.voxels,
+            "leaves": summary.leaves,
+            "depth": a.depth(),
+            "origin": a.origin(),
+            "op": match args.op {
+                OpArg::Union => "union",
+                OpArg::Intersection => "intersection",
+                OpArg::Difference => "difference",
+                OpArg::Xor => "xor",
+            },
+            "streamed": true,
+        });
+        crate::outln!("{out}")?;
+    }
+    Ok(Some(Ok(())))
 }

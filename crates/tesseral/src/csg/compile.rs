@@ -569,6 +569,19 @@ impl Csg {
         }
     }
 
+    /// Classifies the cell `(min, k)` with nothing known from its ancestors.
+    pub(crate) fn classify_cell(&self, min: Voxel, k: u8) -> CellClass {
+        let (c, r) = cell_ball(min, k);
+        let known = Known::default();
+        let mut learn = known;
+        self.eval(self.root, c, r, known, &mut learn)
+    }
+
+    /// Appends the leaves of the cell `(code, min, k)`, built on this thread.
+    pub(crate) fn build_subtree(&self, code: u64, min: Voxel, k: u8, out: &mut Vec<Leaf>) {
+        self.build_cell(code, min, k, Known::default(), out);
+    }
+
     /// The sequential levels: leaves are appended to `out`, merged as they come.
     fn build_cell(&self, code: u64, min: Voxel, k: u8, known: Known, out: &mut Vec<Leaf>) {
         let (c, r) = cell_ball(min, k);

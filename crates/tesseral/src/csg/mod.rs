@@ -28,6 +28,7 @@ mod compile;
 mod index;
 pub mod scene;
 mod shape;
+mod stream;
 
 #[cfg(test)]
 pub(crate) mod tests;
@@ -38,6 +39,8 @@ pub use colours::colour_parts;
 pub use compile::{Csg, DEFAULT_MAX_LEAVES};
 pub use scene::{Scene, SceneError};
 pub use shape::Shape;
+pub(crate) use stream::clip_leaf;
+pub use stream::{StreamPlan, StreamProgress, STREAM_CELL_LOG2};
 
 use crate::linear::OctreeError;
 

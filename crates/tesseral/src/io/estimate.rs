@@ -21,7 +21,7 @@ const MESH_BYTES_PER_LEAF: u64 = 12 * 50;
 /// | format | estimate |
 /// |---|---|
 /// | `.xyz` | one line per voxel, each as long as the widest coordinates allow (an upper bound) |
-/// | `.tess` | at most ten bytes per leaf, plus header and checksum (an upper bound; colours not counted) |
+/// | `.tess` | at most ten bytes per leaf, plus header, chunk headers and index (an upper bound; colours not counted) |
 /// | `.bt`, `.ot` | OctoMap nodes: at most 16 levels above each leaf, 2 (`.bt`) or 9 (`.ot`) bytes each |
 /// | `.binvox` | two bytes per run of the dense grid over the bounding box |
 /// | `.vox` | four bytes per voxel, plus the palette |
@@ -57,7 +57,11 @@ pub fn estimate_output_bytes(tree: &LinearOctree, ext: &str) -> Option<u64> {
             };
             80u64.saturating_add(tree.voxel_count().saturating_mul(line))
         }
-        "tess" => 100u64.saturating_add(leaves.saturating_mul(10)),
+        // Header, frame and trailer; ten bytes a leaf at most; 68 bytes a chunk (its
+        // header, checksum and index entry).
+        "tess" => 200u64
+            .saturating_add(leaves.saturating_mul(10))
+            .saturating_add((leaves / super::DEFAULT_CHUNK_LEAVES as u64 + 1) * 68),
         "bt" => 200u64.saturating_add(leaves.saturating_mul(16 * 2)),
         "ot" => 200u64.saturating_add(leaves.saturating_mul(16 * 9)),
         "binvox" => {

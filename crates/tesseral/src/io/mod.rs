@@ -23,6 +23,7 @@
 
 mod atomic;
 pub mod binvox;
+mod chunked;
 mod estimate;
 mod leafstream;
 pub mod mesh;
@@ -30,16 +31,20 @@ pub mod native;
 pub mod octomap;
 mod reframe;
 pub mod scan;
+mod sections;
 mod sniff;
+mod tess_file;
 pub mod vox;
 pub mod xyz;
 
 mod error;
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
+pub use chunked::{ChunkInfo, TessWriter, DEFAULT_CHUNK_LEAVES};
 pub use error::FormatError;
 pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
 pub use sniff::sniff_format;
+pub use tess_file::TessFile;
 
 use std::fs;
 use std::path::Path;

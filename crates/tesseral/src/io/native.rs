@@ -1,11 +1,35 @@
 //! tesseral's native binary format, extension `.tess`: a linear octree as delta-coded
-//! varints, with a versioned header and a CRC-32 checksum.
+//! varints, with a versioned header and CRC-32 checksums.
 //!
-//! Layout (all integers little-endian):
+//! Version 2 (written since the streaming work) keeps the leaves in *chunks*, in
+//! tesseral order, each with its code range, count and CRC, and ends with an index
+//! of the chunks, so a writer never holds the whole tree ([`super::TessWriter`]) and
+//! a reader seeks to a code range ([`super::TessFile`]). All integers little-endian:
+//!
+//! | part | size | field |
+//! |---|---|---|
+//! | header | 8 | magic `89 54 45 53 53 52 4C 0A` (`\x89TESSRL\n`) |
+//! | | 2 | version, `2` |
+//! | | 2 | zero |
+//! | | 1 | depth D (≤ 21) |
+//! | | 3 | zero |
+//! | | 24 | origin, three `i64` |
+//! | chunk (repeated) | 32 | `lo` (first leaf's code), `hi` (end of its last leaf), leaf count c, payload length p: four `u64` |
+//! | | p | c varints: the first packed leaf, then each one's difference from the one before |
+//! | | 4 | CRC-32 of the chunk's 32 + p bytes |
+//! | sections | 2 | flags (below) |
+//! | | … | the sections named by the flags, as in version 1 |
+//! | index | 32 × chunks | per chunk: offset, `lo`, `hi`, count: four `u64` |
+//! | trailer | 32 | sections offset, index offset, chunk count, leaf count: four `u64` |
+//! | | 4 | zero |
+//! | | 4 | CRC-32 of the header, the sections, the index and the trailer before it |
+//! | | 8 | `TESSIDX\n` |
+//!
+//! Version 1 (still read) holds the leaves in one payload:
 //!
 //! | offset | size | field |
 //! |---|---|---|
-//! | 0 | 8 | magic `89 54 45 53 53 52 4C 0A` (`\x89TESSRL\n`) |
+//! | 0 | 8 | magic |
 //! | 8 | 2 | version, `1` |
 //! | 10 | 2 | flags: which sections follow the leaves (below) |
 //! | 12 | 1 | depth D (≤ 21) |
@@ -14,12 +38,18 @@
 //! | 40 | 8 | leaf count n |
 //! | 48 | 8 | payload length p in bytes |
 //! | 56 | p | n varints (LEB128): the first packed leaf, then the difference of each packed leaf from the one before |
-//! | … | 32 | flag bit 0: the frame, voxel size and translate, four `f64` |
-//! | … | … | flag bit 1 (read only, written by older versions): colour count m (`u64`), then m × (varint code delta, 4 bytes RGBA) |
-//! | … | … | flag bit 2: colours as regions (a *layer*, below) of 4 bytes RGBA |
-//! | … | … | flag bit 3: known-free space, a *leaf stream* |
-//! | … | … | flag bit 4: occupancy log-odds as a layer of 4-byte `f32` |
+//! | … | … | the sections |
 //! | end − 4 | 4 | CRC-32 (IEEE) of every byte before it |
+//!
+//! The sections, in this order, each present when its flag bit is set:
+//!
+//! | flag bit | section |
+//! |---|---|
+//! | 0 | the frame, voxel size and translate, four `f64` |
+//! | 1 | (read only, written by older versions) colour count m (`u64`), then m × (varint code delta, 4 bytes RGBA) |
+//! | 2 | colours as regions (a *layer*, below) of 4 bytes RGBA |
+//! | 3 | known-free space, a *leaf stream* |
+//! | 4 | occupancy log-odds as a layer of 4-byte `f32` |
 //!
 //! A *leaf stream* is a leaf count n (`u64`) then n varints as in the payload. A
 //! *layer* is a region count r (`u64`), then per region its value's bytes and a leaf
@@ -28,31 +58,30 @@
 //!
 //! A packed leaf ([`crate::linear::Leaf::packed`]) holds the code and the block size, and packed
 //! leaves increase strictly, so the deltas are positive and small: one byte for most
-//! leaves of a solid. The layout has no pointers, so the file can be memory-mapped
-//! and decoded in one pass ([`read`] maps it with `memmap2`).
+//! leaves of a solid. The layout has no pointers but the index, so the file can be
+//! memory-mapped and decoded in one pass ([`read`] maps it with `memmap2`).
 //!
-//! The reader trusts no stored count: it checks the checksum first, allocates no more
+//! The reader trusts no stored count: it checks the checksums first, allocates no more
 //! than the file's own length can justify, validates every leaf (packing, size,
 //! bounds, order) and checks that the counts and lengths add up exactly.
 
 use std::io::{self, Write};
 use std::path::Path;
 
+use super::chunked::{chunk_leaves, parse_layout, TessWriter, VERSION_CHUNKED};
 use super::leafstream::{put_leaves, read_leaves, Reader};
+use super::sections::{check_parts, put_sections, read_sections, Extras, KNOWN_FLAGS};
 use super::FormatError;
 use crate::linear::{LinearOctree, MAX_DEPTH};
-use crate::model::{Frame, Layer, LayerValue, Model};
+use crate::model::Model;
 
 /// The eight bytes every `.tess` file starts with.
 pub const MAGIC: [u8; 8] = *b"\x89TESSRL\n";
-/// The version this code writes and reads.
-pub const VERSION: u16 = 1;
-const FLAG_FRAME: u16 = 1;
-const FLAG_COLORS: u16 = 2;
-const FLAG_COLOR_LAYER: u16 = 4;
-const FLAG_FREE: u16 = 8;
-const FLAG_LOG_ODDS: u16 = 16;
-const KNOWN_FLAGS: u16 = FLAG_FRAME | FLAG_COLORS | FLAG_COLOR_LAYER | FLAG_FREE | FLAG_LOG_ODDS;
+/// The version this code writes: chunked, with an index.
+pub const VERSION: u16 = VERSION_CHUNKED;
+/// The first version, with the leaves in one payload: still read, and written by
+/// [`write_v1`].
+pub const VERSION_1: u16 = 1;
 const HEADER_LEN: usize = 56;
 
 /// Reads a `.tess` file by memory-mapping it, falling back to reading it into memory
@@ -107,7 +136,7 @@ pub fn encode(model: &Model) -> Vec<u8> {
     out
 }
 
-/// Writes a model in the `.tess` format.
+/// Writes a model in the `.tess` format (version 2, chunked).
 ///
 /// # Runtime
 /// O(n) for n leaves (plus the colours).
@@ -116,29 +145,28 @@ pub fn encode(model: &Model) -> Vec<u8> {
 /// Any I/O error of `w`.
 pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     let tree = &model.tree;
+    let mut tw = TessWriter::new(w, tree.depth(), tree.origin())?;
+    for &leaf in tree.leaves() {
+        tw.push(leaf)?;
+    }
+    tw.finish_extras(&Extras::of(model))?;
+    Ok(())
+}
+
+/// Writes a model in version 1 of the `.tess` format (one payload, one checksum),
+/// which older builds read.
+///
+/// # Errors
+/// Any I/O error of `w`.
+pub fn write_v1(w: &mut dyn Write, model: &Model) -> io::Result<()> {
+    let tree = &model.tree;
     let mut payload = Vec::with_capacity(tree.leaf_count() + 16);
     put_leaves(&mut payload, tree.leaves());
-    let mut flags = FLAG_FRAME;
     let mut tail = Vec::new();
-    tail.extend_from_slice(&model.frame.voxel_size.to_le_bytes());
-    for t in model.frame.translate {
-        tail.extend_from_slice(&t.to_le_bytes());
-    }
-    if let Some(colors) = &model.colors {
-        flags |= FLAG_COLOR_LAYER;
-        put_layer(&mut tail, colors, |c| c.to_vec());
-    }
-    if let Some(free) = &model.free {
-        flags |= FLAG_FREE;
-        put_stream(&mut tail, free);
-    }
-    if let Some(odds) = &model.log_odds {
-        flags |= FLAG_LOG_ODDS;
-        put_layer(&mut tail, odds, |x| x.to_le_bytes().to_vec());
-    }
+    let flags = put_sections(&mut tail, &Extras::of(model));
     let mut header = Vec::with_capacity(HEADER_LEN);
     header.extend_from_slice(&MAGIC);
-    header.extend_from_slice(&VERSION.to_le_bytes());
+    header.extend_from_slice(&VERSION_1.to_le_bytes());
     header.extend_from_slice(&flags.to_le_bytes());
     header.push(tree.depth());
     header.extend_from_slice(&[0, 0, 0]);
@@ -155,7 +183,7 @@ pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     w.write_all(&crc.finalize().to_le_bytes())
 }
 
-/// Decodes `.tess` bytes; `path` names the source in errors.
+/// Decodes `.tess` bytes of either version.
 ///
 /// # Runtime
 /// O(len + n).
@@ -167,17 +195,67 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
     if bytes.len() < 8 || bytes[..8] != MAGIC {
         return Err(bad("not a tesseral .tess file (bad magic number)".into()));
     }
+    if bytes.len() < 10 {
+        return Err(bad("truncated: no version after the magic number".into()));
+    }
+    match u16::from_le_bytes([bytes[8], bytes[9]]) {
+        VERSION_1 => decode_v1(bytes),
+        VERSION_CHUNKED => decode_v2(bytes),
+        version => Err(FormatError::unsupported(format!(
+            "format version {version}; this build reads versions {VERSION_1} and {VERSION}"
+        ))),
+    }
+}
+
+/// Decodes version-2 bytes: the layout, every chunk, the sections.
+fn decode_v2(bytes: &[u8]) -> Result<Model, FormatError> {
+    let bad = |m: String| FormatError::corrupt(m);
+    let layout = parse_layout(bytes).map_err(bad)?;
+    let mut leaves = Vec::with_capacity(layout.leaf_count as usize);
+    for i in 0..layout.chunks.len() {
+        leaves.extend(chunk_leaves(bytes, &layout, i).map_err(bad)?);
+    }
+    let tree = LinearOctree::from_sorted_leaves(layout.depth, layout.origin, leaves)
+        .map_err(FormatError::octree)?;
+    let extras = decode_sections(bytes, &layout, &tree).map_err(bad)?;
+    let model = extras.into_model(tree);
+    check_parts(&model).map_err(bad)?;
+    Ok(model)
+}
+
+/// The sections of a version-2 file, read exactly to the index.
+pub(crate) fn decode_sections(
+    bytes: &[u8],
+    layout: &super::chunked::Layout,
+    space: &LinearOctree,
+) -> Result<Extras, String> {
+    let (start, end) = layout.sections;
+    let mut r = Reader {
+        bytes: &bytes[..end],
+        pos: start,
+    };
+    let flags = r.u16()?;
+    if flags & !KNOWN_FLAGS != 0 {
+        return Err(format!("unknown section flags {flags:#06x}"));
+    }
+    let extras = read_sections(&mut r, flags, space)?;
+    if r.pos != end {
+        return Err(format!(
+            "{} unexpected byte(s) before the index",
+            end - r.pos
+        ));
+    }
+    Ok(extras)
+}
+
+/// Decodes version-1 bytes.
+fn decode_v1(bytes: &[u8]) -> Result<Model, FormatError> {
+    let bad = |m: String| FormatError::corrupt(m);
     if bytes.len() < HEADER_LEN + 4 {
         return Err(bad(format!(
             "truncated: {} bytes, a header needs {}",
             bytes.len(),
             HEADER_LEN + 4
-        )));
-    }
-    let version = u16::from_le_bytes([bytes[8], bytes[9]]);
-    if version != VERSION {
-        return Err(FormatError::unsupported(format!(
-            "format version {version}; this build reads version {VERSION}"
         )));
     }
     let (body, stored) = bytes.split_at(bytes.len() - 4);
@@ -227,7 +305,6 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
             "leaf count {leaf_count} cannot fit in a payload of {payload_len} bytes"
         )));
     }
-    let space_end = 1u64 << (3 * u32::from(depth));
     let mut payload = Reader {
         bytes: &body[..payload_end],
         pos: HEADER_LEN,
@@ -245,310 +322,18 @@ pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
         bytes: body,
         pos: payload_end,
     };
-    let frame = if flags & FLAG_FRAME != 0 {
-        let voxel_size = tail.f64().map_err(&bad)?;
-        let translate = [
-            tail.f64().map_err(&bad)?,
-            tail.f64().map_err(&bad)?,
-            tail.f64().map_err(&bad)?,
-        ];
-        if !(voxel_size.is_normal() && voxel_size > 0.0) || translate.iter().any(|t| !t.is_finite())
-        {
-            return Err(bad(format!("frame: voxel size {voxel_size} or translate {translate:?} is not finite and positive")));
-        }
-        Frame::new(voxel_size, translate)
-    } else {
-        Frame::default()
-    };
-    let mut colors = None;
-    if flags & FLAG_COLORS != 0 {
-        let count = tail.u64().map_err(&bad)?;
-        let remaining = (body.len() - tail.pos) as u64;
-        if count > remaining / 5 {
-            return Err(bad(format!(
-                "colour count {count} cannot fit in {remaining} bytes"
-            )));
-        }
-        let mut pairs = Vec::with_capacity(count as usize);
-        let mut code = 0u64;
-        for index in 0..count {
-            let delta = tail
-                .varint()
-                .map_err(|m| bad(format!("colour {index}: {m}")))?;
-            code = code
-                .checked_add(delta)
-                .filter(|&c| c < space_end && (index == 0 || delta > 0))
-                .ok_or_else(|| bad(format!("colour {index}: bad voxel code")))?;
-            let rgba = tail.take(4).map_err(&bad)?;
-            pairs.push((tree.voxel_of(code), [rgba[0], rgba[1], rgba[2], rgba[3]]));
-        }
-        colors = Some(Layer::from_voxels(depth, origin, pairs).map_err(FormatError::octree)?);
-    }
-    if flags & FLAG_COLOR_LAYER != 0 {
-        colors = Some(
-            read_layer(&mut tail, depth, origin, "colour", |b| {
-                [b[0], b[1], b[2], b[3]]
-            })
-            .map_err(&bad)?,
-        );
-    }
-    let free = if flags & FLAG_FREE != 0 {
-        Some(read_stream(&mut tail, depth, origin, "free leaf").map_err(&bad)?)
-    } else {
-        None
-    };
-    let log_odds = if flags & FLAG_LOG_ODDS != 0 {
-        Some(
-            read_layer(&mut tail, depth, origin, "log-odds", |b| {
-                f32::from_le_bytes([b[0], b[1], b[2], b[3]])
-            })
-            .map_err(&bad)?,
-        )
-    } else {
-        None
-    };
+    let extras = read_sections(&mut tail, flags, &tree).map_err(&bad)?;
     if tail.pos != body.len() {
         return Err(bad(format!(
             "{} unexpected byte(s) before the checksum",
             body.len() - tail.pos
         )));
     }
-    let model = Model {
-        tree,
-        frame,
-        colors,
-        free,
-        log_odds,
-    };
+    let model = extras.into_model(tree);
     check_parts(&model).map_err(bad)?;
     Ok(model)
 }
 
-/// Checks what the sections claim against each other: colours on black voxels, free
-/// space disjoint from them, log-odds on known voxels.
-fn check_parts(m: &Model) -> Result<(), String> {
-    use crate::linear::SetOp;
-    if let Some(c) = &m.colors {
-        if !c
-            .domain()
-            .set_op_same_space(&m.tree, SetOp::Difference)
-            .is_empty()
-        {
-            return Err("colour section: colours on voxels that are not black".into());
-        }
-    }
-    if let Some(f) = &m.free {
-        if !f.set_op_same_space(&m.tree, SetOp::Intersection).is_empty() {
-            return Err("free section: free voxels that are also black".into());
-        }
-    }
-    if let Some(l) = &m.log_odds {
-        if !l
-            .domain()
-            .set_op_same_space(&m.known(), SetOp::Difference)
-            .is_empty()
-        {
-            return Err("log-odds section: values on unknown voxels".into());
-        }
-    }
-    Ok(())
-}
-
-fn put_stream(out: &mut Vec<u8>, tree: &LinearOctree) {
-    out.extend_from_slice(&(tree.leaf_count() as u64).to_le_bytes());
-    put_leaves(out, tree.leaves());
-}
-
-fn put_layer<T: LayerValue>(out: &mut Vec<u8>, layer: &Layer<T>, bytes: impl Fn(&T) -> Vec<u8>) {
-    out.extend_from_slice(&(layer.region_count() as u64).to_le_bytes());
-    for (x, t) in layer.regions() {
-        out.extend_from_slice(&bytes(x));
-        put_stream(out, t);
-    }
-}
-
-fn read_stream(
-    r: &mut Reader<'_>,
-    depth: u8,
-    origin: crate::Voxel,
-    what: &str,
-) -> Result<LinearOctree, String> {
-    let count = r.u64()?;
-    let leaves = read_leaves(r, count, depth, what)?;
-    LinearOctree::from_sorted_leaves(depth, origin, leaves).map_err(|e| format!("{what}: {e}"))
-}
-
-fn read_layer<T: LayerValue>(
-    r: &mut Reader<'_>,
-    depth: u8,
-    origin: crate::Voxel,
-    what: &str,
-    value: impl Fn(&[u8]) -> T,
-) -> Result<Layer<T>, String> {
-    let count = r.u64()?;
-    let remaining = (r.bytes.len() - r.pos) as u64;
-    // A region takes at least 4 + 8 bytes.
-    if count > remaining / 12 {
-        return Err(format!(
-            "{what} region count {count} cannot fit in {remaining} bytes"
-        ));
-    }
-    let mut regions = Vec::with_capacity(count as usize);
-    let mut keys = std::collections::HashSet::new();
-    for i in 0..count {
-        let x = value(r.take(4)?);
-        if !keys.insert(x.key()) {
-            return Err(format!("{what} region {i}: repeats a value"));
-        }
-        regions.push((
-            x,
-            read_stream(r, depth, origin, &format!("{what} region {i} leaf"))?,
-        ));
-    }
-    let layer = Layer::from_regions(depth, origin, regions).map_err(|e| e.to_string())?;
-    let total: u64 = layer.regions().iter().map(|(_, t)| t.voxel_count()).sum();
-    if layer.domain().voxel_count() != total {
-        return Err(format!("{what} section: regions overlap"));
-    }
-    Ok(layer)
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::io::leafstream::put_varint;
-    use rand::{Rng, SeedableRng};
-
-    fn random_tree(seed: u64) -> LinearOctree {
-        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-        let depth = rng.random_range(0..=6u8);
-        let side = 1i64 << depth;
-        let origin = [rng.random_range(-100..100), rng.random_range(-100..100), 7];
-        let n = rng.random_range(0..300);
-        let blob = rng.random_bool(0.5);
-        let voxels: Vec<_> = (0..n)
-            .map(|_| {
-                let r = if blob { side / 2 + 1 } else { side };
-                [
-                    origin[0] + rng.random_range(0..r),
-                    origin[1] + rng.random_range(0..r),
-                    origin[2] + rng.random_range(0..r),
-                ]
-            })
-            .collect();
-        LinearOctree::from_voxels(depth, origin, voxels).unwrap()
-    }
-
-    #[test]
-    fn round_trips_random_trees_with_frame_and_colours() {
-        for seed in 0..200 {
-            let tree = random_tree(seed);
-            let pairs = tree
-                .voxels()
-                .step_by(3)
-                .map(|v| (v, [v[0] as u8, v[1] as u8, 9, 255]));
-            let colors = Layer::from_voxels(tree.depth(), tree.origin(), pairs).unwrap();
-            // Free space: the voxels of the space's first octant that are not black.
-            let octant = LinearOctree::full(tree.depth().saturating_sub(1), tree.origin()).unwrap();
-            let free = octant.difference(&tree).unwrap();
-            let known = tree.union(&free).unwrap();
-            let odds = Layer::from_voxels(
-                tree.depth(),
-                tree.origin(),
-                known
-                    .voxels()
-                    .map(|v| (v, if v[0] % 2 == 0 { 0.85f32 } else { -0.4 })),
-            )
-            .unwrap();
-            let frame = if seed % 2 == 0 {
-                Frame::new(0.05, [1.5, -2.0, 0.25])
-            } else {
-                Frame::default()
-            };
-            let model = Model::from_parts(
-                tree.clone(),
-                frame,
-                (seed % 3 == 0).then_some(colors),
-                (seed % 4 < 2).then_some(free),
-                (seed % 4 == 0).then_some(odds),
-            )
-            .unwrap();
-            model.assert_valid();
-            let bytes = encode(&model);
-            let back = decode(&bytes).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-            back.assert_valid();
-            assert_eq!(back, model, "seed {seed}");
-        }
-    }
-
-    #[test]
-    fn every_truncation_and_bit_flip_is_an_error() {
-        let tree = random_tree(7);
-        let bytes = encode(&Model::new(tree));
-        for len in 0..bytes.len() {
-            assert!(decode(&bytes[..len]).is_err(), "truncated to {len}");
-        }
-        for i in 0..bytes.len() {
-            for bit in 0..8 {
-                let mut b = bytes.clone();
-                b[i] ^= 1 << bit;
-                assert!(decode(&b).is_err(), "flip byte {i} bit {bit}");
-            }
-        }
-    }
-
-    #[test]
-    fn hostile_counts_with_valid_checksums_are_refused() {
-        // A forged header claiming 2^60 leaves, with a correct checksum.
-        let tree = LinearOctree::from_voxels(3, [0, 0, 0], [[1, 1, 1]]).unwrap();
-        let mut bytes = encode(&Model::new(tree));
-        bytes[40..48].copy_from_slice(&(1u64 << 60).to_le_bytes());
-        let n = bytes.len();
-        let crc = crc32fast::hash(&bytes[..n - 4]);
-        bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
-        let err = decode(&bytes).unwrap_err().to_string();
-        assert!(err.contains("leaf count"), "{err}");
-        // Depth beyond the limit.
-        let mut bytes = encode(&Model::new(LinearOctree::empty(2, [0; 3]).unwrap()));
-        bytes[12] = 40;
-        let crc = crc32fast::hash(&bytes[..bytes.len() - 4]);
-        let n = bytes.len();
-        bytes[n - 4..].copy_from_slice(&crc.to_le_bytes());
-        let err = decode(&bytes).unwrap_err().to_string();
-        assert!(err.contains("depth 40"), "{err}");
-    }
-
-    #[test]
-    fn varint_round_trip_and_overflow() {
-        for v in [0, 1, 127, 128, 300, u64::MAX >> 1, u64::MAX] {
-            let mut out = Vec::new();
-            put_varint(&mut out, v);
-            assert_eq!(
-                Reader {
-                    bytes: &out,
-                    pos: 0
-                }
-                .varint(),
-                Ok(v)
-            );
-        }
-        let over = [0xffu8; 10];
-        assert!(Reader {
-            bytes: &over,
-            pos: 0
-        }
-        .varint()
-        .is_err());
-    }
-
-    #[test]
-    fn mapped_and_unmapped_reads_agree() {
-        let dir = tempfile::tempdir().unwrap();
-        let path = dir.path().join("t.tess");
-        let model = Model::new(random_tree(3));
-        crate::io::write_model(&path, &model).unwrap();
-        assert_eq!(read(&path).unwrap(), model);
-        assert_eq!(read_unmapped(&path).unwrap(), model);
-        assert_eq!(crate::io::read_octree(&path).unwrap(), model.tree);
-    }
-}
+#[path = "native_tests.rs"]
+mod tests;

@@ -1,0 +1,149 @@
+//! `tesseral build --stream`: the scene's leaves go straight to a `.tess` file, a
+//! few work cells at a time, so memory stays flat whatever the depth.
+
+use std::path::Path;
+
+use anyhow::{Context, Result};
+use tesseral::csg::{Scene, StreamPlan, StreamProgress};
+
+use super::super::budget::Budget;
+use super::super::output;
+
+/// Memory the program takes before any leaf: code, stacks, the scene.
+const BASE_BYTES: u64 = 48 << 20;
+/// A cell may hold this many times the average leaves per cell.
+const CELL_SKEW: u64 = 8;
+/// Bytes a leaf takes while its cell is built (the leaf and vector growth).
+const BYTES_PER_CELL_LEAF: u64 = 16;
+
+/// The memory a streaming build holds: a window of cells, each with up to
+/// `CELL_SKEW` × the average leaves, plus the plan, the writer's chunk and the base.
+pub fn stream_memory(estimate_leaves: u64, cells: u64, window: usize) -> u64 {
+    let per_cell = estimate_leaves / cells.max(1) + 1;
+    let window_bytes = (window as u64)
+        .saturating_mul(per_cell.saturating_mul(CELL_SKEW))
+        .saturating_mul(BYTES_PER_CELL_LEAF);
+    let writer = (tesseral::io::DEFAULT_CHUNK_LEAVES as u64 + 200) * 8 * 3;
+    BASE_BYTES
+        .saturating_add(window_bytes)
+        .saturating_add(cells.saturating_mul(40))
+        .saturating_add(writer)
+}
+
+/// What a streamed build reports.
+pub struct Streamed {
+    pub leaves: u64,
+    pub voxels: u64,
+    pub estimate: u64,
+    pub memory_estimate: u64,
+    pub cells: u64,
+}
+
+/// Builds `scene` straight into the `.tess` file `out`, after checking the memory
+/// estimate against `--memory` and the file's estimated size against `max_output`.
+pub fn build_streamed(
+    path: &Path,
+    scene: &Scene,
+    out: &Path,
+    budget: &Budget,
+    max_output: u64,
+) -> Result<Streamed> {
+    let what = format!("{} at depth {}", path.display(), scene.depth);
+    let estimate = scene.estimate_leaves_streamed()?;
+    let (csg, plan) = scene.stream_plan(0..u64::MAX)?;
+    let window = StreamPlan::default_window();
+    let memory_estimate = stream_memory(estimate, plan.cell_count(), window);
+    budget.check_memory(&what, memory_estimate, " or lower the depth")?;
+    let file_estimate = 200 + estimate.saturating_mul(10);
+    output::check_size(out, file_estimate, max_output)?;
+    if !tesseral::csg::colour_parts(&scene.solid).is_empty() {
+        eprintln!(
+            "note: a streaming build writes the shape only; the scene's colours are not written"
+        );
+    }
+    let bar = progress_bar(plan.cell_count(), estimate);
+    let mut summary = tesseral::partition::StreamSummary::default();
+    let written = tesseral::io::write_atomic(out, |w| {
+        summary = tesseral::partition::write_plan_tess(
+            &plan,
+            &csg,
+            scene.frame(),
+            w,
+            window,
+            &mut |p: StreamProgress| {
+                if let Some(b) = &bar {
+                    b.set_position(p.cells_done);
+                    b.set_message(format!("{} leaves", p.leaves));
+                }
+            },
+        )?;
+        Ok(())
+    });
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    written.with_context(|| format!("writing {}", out.display()))?;
+    Ok(Streamed {
+        leaves: summary.leaves,
+        voxels: summary.voxels,
+        estimate,
+        memory_estimate,
+        cells: plan.cell_count(),
+    })
+}
+
+/// A bar of work cells with the leaves so far and the time left, on a terminal only.
+fn progress_bar(cells: u64, estimate: u64) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(cells);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!(
+            "building {{bar:40}} {{pos}}/{{len}} cells, {{msg}} (~{estimate} expected), eta {{eta}}"
+        ))
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    Some(bar)
+}
+
+/// Builds `scene` into the dataset directory `dir` as `k` parts (each streamed),
+/// after the same memory check as a streamed build.
+pub fn build_parts(
+    path: &Path,
+    scene: &Scene,
+    dir: &Path,
+    k: usize,
+    budget: &Budget,
+) -> Result<Vec<tesseral::partition::ManifestPart>> {
+    let what = format!("{} at depth {}", path.display(), scene.depth);
+    if k == 0 {
+        anyhow::bail!("--parts 0: give at least one part");
+    }
+    if dir.exists() && !tesseral::partition::is_dataset(dir) {
+        let empty = dir.is_dir() && std::fs::read_dir(dir)?.next().is_none();
+        if !empty {
+            anyhow::bail!(
+                "--output {}: exists and is not a dataset directory (no manifest.json); give a new or empty directory",
+                dir.display()
+            );
+        }
+    }
+    let estimate = scene.estimate_leaves_streamed()?;
+    let (_, plan) = scene.stream_plan(0..u64::MAX)?;
+    let window = StreamPlan::default_window();
+    budget.check_memory(
+        &what,
+        stream_memory(estimate, plan.cell_count(), window),
+        " or lower the depth",
+    )?;
+    drop(plan);
+    Ok(tesseral::partition::build_scene_dataset(
+        scene,
+        dir,
+        k,
+        window,
+        &mut |_, _| {},
+    )?)
+}

@@ -1,0 +1,240 @@
+//! A `.tess` file opened for streaming: memory-mapped, its index read, its chunks
+//! decoded one at a time on demand, so a reader holds one chunk, not the tree.
+
+use std::path::{Path, PathBuf};
+
+use super::chunked::{chunk_leaves, parse_layout, ChunkInfo, Layout, DEFAULT_CHUNK_LEAVES};
+use super::sections::Extras;
+use super::FormatError;
+use crate::linear::{Leaf, LinearOctree};
+use crate::model::{Frame, Model};
+use crate::Voxel;
+
+enum Body {
+    /// Version 2: the bytes and their parsed layout.
+    Chunked(Bytes, Layout),
+    /// Version 1 (one payload): decoded whole, shown as chunks of the decoded leaves.
+    Decoded(LinearOctree),
+}
+
+enum Bytes {
+    Map(memmap2::Mmap),
+    Owned(Vec<u8>),
+}
+
+impl std::ops::Deref for Bytes {
+    type Target = [u8];
+    fn deref(&self) -> &[u8] {
+        match self {
+            Bytes::Map(m) => m,
+            Bytes::Owned(v) => v,
+        }
+    }
+}
+
+/// A `.tess` file opened for streaming. Version-2 files are memory-mapped and only
+/// their header, sections and index are read at [`TessFile::open`]; each chunk is
+/// checked (CRC, leaves) when it is read. Version-1 files are decoded whole and
+/// served as chunks of [`DEFAULT_CHUNK_LEAVES`] leaves.
+///
+/// ```
+/// use tesseral::io::{write_model, Model, TessFile};
+/// use tesseral::linear::LinearOctree;
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.tess");
+/// let tree = LinearOctree::from_voxels(4, [0, 0, 0], [[1, 2, 3], [9, 9, 9]]).unwrap();
+/// write_model(&path, &Model::new(tree.clone())).unwrap();
+/// let f = TessFile::open(&path).unwrap();
+/// assert_eq!(f.leaf_count(), 2);
+/// let leaves: Vec<_> = f.leaves().collect::<Result<_, _>>().unwrap();
+/// assert_eq!(leaves, tree.leaves());
+/// ```
+pub struct TessFile {
+    path: PathBuf,
+    body: Body,
+    extras: Extras,
+}
+
+impl TessFile {
+    /// Opens `path`, reading its header, sections and index.
+    ///
+    /// # Errors
+    /// [`FormatError`] naming the file and the field at fault.
+    pub fn open(path: &Path) -> Result<Self, FormatError> {
+        let file = std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
+        // SAFETY: as in `native::read`: the map is read-only and every access is
+        // bounds-checked against its length, so a concurrent rewrite gives a checksum
+        // error or SIGBUS, never undefined reads; our writers replace files by rename.
+        let bytes = match unsafe { memmap2::Mmap::map(&file) } {
+            Ok(m) => Bytes::Map(m),
+            Err(_) => Bytes::Owned(super::read_limited(path, super::MAX_FILE_BYTES)?),
+        };
+        Self::from_body(bytes, path)
+    }
+
+    /// Opens `.tess` bytes held in memory; `path` names them in errors.
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn from_bytes(bytes: Vec<u8>, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body(Bytes::Owned(bytes), path)
+    }
+
+    fn from_body(bytes: Bytes, path: &Path) -> Result<Self, FormatError> {
+        let err = |e: FormatError| e.with_path(path);
+        if bytes.len() < 10 || bytes[..8] != super::native::MAGIC {
+            return Err(err(FormatError::corrupt(
+                "not a tesseral .tess file (bad magic number)",
+            )));
+        }
+        let version = u16::from_le_bytes([bytes[8], bytes[9]]);
+        if version != super::native::VERSION {
+            let model = super::native::decode(&bytes).map_err(err)?;
+            let extras = Extras::of(&model);
+            return Ok(Self {
+                path: path.to_owned(),
+                body: Body::Decoded(model.tree),
+                extras,
+            });
+        }
+        let layout = parse_layout(&bytes).map_err(|m| err(FormatError::corrupt(m)))?;
+        let space =
+            LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
+        let extras = super::native::decode_sections(&bytes, &layout, &space)
+            .map_err(|m| err(FormatError::corrupt(m)))?;
+        Ok(Self {
+            path: path.to_owned(),
+            body: Body::Chunked(bytes, layout),
+            extras,
+        })
+    }
+
+    /// Whether the file is chunked (version 2) and so read chunk by chunk.
+    #[must_use]
+    pub fn is_streamed(&self) -> bool {
+        matches!(self.body, Body::Chunked(..))
+    }
+
+    /// The depth of the space.
+    #[must_use]
+    pub fn depth(&self) -> u8 {
+        match &self.body {
+            Body::Chunked(_, l) => l.depth,
+            Body::Decoded(t) => t.depth(),
+        }
+    }
+
+    /// The lowest voxel of the space.
+    #[must_use]
+    pub fn origin(&self) -> Voxel {
+        match &self.body {
+            Body::Chunked(_, l) => l.origin,
+            Body::Decoded(t) => t.origin(),
+        }
+    }
+
+    /// The frame (voxel size and placement).
+    #[must_use]
+    pub fn frame(&self) -> Frame {
+        self.extras.frame
+    }
+
+    /// Whether the file carries colours, free space or log-odds.
+    #[must_use]
+    pub fn has_layers(&self) -> bool {
+        self.extras.colors.is_some() || self.extras.free.is_some() || self.extras.log_odds.is_some()
+    }
+
+    /// The number of black leaves.
+    #[must_use]
+    pub fn leaf_count(&self) -> u64 {
+        match &self.body {
+            Body::Chunked(_, l) => l.leaf_count,
+            Body::Decoded(t) => t.leaf_count() as u64,
+        }
+    }
+
+    /// The chunks, in tesseral order.
+    #[must_use]
+    pub fn chunks(&self) -> Vec<ChunkInfo> {
+        match &self.body {
+            Body::Chunked(_, l) => l.chunks.clone(),
+            Body::Decoded(t) => t
+                .leaves()
+                .chunks(DEFAULT_CHUNK_LEAVES)
+                .map(|c| ChunkInfo {
+                    offset: 0,
+                    lo: c[0].code(),
+                    hi: c[c.len() - 1].end(),
+                    count: c.len() as u64,
+                })
+                .collect(),
+        }
+    }
+
+    /// The leaves of chunk `i` (of [`TessFile::chunks`]), checked.
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad chunk.
+    ///
+    /// # Panics
+    /// When `i` is not a chunk's index.
+    pub fn chunk(&self, i: usize) -> Result<Vec<Leaf>, FormatError> {
+        match &self.body {
+            Body::Chunked(b, l) => {
+                chunk_leaves(b, l, i).map_err(|m| FormatError::corrupt(m).with_path(&self.path))
+            }
+            Body::Decoded(t) => Ok(t
+                .leaves()
+                .chunks(DEFAULT_CHUNK_LEAVES)
+                .nth(i)
+                .expect("chunk index")
+                .to_vec()),
+        }
+    }
+
+    /// Every leaf in tesseral order, one chunk decoded at a time.
+    pub fn leaves(&self) -> impl Iterator<Item = Result<Leaf, FormatError>> + '_ {
+        self.leaves_in(0, u64::MAX)
+    }
+
+    /// The leaves that meet the code range `[lo, hi)` (whole, not clipped), reading
+    /// only the chunks whose ranges meet it (found by binary search of the index).
+    pub fn leaves_in(
+        &self,
+        lo: u64,
+        hi: u64,
+    ) -> impl Iterator<Item = Result<Leaf, FormatError>> + '_ {
+        let chunks = self.chunks();
+        let first = chunks.partition_point(|c| c.hi <= lo);
+        let last = chunks.partition_point(|c| c.lo < hi);
+        (first..last.max(first)).flat_map(move |i| {
+            let (ok, err) = match self.chunk(i) {
+                Ok(v) => (v, None),
+                Err(e) => (Vec::new(), Some(Err(e))),
+            };
+            err.into_iter().chain(
+                ok.into_iter()
+                    .filter(move |l| l.end() > lo && l.code() < hi)
+                    .map(Ok),
+            )
+        })
+    }
+
+    /// The whole model, read chunk by chunk (as [`super::native::read`]).
+    ///
+    /// # Errors
+    /// As [`TessFile::chunk`].
+    pub fn to_model(&self) -> Result<Model, FormatError> {
+        let mut leaves = Vec::with_capacity(self.leaf_count() as usize);
+        for l in self.leaves() {
+            leaves.push(l?);
+        }
+        let tree = LinearOctree::from_sorted_leaves(self.depth(), self.origin(), leaves)
+            .map_err(FormatError::octree)?;
+        let model = self.extras.clone().into_model(tree);
+        super::sections::check_parts(&model)
+            .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
+        Ok(model)
+    }
+}
