@@ -1,9 +1,11 @@
 //! `tesseral.DynamicOctree`: Libes' unbounded octree, fed whole arrays at a time.
 
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::dynamic::DynamicOctree as Tree;
+use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use crate::arrays::{rows, to_array};
 
@@ -47,6 +49,50 @@ impl DynamicOctree {
         let t = &self.tree;
         let out: Vec<bool> = py.allow_threads(|| v.iter().map(|&p| t.contains(p)).collect());
         Ok(out.into_pyarray(py))
+    }
+
+    /// Inserts one range scan, as a binary map: the cells the ray from `origin` to each
+    /// point crosses are cleared and each point's own cell is set (a cell both hit and
+    /// crossed in one scan is set), with OctoMap's `insertPointCloud` ray rules (see
+    /// `OccupancyMap.insert_scan`). Coordinates are in voxels: voxel i spans [i, i+1).
+    /// A point beyond `max_range` clears its ray up to `max_range` and sets nothing.
+    /// Returns the scan's counts plus `inserted` and `removed` (voxels that changed).
+    #[pyo3(signature = (origin, points, max_range = None))]
+    fn insert_scan<'py>(
+        &mut self,
+        py: Python<'py>,
+        origin: [f64; 3],
+        points: PyReadonlyArray2<'_, f64>,
+        max_range: Option<f64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let pts = rows(&points)?;
+        let t = &mut self.tree;
+        let (s, inserted, removed) = py
+            .allow_threads(|| {
+                // One scan in a fresh map at unit resolution: hit cells end with a
+                // positive log-odds and crossed ones with a negative one.
+                let mut map = OccupancyMap::new(1.0, SensorModel::octomap())?;
+                let s = map.insert_scan(origin, &pts, max_range);
+                let (mut inserted, mut removed) = (0u64, 0u64);
+                for (cell, l) in map.cells() {
+                    if l > 0.0 {
+                        inserted += u64::from(t.insert(cell));
+                    } else {
+                        removed += u64::from(t.remove(cell));
+                    }
+                }
+                Ok::<_, tesseral::occupancy::OccupancyError>((s, inserted, removed))
+            })
+            .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        let d = PyDict::new(py);
+        d.set_item("points", s.points)?;
+        d.set_item("rays", s.rays)?;
+        d.set_item("skipped", s.skipped)?;
+        d.set_item("hits", s.hits)?;
+        d.set_item("misses", s.misses)?;
+        d.set_item("inserted", inserted)?;
+        d.set_item("removed", removed)?;
+        Ok(d)
     }
 
     /// Every voxel, N×3 int64.
