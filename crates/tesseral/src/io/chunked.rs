@@ -270,7 +270,11 @@ pub(crate) fn parse_layout(bytes: &[u8]) -> Result<Layout, String> {
             "index at byte {index_offset} with {chunk_count} chunks does not end at the trailer (byte {t})"
         ));
     }
-    if sections_offset < HEADER_LEN as u64 || sections_offset + 2 > index_offset {
+    if sections_offset < HEADER_LEN as u64
+        || sections_offset
+            .checked_add(2)
+            .is_none_or(|e| e > index_offset)
+    {
         return Err(format!(
             "sections offset {sections_offset} lies outside the file's body"
         ));

@@ -307,3 +307,25 @@ fn mapped_and_unmapped_reads_agree() {
     assert_eq!(read_unmapped(&path).unwrap(), model);
     assert_eq!(crate::io::read_octree(&path).unwrap(), model.tree);
 }
+
+/// Found by `fuzz/fuzz_targets/tess_chunked.rs`: a trailer whose sections offset is
+/// near `u64::MAX` overflowed the layout check. With the index CRC fixed up as the
+/// fuzz target does, it must be an error, not a panic.
+#[test]
+fn a_sections_offset_near_u64_max_is_an_error() {
+    let mut bytes = include_bytes!("../../tests/fixtures/v2-sections-offset-overflow.bin").to_vec();
+    let n = bytes.len();
+    let t = n - 48;
+    let s = usize::try_from(u64::from_le_bytes(bytes[t..t + 8].try_into().unwrap()))
+        .ok()
+        .filter(|&s| s <= n - 12);
+    if let Some(s) = s {
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(&bytes[..40]);
+        crc.update(&bytes[s..n - 12]);
+        let c = crc.finalize();
+        bytes[t + 36..t + 40].copy_from_slice(&c.to_le_bytes());
+    }
+    assert!(decode(&bytes).is_err());
+    assert!(crate::io::TessFile::from_bytes(bytes, std::path::Path::new("x.tess")).is_err());
+}
