@@ -6,7 +6,7 @@ use std::collections::{BTreeMap, BTreeSet};
 use std::path::Path;
 
 /// The source without comment lines and without test code: a file's inline
-/// `#[cfg(test)] mod` ends it, and test files (`tests.rs`, `tests_*.rs`, and
+/// `#[cfg(test)] mod` ends it, and test files (`tests.rs`, `tests_*.rs`, `*_tests.rs`, and
 /// everything in a `tests/` folder) are skipped by the caller.
 fn production_code(text: &str) -> String {
     // An inline test module (`#[cfg(test)] mod tests {`) runs to the end of the
@@ -35,7 +35,11 @@ fn edges(dir: &Path, modules: &BTreeSet<String>, own: &str, out: &mut BTreeSet<S
             }
             continue;
         }
-        if !name.ends_with(".rs") || name == "tests.rs" || name.starts_with("tests_") {
+        if !name.ends_with(".rs")
+            || name == "tests.rs"
+            || name.starts_with("tests_")
+            || name.ends_with("_tests.rs")
+        {
             continue;
         }
         let code = production_code(&std::fs::read_to_string(&path).unwrap());
