@@ -125,7 +125,7 @@ fn summary(name: &str, cells: &[Voxel]) {
     );
     let nb = best_of(3, || {
         let t0 = Instant::now();
-        let s = oq.iter().fold(0u32, |a, &q| a ^ t.neighbourhood(q));
+        let s = oq.iter().fold(0u32, |a, &q| a ^ t.neighbourhood(q).bits());
         black_box(s);
         t0.elapsed().as_nanos() as f64 / oq.len() as f64
     });
@@ -192,7 +192,7 @@ fn surface_walk_summary() {
     let mut acc = 0u32;
     for i in 0..steps {
         let f = t.face((r.next() % t.face_count() as u64) as usize);
-        acc ^= t.neighbourhood(f.voxel);
+        acc ^= t.neighbourhood(f.voxel).bits();
         if i % 2 == 0 {
             t.insert(f.outside());
         } else if t.voxel_count() > 1 {
@@ -212,7 +212,7 @@ fn surface_walk_summary() {
         let mut acc = 0u32;
         for &i in &picks {
             let f = t.face(i);
-            acc ^= t.neighbourhood(f.voxel) ^ t.neighbourhood(f.outside());
+            acc ^= t.neighbourhood(f.voxel).bits() ^ t.neighbourhood(f.outside()).bits();
         }
         black_box(acc);
         t0.elapsed().as_nanos() as f64 / (2 * steps) as f64
@@ -242,7 +242,7 @@ fn criterion_benches(c: &mut Criterion, name: &str, cells: &[Voxel]) {
         b.iter(|| oq.iter().filter(|&&q| t.contains(q)).count())
     });
     g.bench_function("neighbourhood_occupied_1M", |b| {
-        b.iter(|| oq.iter().fold(0u32, |a, &q| a ^ t.neighbourhood(q)))
+        b.iter(|| oq.iter().fold(0u32, |a, &q| a ^ t.neighbourhood(q).bits()))
     });
     let h: HashSet<Voxel> = cells.iter().copied().collect();
     g.bench_function("baseline_hashset_lookup_random_1M", |b| {

@@ -14,6 +14,7 @@ pub mod code;
 pub mod csg;
 pub mod dynamic;
 pub mod io;
+pub mod lattice;
 pub mod linear;
 pub mod mesh;
 pub mod model;

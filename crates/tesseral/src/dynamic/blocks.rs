@@ -219,16 +219,6 @@ pub(super) fn rows27(
     r
 }
 
-/// The six face-neighbour bits (bit `dir`) of a 27-bit neighbourhood.
-#[inline]
-pub(super) fn six(n: u32) -> u8 {
-    let mut m = 0u8;
-    for (dir, &bit) in NEIGHBOUR_BIT.iter().enumerate() {
-        m |= ((n >> bit & 1) as u8) << dir;
-    }
-    m
-}
-
 impl DynamicOctree {
     /// Turns the small block in `slot` (child `ci` of `parent`, containing offsets
     /// `u`) into a bitmap block; returns the new block.

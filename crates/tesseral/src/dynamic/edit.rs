@@ -43,13 +43,13 @@ impl DynamicOctree {
     /// assert!(t.insert_with_neighbourhood([1, 0, 0], nb));
     /// assert_eq!(t.face_count(), 10);
     /// ```
-    pub fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    pub fn insert_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         debug_assert_eq!(nb, self.neighbourhood(v), "stale neighbourhood");
         if !self.insert_bit(v) {
             return false;
         }
         if self.faces.is_some() {
-            self.faces_after_insert(v, six(nb));
+            self.faces_after_insert(v, nb.faces());
         }
         true
     }
@@ -284,13 +284,13 @@ impl DynamicOctree {
     /// assert!(t.remove_with_neighbourhood([1, 0, 0], nb));
     /// assert_eq!(t.face_count(), 6);
     /// ```
-    pub fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    pub fn remove_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         debug_assert_eq!(nb, self.neighbourhood(v), "stale neighbourhood");
         if !self.remove_bit(v) {
             return false;
         }
         if self.faces.is_some() {
-            self.faces_after_remove(v, six(nb));
+            self.faces_after_remove(v, nb.faces());
         }
         true
     }

@@ -3,55 +3,8 @@
 //! uniformly random face is drawn in O(1) (Libes §5: "we stored face information in a
 //! separate array (which we could randomly choose from)").
 
+use crate::lattice::{Direction, Face};
 use crate::Voxel;
-
-/// One exposed face (plaquette) of the surface: the face of the black voxel `voxel`
-/// that points in direction `dir` towards a white voxel.
-///
-/// `dir`: 0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Face {
-    /// The black voxel that owns the face.
-    pub voxel: Voxel,
-    /// The direction the face points in: 0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z.
-    pub dir: u8,
-}
-
-impl Face {
-    /// The white voxel on the other side of the face.
-    ///
-    /// ```
-    /// use tesseral::dynamic::Face;
-    /// let f = Face { voxel: [1, 2, 3], dir: 5 };
-    /// assert_eq!(f.outside(), [1, 2, 4]);
-    /// ```
-    #[must_use]
-    pub fn outside(&self) -> Voxel {
-        step(self.voxel, self.dir)
-    }
-}
-
-/// The unit step of direction `dir` (0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z).
-/// Coordinates wrap at ±2^63.
-#[inline]
-#[must_use]
-pub fn step(v: Voxel, dir: u8) -> Voxel {
-    let mut n = v;
-    let a = usize::from(dir >> 1);
-    n[a] = if dir & 1 == 0 {
-        n[a].wrapping_sub(1)
-    } else {
-        n[a].wrapping_add(1)
-    };
-    n
-}
-
-/// The opposite direction: −x ↔ +x and so on.
-#[inline]
-#[must_use]
-pub fn opposite(dir: u8) -> u8 {
-    dir ^ 1
-}
 
 /// Mixes a voxel into 32 well-spread bits (a multiply-xor fold, then murmur3's
 /// fmix64).
@@ -208,10 +161,10 @@ pub(crate) fn entry_owner(e: Entry) -> u32 {
     e >> 3
 }
 
-/// The direction of a packed entry.
+/// The direction of a packed entry (entries are made only from directions).
 #[inline]
-pub(crate) fn entry_dir(e: Entry) -> u8 {
-    (e & 7) as u8
+pub(crate) fn entry_dir(e: Entry) -> Direction {
+    Direction::ALL[(e & 7) as usize]
 }
 
 /// The most records a face list can hold (the owner takes 29 bits of an entry).
@@ -283,12 +236,12 @@ impl FaceList {
 
     /// Appends face (`v`, `dir`) owned by record `rec`. O(1) amortised.
     #[inline]
-    pub(crate) fn push(&mut self, rec: u32, dir: u8) {
+    pub(crate) fn push(&mut self, rec: u32, dir: Direction) {
         let i = u32::try_from(self.list.len()).expect("more than 2^32 faces");
         let r = &mut self.records[rec as usize];
-        debug_assert_eq!(r.at[usize::from(dir)], NO_FACE, "face pushed twice");
-        r.at[usize::from(dir)] = i;
-        self.list.push(rec << 3 | u32::from(dir));
+        debug_assert_eq!(r.at[dir.index()], NO_FACE, "face pushed twice");
+        r.at[dir.index()] = i;
+        self.list.push(rec << 3 | dir as u32);
     }
 
     /// The face at list position `i`. O(1).
@@ -304,16 +257,19 @@ impl FaceList {
     /// Removes face (`v`, `dir`) owned by record `rec` by `swap_remove`: the last face
     /// takes its place. When `v` has no face left its record goes (one hash removal).
     #[inline]
-    pub(crate) fn remove(&mut self, rec: u32, v: Voxel, dir: u8) {
+    pub(crate) fn remove(&mut self, rec: u32, v: Voxel, dir: Direction) {
         let r = &mut self.records[rec as usize];
-        let i = r.at[usize::from(dir)];
-        assert!(i != NO_FACE, "face {v:?} {dir} missing from the face list");
-        r.at[usize::from(dir)] = NO_FACE;
+        let i = r.at[dir.index()];
+        assert!(
+            i != NO_FACE,
+            "face {v:?} {dir:?} missing from the face list"
+        );
+        r.at[dir.index()] = NO_FACE;
         let gone = r.at == [NO_FACE; 6];
         let last = self.list.pop().expect("face list is empty");
         if (i as usize) < self.list.len() {
             self.list[i as usize] = last;
-            self.records[entry_owner(last) as usize].at[usize::from(entry_dir(last))] = i;
+            self.records[entry_owner(last) as usize].at[entry_dir(last).index()] = i;
         }
         if gone {
             let records = &self.records;
@@ -328,7 +284,7 @@ impl FaceList {
         let key_of = |r: u32| records[r as usize].voxel;
         let free: std::collections::HashSet<u32> = self.free.iter().copied().collect();
         for (i, &e) in self.list.iter().enumerate() {
-            let (owner, dir) = (entry_owner(e), entry_dir(e));
+            let (owner, dir) = (entry_owner(e), e & 7);
             assert!(dir < 6, "face {i} has direction {dir}");
             assert!(
                 (owner as usize) < records.len(),
@@ -338,8 +294,7 @@ impl FaceList {
             let v = records[owner as usize].voxel;
             assert_eq!(self.owners.get(v, key_of), Some(owner), "owner of face {i}");
             assert_eq!(
-                records[owner as usize].at[usize::from(dir)],
-                i as u32,
+                records[owner as usize].at[dir as usize], i as u32,
                 "back-pointer of face {i}"
             );
         }

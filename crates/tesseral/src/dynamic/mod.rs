@@ -64,9 +64,9 @@ mod validate;
 
 use std::fmt;
 
+pub use crate::lattice::{Direction, Directions, Face, Neighbourhood};
 use blocks::*;
 use faces::FaceList;
-pub use faces::{opposite, step, Face};
 use pool::*;
 
 use crate::linear::{CellClass, Classifier, LinearOctree, OctreeError};
@@ -109,12 +109,6 @@ static SPREAD: [u32; 256] = {
 };
 pub(super) const ZERO_BLOCK: [u64; 8] = [0; 8];
 pub(super) const FULL_BLOCK: [u64; 8] = [!0; 8];
-/// All 27 bits of a 3×3×3 neighbourhood.
-pub const NEIGHBOURHOOD_ALL: u32 = (1 << 27) - 1;
-/// Bit of the 27-bit neighbourhood for each face direction 0..6 (−x, +x, −y, +y, −z, +z).
-pub const NEIGHBOUR_BIT: [u32; 6] = [12, 14, 10, 16, 4, 22];
-/// Bit of the 27-bit neighbourhood for the centre voxel.
-pub const CENTRE_BIT: u32 = 13;
 
 /// Eight child slots, 32 bytes aligned to 32, so a node never straddles two cache
 /// lines; its parent link lives in a separate array (`Pool::parent`), which searches

@@ -164,8 +164,8 @@ impl DynamicOctree {
         Some(self.octant_of(t, slot, level, parent))
     }
 
-    /// The 3×3×3 occupancy around `v` as 27 bits: bit `(dx+1) + 3(dy+1) + 9(dz+1)`
-    /// for `dx, dy, dz` in −1..=1 (bit 13 is `v` itself).
+    /// The 3×3×3 occupancy around `v`: the cell at offset `(dx, dy, dz)` is bit
+    /// `(dx+1) + 3(dy+1) + 9(dz+1)` of the [`Neighbourhood`] (bit 13 is `v` itself).
     ///
     /// Finds `v`'s block once; when the 3×3×3 block lies inside it (or inside an
     /// implicit empty or full octant), all 27 bits come from there. Otherwise the
@@ -174,15 +174,21 @@ impl DynamicOctree {
     /// O(depth) worst case, O(1) after the descent in the common case.
     ///
     /// ```
-    /// use tesseral::dynamic::{DynamicOctree, CENTRE_BIT, NEIGHBOUR_BIT};
+    /// use tesseral::dynamic::{DynamicOctree, Neighbourhood};
     /// let mut t = DynamicOctree::new();
     /// t.insert([0, 0, 0]);
     /// t.insert([1, 0, 0]);
     /// let n = t.neighbourhood([0, 0, 0]);
-    /// assert_eq!(n, 1 << CENTRE_BIT | 1 << NEIGHBOUR_BIT[1]);
+    /// assert_eq!(n, Neighbourhood::EMPTY.with([0, 0, 0]).with([1, 0, 0]));
     /// ```
     #[must_use]
-    pub fn neighbourhood(&self, v: Voxel) -> u32 {
+    #[inline]
+    pub fn neighbourhood(&self, v: Voxel) -> Neighbourhood {
+        Neighbourhood::from_bits(self.neighbourhood_bits(v))
+    }
+
+    /// [`neighbourhood`](Self::neighbourhood) as bare bits.
+    fn neighbourhood_bits(&self, v: Voxel) -> u32 {
         if self.root == EMPTY {
             return 0;
         }
@@ -224,7 +230,7 @@ impl DynamicOctree {
         if inner(0) && inner(1) && inner(2) {
             return match cur {
                 EMPTY => 0,
-                FULL => NEIGHBOURHOOD_ALL,
+                FULL => Neighbourhood::FULL.bits(),
                 _ => extract27(&self.block_words(cur), u),
             };
         }
@@ -310,17 +316,17 @@ impl DynamicOctree {
         }
     }
 
-    /// The six face-neighbours of `v` as a mask: bit `dir` is set when the neighbour
-    /// in direction `dir` (0 = −x, 1 = +x, 2 = −y, 3 = +y, 4 = −z, 5 = +z) is black.
-    /// O(depth), from `v`'s own node.
+    /// The directions in which `v`'s face neighbour is black. O(depth), from `v`'s
+    /// own node.
     ///
     /// ```
-    /// let mut t = tesseral::dynamic::DynamicOctree::new();
+    /// use tesseral::dynamic::{Direction, Directions, DynamicOctree};
+    /// let mut t = DynamicOctree::new();
     /// t.insert([0, 0, 0]);
-    /// assert_eq!(t.face_neighbours([0, 0, 1]), 1 << 4);
+    /// assert_eq!(t.face_neighbours([0, 0, 1]), Directions::EMPTY.with(Direction::NegZ));
     /// ```
     #[must_use]
-    pub fn face_neighbours(&self, v: Voxel) -> u8 {
-        six(self.neighbourhood(v))
+    pub fn face_neighbours(&self, v: Voxel) -> Directions {
+        self.neighbourhood(v).faces()
     }
 }

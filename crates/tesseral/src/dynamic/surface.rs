@@ -7,14 +7,14 @@ impl DynamicOctree {
     // ----- faces (Libes §4, §5) -------------------------------------------------------
 
     /// Face passing after `v` was created; `nb` is its face-neighbour mask.
-    pub(super) fn faces_after_insert(&mut self, v: Voxel, nb: u8) {
+    pub(super) fn faces_after_insert(&mut self, v: Voxel, nb: Directions) {
         let f = self.faces.as_mut().expect("face bookkeeping");
         let mut own = None;
-        for dir in 0..6u8 {
-            if nb >> dir & 1 == 1 {
-                let n = step(v, dir);
+        for dir in Direction::ALL {
+            if nb.contains(dir) {
+                let n = dir.step(v);
                 let r = f.existing_record(n);
-                f.remove(r, n, opposite(dir));
+                f.remove(r, n, dir.opposite());
             } else {
                 let r = *own.get_or_insert_with(|| f.record_of(v));
                 f.push(r, dir);
@@ -23,20 +23,20 @@ impl DynamicOctree {
     }
 
     /// Face passing after `v` was deleted; `nb` is its face-neighbour mask.
-    pub(super) fn faces_after_remove(&mut self, v: Voxel, nb: u8) {
+    pub(super) fn faces_after_remove(&mut self, v: Voxel, nb: Directions) {
         let f = self.faces.as_mut().expect("face bookkeeping");
         // A black voxel with a white neighbour has a record; one with six black
         // neighbours has no face to remove.
-        let own = if nb & 0b11_1111 != 0b11_1111 {
+        let own = if nb != Directions::ALL {
             f.existing_record(v)
         } else {
             0
         };
-        for dir in 0..6u8 {
-            if nb >> dir & 1 == 1 {
-                let n = step(v, dir);
+        for dir in Direction::ALL {
+            if nb.contains(dir) {
+                let n = dir.step(v);
                 let r = f.record_of(n);
-                f.push(r, opposite(dir));
+                f.push(r, dir.opposite());
             } else {
                 f.remove(own, v, dir);
             }
@@ -65,7 +65,7 @@ impl DynamicOctree {
         }
         let mut pairs = 0u64;
         for v in self.voxels() {
-            pairs += u64::from((self.face_neighbours(v) & 0b10_1010).count_ones());
+            pairs += u64::from(self.face_neighbours(v).positive().len());
         }
         6 * self.voxels - 2 * pairs
     }

@@ -164,8 +164,9 @@ impl DynamicOctree {
             let pairs: u64 = all
                 .iter()
                 .map(|&v| {
-                    (0..3u8)
-                        .filter(|&a| self.contains(step(v, 2 * a + 1)))
+                    [Direction::PosX, Direction::PosY, Direction::PosZ]
+                        .into_iter()
+                        .filter(|&d| self.contains(d.step(v)))
                         .count() as u64
                 })
                 .sum();

@@ -21,13 +21,14 @@ mod resample;
 mod sort;
 mod transform;
 
+pub use crate::code::Axis;
 pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space};
 pub use box_state::BoxState;
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};
 pub use ops::SetOp;
-pub use transform::{rotation_labels, Axis};
+pub use transform::rotation_labels;
 
 use crate::code;
 use crate::Voxel;

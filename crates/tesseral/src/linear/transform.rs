@@ -11,34 +11,11 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::{push_merging, sort, Leaf, LinearOctree, OctreeError, MAX_DEPTH};
-use crate::code::CodeWord;
+use crate::code::{Axis, CodeWord};
 use crate::Voxel;
 
 /// The x bits of a code: bit `3i` for every digit `i`.
 const MASK_X: u64 = <u64 as CodeWord>::X_MASK;
-
-/// A coordinate axis.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum Axis {
-    /// x, east.
-    X,
-    /// y, north.
-    Y,
-    /// z, up.
-    Z,
-}
-
-impl Axis {
-    /// 0, 1 or 2.
-    #[must_use]
-    pub fn index(self) -> usize {
-        match self {
-            Axis::X => 0,
-            Axis::Y => 1,
-            Axis::Z => 2,
-        }
-    }
-}
 
 /// The two axes a positive quarter turn about `axis` maps into each other:
 /// `(from, to)` with `from` going to `to` (about z: +x goes to +y).

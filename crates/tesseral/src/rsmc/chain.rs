@@ -4,8 +4,8 @@ use rand::{RngCore, SeedableRng};
 use rand_pcg::Pcg64Mcg;
 use serde::{Deserialize, Serialize};
 
-use super::legality::{face_set, legal_join, ALL27};
-use super::{step, topology, Lattice, RsmcError};
+use super::legality::legal_join;
+use super::{topology, Direction, Lattice, RsmcError};
 use crate::Voxel;
 
 /// Version of the [`Checkpoint`] layout.
@@ -240,18 +240,14 @@ impl<L: Lattice> Chain<L> {
         let r = self.below(2 * area as u64);
         let face = self.lattice.face((r >> 1) as usize);
         let shrink = r & 1 == 1;
-        let p = if shrink {
-            face.voxel
-        } else {
-            step(face.voxel, face.dir)
-        };
+        let p = if shrink { face.voxel } else { face.outside() };
         let nb = self.lattice.neighbourhood(p);
-        let joins = if shrink { !nb & ALL27 } else { nb };
+        let joins = if shrink { nb.complement() } else { nb };
         if !legal_join(joins) {
             self.counters.illegal += 1;
             return false;
         }
-        let k = face_set(joins).count_ones() as usize;
+        let k = joins.faces().len() as usize;
         let new_area = area + 6 - 2 * k;
         if new_area > self.max_area {
             self.counters.capped += 1;
@@ -354,8 +350,8 @@ impl<L: Lattice> Chain<L> {
             }
         }
         while let Some(v) = stack.pop() {
-            for d in 0..6 {
-                let n = step(v, d);
+            for d in Direction::ALL {
+                let n = d.step(v);
                 if self.lattice.contains(n) && seen.insert(n) {
                     stack.push(n);
                 }

@@ -1,6 +1,6 @@
 //! The dense-array lattice: the baseline and test oracle for RS/MC.
 
-use super::{step, Face, Lattice};
+use super::{Direction, Face, Lattice, Neighbourhood};
 use crate::Voxel;
 
 /// Cells of margin kept white around every black voxel, so that the 3×3×3 block of
@@ -181,21 +181,21 @@ impl DenseLattice {
     }
 
     #[inline]
-    fn push_face(&mut self, slot: usize, v: Voxel, dir: u8) {
-        self.slots[slot][dir as usize] = self.faces.len() as u32;
+    fn push_face(&mut self, slot: usize, v: Voxel, dir: Direction) {
+        self.slots[slot][dir.index()] = self.faces.len() as u32;
         self.faces.push(Face { voxel: v, dir });
     }
 
     #[inline]
-    fn remove_face(&mut self, slot: usize, dir: u8) {
-        let i = self.slots[slot][dir as usize] as usize;
+    fn remove_face(&mut self, slot: usize, dir: Direction) {
+        let i = self.slots[slot][dir.index()] as usize;
         debug_assert!(i != NONE as usize);
-        self.slots[slot][dir as usize] = NONE;
+        self.slots[slot][dir.index()] = NONE;
         self.faces.swap_remove(i);
         if i < self.faces.len() {
             let moved = self.faces[i];
             let s = self.slot(moved.voxel).expect("face of a black voxel");
-            self.slots[s][moved.dir as usize] = i as u32;
+            self.slots[s][moved.dir.index()] = i as u32;
         }
     }
 
@@ -220,14 +220,14 @@ impl DenseLattice {
             let s = (self.cells[i] - 1) as usize;
             assert!(!used[s], "slot {s} used twice");
             used[s] = true;
-            for d in 0..6u8 {
-                let n = step(v, d);
-                let fi = self.slots[s][d as usize];
+            for d in Direction::ALL {
+                let n = d.step(v);
+                let fi = self.slots[s][d.index()];
                 if self.contains(n) {
-                    assert_eq!(fi, NONE, "hidden face {v:?} dir {d} is listed");
+                    assert_eq!(fi, NONE, "hidden face {v:?} dir {d:?} is listed");
                 } else {
                     exposed += 1;
-                    assert!((fi as usize) < self.faces.len(), "face {v:?} {d} missing");
+                    assert!((fi as usize) < self.faces.len(), "face {v:?} {d:?} missing");
                     assert_eq!(self.faces[fi as usize], Face { voxel: v, dir: d });
                 }
             }
@@ -269,10 +269,10 @@ impl Lattice for DenseLattice {
         self.cells[i] = slot as u32 + 1;
         self.occ[i] = 1;
         self.count += 1;
-        for d in 0..6u8 {
-            let n = step(v, d);
+        for d in Direction::ALL {
+            let n = d.step(v);
             match self.slot(n) {
-                Some(ns) => self.remove_face(ns, d ^ 1),
+                Some(ns) => self.remove_face(ns, d.opposite()),
                 None => self.push_face(slot, v, d),
             }
         }
@@ -285,10 +285,10 @@ impl Lattice for DenseLattice {
             return false;
         }
         let slot = (self.cells[i] - 1) as usize;
-        for d in 0..6u8 {
-            let n = step(v, d);
+        for d in Direction::ALL {
+            let n = d.step(v);
             match self.slot(n) {
-                Some(ns) => self.push_face(ns, n, d ^ 1),
+                Some(ns) => self.push_face(ns, n, d.opposite()),
                 None => self.remove_face(slot, d),
             }
         }
@@ -319,7 +319,7 @@ impl Lattice for DenseLattice {
     }
 
     #[inline]
-    fn neighbourhood(&self, v: Voxel) -> u32 {
+    fn neighbourhood(&self, v: Voxel) -> Neighbourhood {
         let lo = [v[0] - 1, v[1] - 1, v[2] - 1];
         let hi = [v[0] + 1, v[1] + 1, v[2] + 1];
         match (self.index(lo), self.index(hi)) {
@@ -340,7 +340,7 @@ impl Lattice for DenseLattice {
                         b += 3;
                     }
                 }
-                bits
+                Neighbourhood::from_bits(bits)
             }
             _ => {
                 let mut bits = 0u32;
@@ -348,7 +348,7 @@ impl Lattice for DenseLattice {
                     let w = [v[0] + b % 3 - 1, v[1] + (b / 3) % 3 - 1, v[2] + b / 9 - 1];
                     bits |= u32::from(self.contains(w)) << b;
                 }
-                bits
+                Neighbourhood::from_bits(bits)
             }
         }
     }
@@ -392,7 +392,11 @@ mod tests {
                 let w = [q[0] + b % 3 - 1, q[1] + (b / 3) % 3 - 1, q[2] + b / 9 - 1];
                 expect |= u32::from(model.contains(&w)) << b;
             }
-            assert_eq!(l.neighbourhood(q), expect, "neighbourhood {q:?} op {i}");
+            assert_eq!(
+                l.neighbourhood(q).bits(),
+                expect,
+                "neighbourhood {q:?} op {i}"
+            );
         }
         l.assert_valid();
         assert_eq!(l.voxel_count(), model.len() as u64);
@@ -402,13 +406,13 @@ mod tests {
     fn face_order_rule_by_hand() {
         let mut l = DenseLattice::new();
         l.insert([0, 0, 0]);
-        let dirs: Vec<u8> = (0..6).map(|i| l.face(i).dir).collect();
+        let dirs: Vec<u8> = (0..6).map(|i| l.face(i).dir as u8).collect();
         assert_eq!(dirs, vec![0, 1, 2, 3, 4, 5]);
         // Insert +x: dir 0 of the new voxel hits (0,0,0): remove its face 1 (index 1,
         // the last face (0,0,0,5) moves there), then push dirs 1..6.
         l.insert([1, 0, 0]);
         let got: Vec<(i64, u8)> = (0..l.face_count())
-            .map(|i| (l.face(i).voxel[0], l.face(i).dir))
+            .map(|i| (l.face(i).voxel[0], l.face(i).dir as u8))
             .collect();
         assert_eq!(
             got,

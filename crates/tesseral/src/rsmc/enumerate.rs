@@ -20,7 +20,7 @@
 
 use std::collections::HashSet;
 
-use super::{topology, RsmcError, DIRS};
+use super::{topology, Direction, RsmcError};
 use crate::Voxel;
 
 /// The largest `A_max` accepted by [`sphere_counts`] (polycubes of up to 9 voxels,
@@ -51,7 +51,7 @@ fn grow_level(level: &[Cells]) -> Vec<Cells> {
     for cells in level {
         let set: HashSet<[i8; 3]> = cells.iter().copied().collect();
         for c in cells {
-            for d in DIRS {
+            for d in Direction::ALL.map(Direction::unit) {
                 let q = [c[0] + d[0] as i8, c[1] + d[1] as i8, c[2] + d[2] as i8];
                 if !set.contains(&q) {
                     let mut grown = cells.clone();
@@ -95,7 +95,7 @@ pub fn sphere_surfaces(max_area: u64) -> Result<Vec<Vec<Voxel>>, RsmcError> {
             let set: HashSet<[i8; 3]> = cells.iter().copied().collect();
             let mut adj = 0u64;
             for c in cells {
-                for d in DIRS {
+                for d in Direction::ALL.map(Direction::unit) {
                     if set.contains(&[c[0] + d[0] as i8, c[1] + d[1] as i8, c[2] + d[2] as i8]) {
                         adj += 1;
                     }
@@ -131,8 +131,8 @@ pub fn sphere_counts(max_area: u64) -> Result<Vec<u64>, RsmcError> {
         let set: HashSet<Voxel> = s.iter().copied().collect();
         let mut area = 0;
         for v in &s {
-            for d in 0..6 {
-                if !set.contains(&super::step(*v, d)) {
+            for d in Direction::ALL {
+                if !set.contains(&d.step(*v)) {
                     area += 1;
                 }
             }

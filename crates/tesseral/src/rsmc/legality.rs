@@ -33,50 +33,25 @@
 //! look-ups and a mask, O(1).
 //!
 //! ```
-//! use tesseral::rsmc::legality::{legal_grow, CENTRE};
+//! use tesseral::lattice::Neighbourhood;
+//! use tesseral::rsmc::legality::legal_grow;
 //! // Growing next to a lone voxel at -x: legal.
-//! let lone = (1u32 << CENTRE) >> 1;
+//! let lone = Neighbourhood::EMPTY.with([-1, 0, 0]);
 //! assert!(legal_grow(lone));
 //! // Only the top and bottom neighbours: would close a tunnel (Libes Fig. 4).
-//! let top_bottom = (1u32 << 4) | (1 << 22);
+//! let top_bottom = Neighbourhood::EMPTY.with([0, 0, -1]).with([0, 0, 1]);
 //! assert!(!legal_grow(top_bottom));
 //! ```
 
-/// Bit of the centre cell in a 27-bit neighbourhood.
-pub const CENTRE: u32 = 13;
+use crate::lattice::{Directions, Neighbourhood};
 
-/// All 27 bits of a neighbourhood.
-pub const ALL27: u32 = (1 << 27) - 1;
+/// The 20 edge and corner neighbours (two or three non-zero offsets), as bits.
+const NON_FACE: u32 = Neighbourhood::EDGES_AND_CORNERS.bits();
 
-/// Neighbourhood bit of the face neighbour in each direction (0 = −x … 5 = +z).
-pub const FACE_BITS: [u32; 6] = [12, 14, 10, 16, 4, 22];
-
-/// Neighbourhood bit of the offset `d` (each component in −1..=1).
-#[inline]
+/// Whether the face set `f` is a disc on the cube.
 #[must_use]
-pub const fn bit_of(d: [i64; 3]) -> u32 {
-    ((d[0] + 1) + 3 * (d[1] + 1) + 9 * (d[2] + 1)) as u32
-}
-
-/// Mask of the 20 edge and corner neighbours (two or three non-zero offsets).
-pub const NON_FACE: u32 = {
-    let mut m = 0u32;
-    let mut b = 0;
-    while b < 27 {
-        let d = [b % 3, (b / 3) % 3, b / 9];
-        let nz = (d[0] != 1) as u32 + (d[1] != 1) as u32 + (d[2] != 1) as u32;
-        if nz >= 2 {
-            m |= 1 << b;
-        }
-        b += 1;
-    }
-    m
-};
-
-/// Whether the face set `f` (bit `d` = face in direction `d`) is a disc on the cube.
-#[must_use]
-pub const fn face_set_is_disc(f: u8) -> bool {
-    let f = f & 0x3f;
+pub const fn face_set_is_disc(f: Directions) -> bool {
+    let f = f.bits();
     let n = f.count_ones();
     if n == 0 || n == 6 {
         return false;
@@ -100,7 +75,7 @@ pub const DISC: [bool; 64] = {
     let mut t = [false; 64];
     let mut f = 0;
     while f < 64 {
-        t[f] = face_set_is_disc(f as u8);
+        t[f] = face_set_is_disc(Directions::from_bits(f as u8));
         f += 1;
     }
     t
@@ -143,33 +118,21 @@ pub const COVERED: [u32; 64] = {
     t
 };
 
-/// The six face-neighbour bits of a neighbourhood, packed as bit `dir`.
-#[inline]
-#[must_use]
-pub const fn face_set(x: u32) -> u8 {
-    (((x >> 12) & 1)
-        | (((x >> 14) & 1) << 1)
-        | (((x >> 10) & 1) << 2)
-        | (((x >> 16) & 1) << 3)
-        | (((x >> 4) & 1) << 4)
-        | (((x >> 22) & 1) << 5)) as u8
-}
-
 /// Whether toggling the centre cell into colour `X` keeps the black set a ball,
 /// where `x` holds the cells of colour `X` in the 26-neighbourhood (the centre bit
 /// is ignored). O(1).
 #[inline]
 #[must_use]
-pub const fn legal_join(x: u32) -> bool {
-    let f = face_set(x);
-    DISC[f as usize] && (x & NON_FACE & !COVERED[f as usize]) == 0
+pub const fn legal_join(x: Neighbourhood) -> bool {
+    let f = x.faces().bits() as usize;
+    DISC[f] && (x.bits() & NON_FACE & !COVERED[f]) == 0
 }
 
 /// Whether creating the (white) centre voxel is legal, given the black occupancy
 /// `n` of its neighbourhood. O(1).
 #[inline]
 #[must_use]
-pub const fn legal_grow(n: u32) -> bool {
+pub const fn legal_grow(n: Neighbourhood) -> bool {
     legal_join(n)
 }
 
@@ -177,8 +140,8 @@ pub const fn legal_grow(n: u32) -> bool {
 /// `n` of its neighbourhood. O(1).
 #[inline]
 #[must_use]
-pub const fn legal_shrink(n: u32) -> bool {
-    legal_join(!n & ALL27)
+pub const fn legal_shrink(n: Neighbourhood) -> bool {
+    legal_join(n.complement())
 }
 
 #[cfg(test)]
@@ -187,10 +150,15 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use std::collections::{BTreeSet, HashMap};
 
+    fn nb(bits: u32) -> Neighbourhood {
+        Neighbourhood::from_bits(bits)
+    }
+
     /// Brute force, from the definition: build the sub-complex K of the cube surface
     /// ∂p touched by closed cubes of colour X, and decide whether K is a closed disc
     /// (connected pure 2-complex, a 2-manifold with boundary, Euler characteristic 1).
-    fn brute_is_disc(x: u32) -> bool {
+    fn brute_is_disc(x: Neighbourhood) -> bool {
+        let x = x.bits();
         // Cube p = [0,1]^3 with lattice points in {0,1}^3. A neighbour cell with
         // offset d occupies [d, d+1]; it touches the point q of p iff q_i ∈ {d_i, d_i+1}.
         let cells: Vec<[i64; 3]> = (0..27)
@@ -286,16 +254,18 @@ mod tests {
         // corner neighbours: 128 cases, exhaustive.
         for f in 0..64u32 {
             let mut x = 0;
-            for (d, bit) in FACE_BITS.iter().enumerate() {
-                if f & (1 << d) != 0 {
-                    x |= 1 << bit;
-                }
+            for d in Directions::from_bits(f as u8).iter() {
+                x |= 1 << Neighbourhood::face_bit(d);
             }
-            assert_eq!(legal_join(x), brute_is_disc(x), "faces only {f:06b}");
+            assert_eq!(
+                legal_join(nb(x)),
+                brute_is_disc(nb(x)),
+                "faces only {f:06b}"
+            );
             let y = x | NON_FACE;
             assert_eq!(
-                legal_join(y),
-                brute_is_disc(y),
+                legal_join(nb(y)),
+                brute_is_disc(nb(y)),
                 "faces {f:06b} + all others"
             );
         }
@@ -309,10 +279,8 @@ mod tests {
         assert_eq!(others.len(), 20);
         for f in 0..64u32 {
             let mut x = 0;
-            for (d, bit) in FACE_BITS.iter().enumerate() {
-                if f & (1 << d) != 0 {
-                    x |= 1 << bit;
-                }
+            for d in Directions::from_bits(f as u8).iter() {
+                x |= 1 << Neighbourhood::face_bit(d);
             }
             for i in 0..=others.len() {
                 for j in i..=others.len() {
@@ -323,7 +291,7 @@ mod tests {
                     if j < others.len() {
                         y |= 1 << others[j];
                     }
-                    assert_eq!(legal_join(y), brute_is_disc(y), "x = {y:#029b}");
+                    assert_eq!(legal_join(nb(y)), brute_is_disc(nb(y)), "x = {y:#029b}");
                 }
             }
         }
@@ -344,10 +312,10 @@ mod tests {
                     x |= 1 << b;
                 }
             }
-            let fast = legal_join(x);
+            let fast = legal_join(nb(x));
             assert_eq!(
                 fast,
-                brute_is_disc(x),
+                brute_is_disc(nb(x)),
                 "x = {x:#029b} (seed {seed:#x}, case {i})"
             );
             *agree.entry(fast).or_default() += 1;
@@ -362,14 +330,14 @@ mod tests {
         // Black: centre, +x, +y, and the diagonal (+x,+y)... deleting the centre leaves
         // +x, +y, diag: still connected through the diagonal, legal. Instead take black
         // centre, +x and +y only: deleting the centre leaves +x and +y sharing an edge.
-        let n = (1 << CENTRE) | (1 << 14) | (1 << 16);
+        let e = Neighbourhood::EMPTY;
+        let n = e.with([0, 0, 0]).with([1, 0, 0]).with([0, 1, 0]);
         assert!(!legal_shrink(n));
         // Growing next to a lone edge-diagonal voxel only: rule (i).
-        let diag = 1 << bit_of([1, 1, 0]);
-        assert!(!legal_grow(diag | (1 << 12)));
+        assert!(!legal_grow(e.with([1, 1, 0]).with([-1, 0, 0])));
         // Rule (ii), Fig. 4: top and bottom only.
-        assert!(!legal_grow((1 << 4) | (1 << 22)));
+        assert!(!legal_grow(e.with([0, 0, -1]).with([0, 0, 1])));
         // The last voxel can never be deleted.
-        assert!(!legal_shrink(1 << CENTRE));
+        assert!(!legal_shrink(e.with([0, 0, 0])));
     }
 }

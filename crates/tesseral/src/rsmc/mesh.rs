@@ -2,8 +2,8 @@
 //! lattice points shared, faces wound counter-clockwise seen from outside.
 //!
 //! ```
-//! use tesseral::rsmc::{mesh, Face};
-//! let faces: Vec<Face> = (0..6).map(|dir| Face { voxel: [0, 0, 0], dir }).collect();
+//! use tesseral::rsmc::{mesh, Direction, Face};
+//! let faces = Direction::ALL.map(|dir| Face { voxel: [0, 0, 0], dir });
 //! let mut obj = Vec::new();
 //! mesh::write_obj(&faces, &mut obj).unwrap();
 //! let text = String::from_utf8(obj).unwrap();
@@ -20,8 +20,8 @@ use crate::Voxel;
 /// The four corners of a plaquette, counter-clockwise seen from outside.
 #[must_use]
 pub fn corners(f: Face) -> [Voxel; 4] {
-    let axis = (f.dir / 2) as usize;
-    let positive = f.dir & 1 == 1;
+    let axis = f.dir.axis() as usize;
+    let positive = f.dir.is_positive();
     let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
     let mut base = f.voxel;
     if positive {
@@ -103,15 +103,16 @@ pub fn write_ply<W: Write>(faces: &[Face], mut w: W) -> io::Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::lattice::Direction;
 
     #[test]
     fn cube_is_closed_and_outward() {
-        let faces: Vec<Face> = (0..6)
+        let faces: Vec<Face> = Direction::ALL
             .map(|dir| Face {
                 voxel: [2, 3, 4],
                 dir,
             })
-            .collect();
+            .to_vec();
         let (v, q) = indexed(&faces);
         assert_eq!(v.len(), 8);
         // Outward: the signed volume by the divergence theorem is +1.

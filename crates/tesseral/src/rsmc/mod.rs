@@ -43,22 +43,9 @@ pub use dense::{DenseLattice, MAX_CELLS};
 
 use crate::Voxel;
 
-/// One plaquette of the surface is a [`Face`] of the dynamic octree: the lattice has
-/// one vocabulary.
-pub use crate::dynamic::Face;
-
-/// Unit steps of the six face directions, in the order 0 = −x, 1 = +x, 2 = −y,
-/// 3 = +y, 4 = −z, 5 = +z. The opposite of direction `d` is `d ^ 1`.
-pub const DIRS: [[i64; 3]; 6] = [
-    [-1, 0, 0],
-    [1, 0, 0],
-    [0, -1, 0],
-    [0, 1, 0],
-    [0, 0, -1],
-    [0, 0, 1],
-];
-
-pub use crate::dynamic::step;
+/// One plaquette of the surface is a lattice [`Face`], as in the dynamic octree: the
+/// lattice has one vocabulary ([`crate::lattice`]).
+pub use crate::lattice::{Direction, Face, Neighbourhood};
 
 /// The lattice operations the chain needs: a set of black voxels with the list of
 /// exposed faces.
@@ -66,11 +53,11 @@ pub use crate::dynamic::step;
 /// Implementations must keep the faces in one dense list and follow the face-list
 /// order rule of the dynamic octree contract, so that two implementations fed the
 /// same operations hold the same list, index for index:
-/// - `insert(v)` of a new voxel: for `dir` in `0..6`, let `n` be the neighbour in
-///   that direction. If `n` is black, remove `n`'s face pointing at `v`
-///   (`swap_remove`); otherwise push the face `(v, dir)`.
-/// - `remove(v)` of a present voxel: for `dir` in `0..6`, if `n` is black, push
-///   `(n, dir ^ 1)`; otherwise remove the face `(v, dir)` (`swap_remove`).
+/// - `insert(v)` of a new voxel: for `dir` in [`Direction::ALL`] (−x, +x, −y, +y,
+///   −z, +z), let `n` be the neighbour in that direction. If `n` is black, remove
+///   `n`'s face pointing at `v` (`swap_remove`); otherwise push the face `(v, dir)`.
+/// - `remove(v)` of a present voxel: for `dir` in the same order, if `n` is black,
+///   push `(n, dir.opposite())`; otherwise remove the face `(v, dir)` (`swap_remove`).
 pub trait Lattice {
     /// An empty lattice of the same kind (used to rebuild in canonical order).
     #[must_use]
@@ -89,20 +76,19 @@ pub trait Lattice {
     fn face_count(&self) -> usize;
     /// The `i`-th face of the face list; `i < face_count()`.
     fn face(&self, i: usize) -> Face;
-    /// The 27-bit occupancy of the 3×3×3 block around `v`: bit
-    /// `(dx+1) + 3(dy+1) + 9(dz+1)`.
-    fn neighbourhood(&self, v: Voxel) -> u32;
+    /// The occupancy of the 3×3×3 block around `v`.
+    fn neighbourhood(&self, v: Voxel) -> Neighbourhood;
     /// [`insert`](Self::insert) for a caller that holds `nb = neighbourhood(v)`,
     /// taken since the last change; a backend may use it to skip a search. The
     /// default ignores `nb`.
-    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         let _ = nb;
         self.insert(v)
     }
     /// [`remove`](Self::remove) for a caller that holds `nb = neighbourhood(v)`,
     /// taken since the last change; a backend may use it to skip a search. The
     /// default ignores `nb`.
-    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         let _ = nb;
         self.remove(v)
     }

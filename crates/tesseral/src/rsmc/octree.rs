@@ -2,7 +2,7 @@
 //! unbounded growth. Its face list follows the same order rule as
 //! [`DenseLattice`](super::DenseLattice), so the two give identical trajectories.
 
-use super::{Face, Lattice};
+use super::{Face, Lattice, Neighbourhood};
 use crate::dynamic::DynamicOctree;
 use crate::Voxel;
 
@@ -39,15 +39,15 @@ impl Lattice for DynamicOctree {
         }
     }
     #[inline]
-    fn neighbourhood(&self, v: Voxel) -> u32 {
+    fn neighbourhood(&self, v: Voxel) -> Neighbourhood {
         DynamicOctree::neighbourhood(self, v)
     }
     #[inline]
-    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    fn insert_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         DynamicOctree::insert_with_neighbourhood(self, v, nb)
     }
     #[inline]
-    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: u32) -> bool {
+    fn remove_with_neighbourhood(&mut self, v: Voxel, nb: Neighbourhood) -> bool {
         DynamicOctree::remove_with_neighbourhood(self, v, nb)
     }
 }

@@ -38,12 +38,12 @@ impl Lattice for NaiveLattice {
         if !self.set.insert(v) {
             return false;
         }
-        for d in 0..6u8 {
-            let n = step(v, d);
+        for d in Direction::ALL {
+            let n = d.step(v);
             if self.set.contains(&n) {
                 self.take(Face {
                     voxel: n,
-                    dir: d ^ 1,
+                    dir: d.opposite(),
                 });
             } else {
                 self.push(Face { voxel: v, dir: d });
@@ -55,12 +55,12 @@ impl Lattice for NaiveLattice {
         if !self.set.remove(&v) {
             return false;
         }
-        for d in 0..6u8 {
-            let n = step(v, d);
+        for d in Direction::ALL {
+            let n = d.step(v);
             if self.set.contains(&n) {
                 self.push(Face {
                     voxel: n,
-                    dir: d ^ 1,
+                    dir: d.opposite(),
                 });
             } else {
                 self.take(Face { voxel: v, dir: d });
@@ -80,13 +80,13 @@ impl Lattice for NaiveLattice {
     fn face(&self, i: usize) -> Face {
         self.faces[i]
     }
-    fn neighbourhood(&self, v: Voxel) -> u32 {
+    fn neighbourhood(&self, v: Voxel) -> Neighbourhood {
         let mut bits = 0;
         for b in 0..27i64 {
             let w = [v[0] + b % 3 - 1, v[1] + (b / 3) % 3 - 1, v[2] + b / 9 - 1];
             bits |= u32::from(self.set.contains(&w)) << b;
         }
-        bits
+        Neighbourhood::from_bits(bits)
     }
 }
 
@@ -302,7 +302,12 @@ fn detailed_balance_with_volume_weight() {
         let set: HashSet<Voxel> = s.iter().copied().collect();
         let area = s
             .iter()
-            .map(|&v| (0..6).filter(|&d| !set.contains(&step(v, d))).count() as u64)
+            .map(|&v| {
+                Direction::ALL
+                    .iter()
+                    .filter(|d| !set.contains(&d.step(v)))
+                    .count() as u64
+            })
             .sum::<u64>();
         counts[key(area, s.len() as u64)] += 1;
     }

@@ -13,7 +13,7 @@
 
 use std::collections::{HashMap, HashSet};
 
-use super::{step, DIRS};
+use super::Direction;
 use crate::Voxel;
 
 /// The counts of the surface's cell complex.
@@ -76,9 +76,9 @@ pub enum TopologyError {
 pub const MAX_COORD: i64 = 1 << 60;
 
 /// Corner points of the face of voxel `v` in direction `dir`, in cyclic order.
-fn face_corners(v: Voxel, dir: u8) -> [Voxel; 4] {
-    let axis = (dir / 2) as usize;
-    let side = i64::from(dir & 1);
+fn face_corners(v: Voxel, dir: Direction) -> [Voxel; 4] {
+    let axis = dir.axis() as usize;
+    let side = i64::from(dir.is_positive());
     let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
     let mut base = v;
     base[axis] += side;
@@ -112,8 +112,8 @@ pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
     let mut stack = vec![voxels[0]];
     seen.insert(voxels[0]);
     while let Some(v) = stack.pop() {
-        for d in 0..6 {
-            let n = step(v, d);
+        for d in Direction::ALL {
+            let n = d.step(v);
             if set.contains(&n) && seen.insert(n) {
                 stack.push(n);
             }
@@ -146,8 +146,8 @@ pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
         state[idx(lo)] = 2;
         let mut reached = 1u64;
         while let Some(v) = stack.pop() {
-            for d in DIRS {
-                let n = [v[0] + d[0], v[1] + d[1], v[2] + d[2]];
+            for d in Direction::ALL {
+                let n = d.step(v);
                 if (0..3).all(|a| n[a] >= lo[a] && n[a] <= hi[a]) && state[idx(n)] == 0 {
                     state[idx(n)] = 2;
                     reached += 1;
@@ -192,8 +192,8 @@ pub fn check_sphere(voxels: &[Voxel]) -> Result<SurfaceReport, TopologyError> {
     let mut edges: HashMap<(Voxel, u8), u32> = HashMap::new();
     let mut vertex_faces: HashMap<Voxel, Vec<[Voxel; 4]>> = HashMap::new();
     for v in &set {
-        for d in 0..6u8 {
-            if set.contains(&step(*v, d)) {
+        for d in Direction::ALL {
+            if set.contains(&d.step(*v)) {
                 continue;
             }
             faces += 1;

@@ -23,7 +23,8 @@ use super::{CodeError, CodeWord};
 mod coords;
 mod signed;
 
-/// One of the three axes: x east, y north, z up.
+/// One of the three axes: x east, y north, z up. The lattice's one axis type (also
+/// `tesseral::lattice::Axis` and `tesseral::linear::Axis`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub enum Axis {
     /// x, east: bit 0 of each digit.
@@ -55,6 +56,17 @@ impl Axis {
     #[must_use]
     pub const fn unit_digit(self) -> u8 {
         1 << self as u32
+    }
+
+    /// Its index as an array subscript: 0, 1 or 2.
+    ///
+    /// ```
+    /// assert_eq!(tesseral::code::Axis::Z.index(), 2);
+    /// ```
+    #[inline]
+    #[must_use]
+    pub const fn index(self) -> usize {
+        self as usize
     }
 
     /// The axis's lower-case name.
