@@ -11,8 +11,6 @@ use tesseral::Voxel;
 
 use crate::arrays::{rows, to_array};
 
-/// The largest start shape, in voxels (the CLI's cap).
-const MAX_START_VOXELS: u64 = 1_000_000;
 /// The most rows a trajectory may hold, so that `steps / sample_every` is a budget
 /// checked before the run.
 const MAX_ROWS: u64 = 10_000_000;
@@ -34,35 +32,7 @@ fn start_voxels(start: &Bound<'_, PyAny>) -> PyResult<Vec<Voxel>> {
     let s: String = start.extract().map_err(|_| {
         PyValueError::new_err("start: expected \"voxel\", \"box:AxBxC\" or an N×3 int64 array")
     })?;
-    if s == "voxel" {
-        return Ok(vec![[0, 0, 0]]);
-    }
-    let bad = || PyValueError::new_err(format!("start {s:?}: expected \"voxel\" or \"box:AxBxC\""));
-    let dims = s.strip_prefix("box:").ok_or_else(bad)?;
-    let d: Vec<u64> = dims
-        .split('x')
-        .map(|p| p.parse::<u64>().map_err(|_| bad()))
-        .collect::<PyResult<_>>()?;
-    if d.len() != 3 || d.contains(&0) {
-        return Err(bad());
-    }
-    if d.iter()
-        .try_fold(1u64, |a, &k| a.checked_mul(k))
-        .is_none_or(|n| n > MAX_START_VOXELS)
-    {
-        return Err(PyValueError::new_err(format!(
-            "start {s:?}: more than {MAX_START_VOXELS} voxels"
-        )));
-    }
-    let mut v = Vec::new();
-    for z in 0..d[2] as i64 {
-        for y in 0..d[1] as i64 {
-            for x in 0..d[0] as i64 {
-                v.push([x, y, z]);
-            }
-        }
-    }
-    Ok(v)
+    tesseral::rsmc::parse_start(&s).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// Runs the chain for `steps` attempted steps, sampling every `sample_every`.

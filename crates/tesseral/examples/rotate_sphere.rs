@@ -7,41 +7,16 @@
 
 use std::time::Instant;
 
-use tesseral::linear::{rotation_matrix, CellClass, LinearOctree};
+use tesseral::linear::rotation_matrix;
+
+mod common;
+use common::sphere;
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let r: i64 = args.next().map_or(100, |a| a.parse().expect("radius"));
     let degrees: f64 = args.next().map_or(30.0, |a| a.parse().expect("degrees"));
-    // In doubled coordinates the centre of voxel x is 2x + 1: inside when
-    // |2c|^2 <= 4 r^2, exactly as the OpenVDB harness fills its grid.
-    let sphere = move |min: [i64; 3], k: u8| {
-        let s = 1i64 << k;
-        let (mut near, mut far) = (0i64, 0i64);
-        for &m in &min {
-            let (lo, hi) = (2 * m + 1, 2 * (m + s) - 1);
-            let n = if lo > 0 {
-                lo
-            } else if hi < 0 {
-                hi
-            } else {
-                0
-            };
-            let f = lo.abs().max(hi.abs());
-            near += n * n;
-            far += f * f;
-        }
-        if far <= 4 * r * r {
-            CellClass::Inside
-        } else if near > 4 * r * r {
-            CellClass::Outside
-        } else {
-            CellClass::Partial
-        }
-    };
-    let depth = (64 - (2 * r + 2).leading_zeros()) as u8;
-    let half = 1i64 << (depth - 1);
-    let tree = LinearOctree::from_classifier(depth, [-half; 3], &sphere).expect("sphere");
+    let tree = sphere(r);
     let m = rotation_matrix([0.0, 0.0, 1.0], degrees);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)

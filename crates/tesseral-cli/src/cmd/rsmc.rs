@@ -127,10 +127,8 @@ struct Row {
     acceptance: f64,
 }
 
-const MAX_BOX_SIDE: u64 = 1000;
 /// The series is kept in memory (it is rewritten at each checkpoint and plotted).
 const MAX_ROWS: u64 = 10_000_000;
-const MAX_START_VOXELS: u64 = 10_000_000;
 
 /// Validates the fields the CLI adds to the chain's checkpoint, and the chain's own
 /// ([`Checkpoint::validate`]), naming the field at fault.
@@ -168,40 +166,7 @@ fn check_checkpoint(cp: &CliCheckpoint, steps: u64) -> Result<()> {
 }
 
 fn parse_start(s: &str) -> Result<Vec<Voxel>> {
-    if s == "voxel" {
-        return Ok(vec![[0, 0, 0]]);
-    }
-    let Some(dims) = s.strip_prefix("box:") else {
-        bail!("--start {s:?}: expected `voxel` or `box:AxBxC`");
-    };
-    let parts: Vec<&str> = dims.split('x').collect();
-    ensure!(
-        parts.len() == 3,
-        "--start {s:?}: expected three sizes, as in box:3x2x1"
-    );
-    let mut d = [0u64; 3];
-    for (k, p) in parts.iter().enumerate() {
-        d[k] = p
-            .parse()
-            .with_context(|| format!("--start {s:?}: size {p:?} is not a number"))?;
-        ensure!(
-            (1..=MAX_BOX_SIDE).contains(&d[k]),
-            "--start {s:?}: sizes must be 1 to {MAX_BOX_SIDE}"
-        );
-    }
-    ensure!(
-        d[0] * d[1] * d[2] <= MAX_START_VOXELS,
-        "--start {s:?}: more than {MAX_START_VOXELS} voxels"
-    );
-    let mut v = Vec::new();
-    for z in 0..d[2] as i64 {
-        for y in 0..d[1] as i64 {
-            for x in 0..d[0] as i64 {
-                v.push([x, y, z]);
-            }
-        }
-    }
-    Ok(v)
+    tesseral::rsmc::parse_start(s).with_context(|| format!("--start {s:?}"))
 }
 
 fn write_file(path: &Path, body: impl FnOnce(&mut dyn Write) -> std::io::Result<()>) -> Result<()> {

@@ -32,6 +32,7 @@ pub mod legality;
 pub mod mesh;
 mod octree;
 pub mod plot;
+mod start;
 pub mod stats;
 #[cfg(test)]
 mod tests;
@@ -40,6 +41,7 @@ pub mod topology;
 pub use chain::{Chain, Checkpoint, Counters, Params, CHECKPOINT_FORMAT};
 pub use checkpoint::MAX_CHECKPOINT_COORDINATE;
 pub use dense::{DenseLattice, MAX_CELLS};
+pub use start::{parse_start, MAX_BOX_SIDE, MAX_START_VOXELS};
 
 use crate::Voxel;
 
