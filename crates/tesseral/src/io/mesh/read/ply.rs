@@ -1,0 +1,343 @@
+//! PLY: ASCII and binary of either byte order.
+
+use super::{syntax, words, MAX_MESH_ELEMENTS};
+use crate::io::FormatError;
+use crate::mesh::TriMesh;
+
+#[derive(Clone, Copy, PartialEq, Eq, Debug)]
+enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    fn parse(s: &str) -> Option<Self> {
+        Some(match s {
+            "char" | "int8" => Self::I8,
+            "uchar" | "uint8" => Self::U8,
+            "short" | "int16" => Self::I16,
+            "ushort" | "uint16" => Self::U16,
+            "int" | "int32" => Self::I32,
+            "uint" | "uint32" => Self::U32,
+            "float" | "float32" => Self::F32,
+            "double" | "float64" => Self::F64,
+            _ => return None,
+        })
+    }
+    fn size(self) -> usize {
+        match self {
+            Self::I8 | Self::U8 => 1,
+            Self::I16 | Self::U16 => 2,
+            Self::I32 | Self::U32 | Self::F32 => 4,
+            Self::F64 => 8,
+        }
+    }
+}
+
+#[derive(Debug)]
+struct Property {
+    name: String,
+    /// `Some(count type)` for a list.
+    list: Option<Scalar>,
+    ty: Scalar,
+}
+
+#[derive(Debug)]
+struct Element {
+    name: String,
+    count: u64,
+    props: Vec<Property>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum PlyFormat {
+    Ascii,
+    Little,
+    Big,
+}
+
+/// A cursor over the PLY body, ASCII or binary.
+struct PlyBody<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    format: PlyFormat,
+    line: usize,
+}
+
+impl PlyBody<'_> {
+    fn value(&mut self, ty: Scalar) -> Result<f64, FormatError> {
+        if self.format == PlyFormat::Ascii {
+            while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
+                if self.bytes[self.pos] == b'\n' {
+                    self.line += 1;
+                }
+                self.pos += 1;
+            }
+            let start = self.pos;
+            while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
+                self.pos += 1;
+            }
+            if start == self.pos {
+                return Err(syntax(self.line, 1, "file ends inside an element"));
+            }
+            let w = String::from_utf8_lossy(&self.bytes[start..self.pos]);
+            return match w.parse::<f64>() {
+                Ok(x) if x.is_finite() => Ok(x),
+                _ => Err(syntax(self.line, 1, format!("`{w}` is not a number"))),
+            };
+        }
+        let n = ty.size();
+        if self.pos + n > self.bytes.len() {
+            return Err(FormatError::corrupt(format!(
+                "file ends at byte {} inside an element",
+                self.pos
+            )));
+        }
+        let mut b = [0u8; 8];
+        b[..n].copy_from_slice(&self.bytes[self.pos..self.pos + n]);
+        if self.format == PlyFormat::Big {
+            b[..n].reverse();
+        }
+        self.pos += n;
+        let v = match ty {
+            Scalar::I8 => f64::from(b[0] as i8),
+            Scalar::U8 => f64::from(b[0]),
+            Scalar::I16 => f64::from(i16::from_le_bytes([b[0], b[1]])),
+            Scalar::U16 => f64::from(u16::from_le_bytes([b[0], b[1]])),
+            Scalar::I32 => f64::from(i32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            Scalar::U32 => f64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            Scalar::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
+            Scalar::F64 => f64::from_le_bytes(b),
+        };
+        if !v.is_finite() {
+            return Err(FormatError::corrupt(format!(
+                "value at byte {} is not finite",
+                self.pos - n
+            )));
+        }
+        Ok(v)
+    }
+}
+
+/// Parses PLY (ASCII, binary little- or big-endian): the `vertex` element's `x`, `y`,
+/// `z` and the `face` element's `vertex_indices` (or `vertex_index`) list; other
+/// elements and properties are skipped.
+///
+/// # Errors
+/// As [`read`].
+pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
+    let end = bytes
+        .windows(11)
+        .position(|w| w == b"end_header\n" || w == b"end_header\r")
+        .ok_or_else(|| syntax(1, 1, "no `end_header` line"))?;
+    let header = String::from_utf8_lossy(&bytes[..end]);
+    let mut body_start = end + 11;
+    if bytes.get(end + 10) == Some(&b'\r') && bytes.get(body_start) == Some(&b'\n') {
+        body_start += 1;
+    }
+    let mut format = None;
+    let mut elements: Vec<Element> = Vec::new();
+    let mut header_lines = 0;
+    for (i, line) in header.lines().enumerate() {
+        header_lines = i + 1;
+        let ws: Vec<(usize, &str)> = words(line).collect();
+        let Some(&(col, key)) = ws.first() else {
+            continue;
+        };
+        let err = |m: &str| syntax(i + 1, col, m.to_string());
+        match key {
+            "ply" if i == 0 => {}
+            _ if i == 0 => return Err(err("not a PLY file (first line must be `ply`)")),
+            "comment" | "obj_info" => {}
+            "format" => {
+                format = Some(match ws.get(1).map(|w| w.1) {
+                    Some("ascii") => PlyFormat::Ascii,
+                    Some("binary_little_endian") => PlyFormat::Little,
+                    Some("binary_big_endian") => PlyFormat::Big,
+                    _ => return Err(err("unknown PLY format")),
+                });
+            }
+            "element" => {
+                let (Some(name), Some(count)) = (ws.get(1), ws.get(2)) else {
+                    return Err(err("`element` needs a name and a count"));
+                };
+                let count: u64 = count
+                    .1
+                    .parse()
+                    .map_err(|_| syntax(i + 1, count.0, "element count is not a number"))?;
+                elements.push(Element {
+                    name: name.1.to_string(),
+                    count,
+                    props: Vec::new(),
+                });
+            }
+            "property" => {
+                let el = elements
+                    .last_mut()
+                    .ok_or_else(|| err("`property` before any `element`"))?;
+                let prop = if ws.get(1).map(|w| w.1) == Some("list") {
+                    let (Some(ct), Some(ty), Some(name)) = (ws.get(2), ws.get(3), ws.get(4)) else {
+                        return Err(err("`property list` needs two types and a name"));
+                    };
+                    Property {
+                        name: name.1.to_string(),
+                        list: Some(
+                            Scalar::parse(ct.1)
+                                .ok_or_else(|| syntax(i + 1, ct.0, "unknown type"))?,
+                        ),
+                        ty: Scalar::parse(ty.1)
+                            .ok_or_else(|| syntax(i + 1, ty.0, "unknown type"))?,
+                    }
+                } else {
+                    let (Some(ty), Some(name)) = (ws.get(1), ws.get(2)) else {
+                        return Err(err("`property` needs a type and a name"));
+                    };
+                    Property {
+                        name: name.1.to_string(),
+                        list: None,
+                        ty: Scalar::parse(ty.1)
+                            .ok_or_else(|| syntax(i + 1, ty.0, "unknown type"))?,
+                    }
+                };
+                el.props.push(prop);
+            }
+            _ => return Err(err(&format!("unexpected `{key}` in the PLY header"))),
+        }
+    }
+    let format = format.ok_or_else(|| syntax(2, 1, "no `format` line"))?;
+    let remaining = (bytes.len() - body_start.min(bytes.len())) as u64;
+    let mut body = PlyBody {
+        bytes,
+        pos: body_start.min(bytes.len()),
+        format,
+        line: header_lines + 2,
+    };
+    let mut m = TriMesh::default();
+    for el in &elements {
+        // Every element takes at least one byte (binary) or two (ASCII: a digit and a
+        // separator), so a count beyond the bytes left is a lie.
+        let min = if format == PlyFormat::Ascii {
+            2 * el.props.len() as u64
+        } else {
+            el.props
+                .iter()
+                .map(|p| p.list.unwrap_or(p.ty).size() as u64)
+                .sum()
+        };
+        if el.count > 0 && min > 0 && el.count > remaining / min {
+            return Err(FormatError::corrupt(format!(
+                "header declares {} `{}` elements; the file is too short for them",
+                el.count, el.name
+            )));
+        }
+        if el.count > MAX_MESH_ELEMENTS as u64 {
+            return Err(FormatError::too_large(format!(
+                "{} `{}` elements",
+                el.count, el.name
+            )));
+        }
+        let xyz: Vec<Option<usize>> = ["x", "y", "z"]
+            .iter()
+            .map(|n| {
+                el.props
+                    .iter()
+                    .position(|p| p.name == *n && p.list.is_none())
+            })
+            .collect();
+        let faces = el.props.iter().position(|p| {
+            p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
+        });
+        let is_vertex = el.name == "vertex";
+        if is_vertex && xyz.iter().any(Option::is_none) {
+            return Err(syntax(1, 1, "`vertex` element lacks x, y or z"));
+        }
+        let is_face = el.name == "face";
+        if is_face && faces.is_none() {
+            return Err(syntax(1, 1, "`face` element lacks a vertex_indices list"));
+        }
+        let mut poly: Vec<u32> = Vec::new();
+        for index in 0..el.count {
+            let mut p = [0.0; 3];
+            for (pi, prop) in el.props.iter().enumerate() {
+                match prop.list {
+                    None => {
+                        let v = body.value(prop.ty)?;
+                        if is_vertex {
+                            for a in 0..3 {
+                                if xyz[a] == Some(pi) {
+                                    p[a] = v;
+                                }
+                            }
+                        }
+                    }
+                    Some(ct) => {
+                        let n = body.value(ct)?;
+                        if !(0.0..=1e9).contains(&n) || n.fract() != 0.0 {
+                            return Err(FormatError::corrupt(format!(
+                                "element {index}: bad list length {n}"
+                            )));
+                        }
+                        let take = is_face && faces == Some(pi);
+                        poly.clear();
+                        for _ in 0..n as u64 {
+                            let v = body.value(prop.ty)?;
+                            if take {
+                                // A vertex index is a whole number from 0: `1.5` or `-2`
+                                // is an error that says so, not a face to guess at.
+                                let why = if v.fract() != 0.0 {
+                                    Some("is not a whole number")
+                                } else if v < 0.0 {
+                                    Some("is negative")
+                                } else {
+                                    None
+                                };
+                                if let Some(why) = why {
+                                    let msg = format!("face {index}: vertex index {v} {why}");
+                                    return Err(if body.format == PlyFormat::Ascii {
+                                        syntax(body.line, 1, msg)
+                                    } else {
+                                        FormatError::corrupt(format!("{msg} (byte {})", body.pos))
+                                    });
+                                }
+                                poly.push(if v < u32::MAX as f64 {
+                                    v as u32
+                                } else {
+                                    u32::MAX
+                                });
+                            }
+                        }
+                        if take {
+                            if poly.len() < 3 {
+                                return Err(FormatError::corrupt(format!(
+                                    "face {index} has fewer than three vertices"
+                                )));
+                            }
+                            for j in 1..poly.len() - 1 {
+                                m.triangles.push([poly[0], poly[j], poly[j + 1]]);
+                            }
+                            if m.triangles.len() > MAX_MESH_ELEMENTS {
+                                return Err(FormatError::too_large("too many triangles"));
+                            }
+                        }
+                    }
+                }
+            }
+            if is_vertex {
+                m.positions.push(p);
+            }
+        }
+    }
+    let n = m.positions.len() as u32;
+    if let Some(t) = m.triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {
+        return Err(FormatError::corrupt(format!(
+            "face {t} names a vertex beyond the {n} there are"
+        )));
+    }
+    Ok(m)
+}
