@@ -18,9 +18,11 @@
 
 mod draw;
 mod interfere;
+mod minkowski;
 mod orient;
 mod plan;
 mod plan_estimate;
+mod plan_search;
 mod plan_turns;
 mod simulate;
 mod sweep;

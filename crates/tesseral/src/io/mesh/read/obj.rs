@@ -66,7 +66,7 @@ fn line_col(bytes: &[u8], offset: usize) -> (usize, usize) {
 /// mesh.
 ///
 /// # Errors
-/// As [`read`].
+/// As [`read`](super::read).
 pub fn parse_obj(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let (line, column) = line_col(bytes, e.valid_up_to());

@@ -130,7 +130,7 @@ impl PlyBody<'_> {
 /// elements and properties are skipped.
 ///
 /// # Errors
-/// As [`read`].
+/// As [`read`](super::read).
 pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     let end = bytes
         .windows(11)

@@ -7,7 +7,7 @@ use crate::mesh::TriMesh;
 /// Parses STL, binary when the size matches its triangle count, ASCII otherwise.
 ///
 /// # Errors
-/// As [`read`].
+/// As [`read`](super::read).
 pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
