@@ -1,15 +1,12 @@
-//! A solid compiled for evaluation, its conservative cell classifier and its top-down
-//! octree builder.
+//! A solid compiled for evaluation: primitives with their maps, the node list of
+//! the expression, the conservative cell test (`eval`) and point queries (inside,
+//! colour, normal, bounds). The builder is in `build.rs`.
 
 use std::ops::ControlFlow;
-use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-
-use rayon::prelude::*;
 
 use super::index::{Bounds, BoxIndex};
 use super::{Colour, CsgError, Shape, Solid, Transform};
-use crate::linear::{push_merging, CellClass, Classifier, Leaf, LinearOctree};
-use crate::Voxel;
+use crate::linear::CellClass;
 
 /// The default cap on the leaves of a build (about 400 MB of leaves): a hostile scene
 /// stops with [`CsgError::TooManyLeaves`] rather than exhausting memory.
@@ -18,17 +15,17 @@ pub const DEFAULT_MAX_LEAVES: usize = 50_000_000;
 /// A primitive with its world-to-local map `local = inv · (p − at)`, where
 /// `inv = Rᵀ / s`; world distances are `s` times local ones.
 #[derive(Debug, Clone)]
-struct Prim {
-    shape: Shape,
-    inv: [[f64; 3]; 3],
-    at: [f64; 3],
-    scale: f64,
-    world: Transform,
+pub(super) struct Prim {
+    pub(super) shape: Shape,
+    pub(super) inv: [[f64; 3]; 3],
+    pub(super) at: [f64; 3],
+    pub(super) scale: f64,
+    pub(super) world: Transform,
 }
 
 impl Prim {
     #[inline]
-    fn local(&self, p: [f64; 3]) -> [f64; 3] {
+    pub(super) fn local(&self, p: [f64; 3]) -> [f64; 3] {
         let d = [p[0] - self.at[0], p[1] - self.at[1], p[2] - self.at[2]];
         let m = &self.inv;
         [
@@ -40,7 +37,7 @@ impl Prim {
 
     /// The class of the ball of radius `r` around `c` (`r == 0`: the point `c`).
     #[inline]
-    fn class(&self, c: [f64; 3], r: f64) -> CellClass {
+    pub(super) fn class(&self, c: [f64; 3], r: f64) -> CellClass {
         let l = self.local(c);
         if r == 0.0 {
             return if self.shape.contains(l) {
@@ -63,7 +60,7 @@ impl Prim {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Op {
+pub(super) enum Op {
     Prim(u32),
     Union,
     Inter,
@@ -72,24 +69,24 @@ enum Op {
 }
 
 #[derive(Debug, Clone)]
-struct Node {
-    op: Op,
-    first: u32,
-    len: u32,
-    colour: Option<Colour>,
+pub(super) struct Node {
+    pub(super) op: Op,
+    pub(super) first: u32,
+    pub(super) len: u32,
+    pub(super) colour: Option<Colour>,
 }
 
 /// Per-cell knowledge passed from a cell to its children: which of the first 64
 /// primitives are already known to be wholly inside or outside the cell (and so are of
 /// every sub-cell).
 #[derive(Debug, Clone, Copy, Default)]
-struct Known {
-    inside: u64,
-    outside: u64,
+pub(super) struct Known {
+    pub(super) inside: u64,
+    pub(super) outside: u64,
 }
 
 /// A compiled solid: primitives with their world-to-local maps and the tree of set
-/// operations over them. It is a [`Classifier`], and builds octrees with
+/// operations over them. It is a [`Classifier`](crate::linear::Classifier), and builds octrees with
 /// [`Csg::build`], which also prunes primitives already decided for a cell.
 ///
 /// ```
@@ -100,13 +97,13 @@ struct Known {
 /// ```
 #[derive(Debug, Clone)]
 pub struct Csg {
-    prims: Vec<Prim>,
-    nodes: Vec<Node>,
-    kids: Vec<u32>,
-    root: u32,
+    pub(super) prims: Vec<Prim>,
+    pub(super) nodes: Vec<Node>,
+    pub(super) kids: Vec<u32>,
+    pub(super) root: u32,
     /// Per node: for a union of at least [`INDEX_MIN_PARTS`] parts, the index of
     /// their boxes.
-    index: Vec<Option<BoxIndex>>,
+    pub(super) index: Vec<Option<BoxIndex>>,
 }
 
 /// Unions of at least this many parts get a [`BoxIndex`]; below it a scan is as fast.
@@ -135,12 +132,12 @@ impl Csg {
         Ok(c)
     }
 
-    fn kids_of(&self, n: u32) -> &[u32] {
+    pub(super) fn kids_of(&self, n: u32) -> &[u32] {
         let node = &self.nodes[n as usize];
         &self.kids[node.first as usize..(node.first + node.len) as usize]
     }
 
-    fn add(
+    pub(super) fn add(
         &mut self,
         solid: &Solid,
         t: &Transform,
@@ -200,7 +197,7 @@ impl Csg {
         Ok(self.push_node(op, &ids, colour))
     }
 
-    fn push_node(&mut self, op: Op, kids: &[u32], colour: Option<Colour>) -> u32 {
+    pub(super) fn push_node(&mut self, op: Op, kids: &[u32], colour: Option<Colour>) -> u32 {
         let first = self.kids.len() as u32;
         self.kids.extend_from_slice(kids);
         self.nodes.push(Node {
@@ -229,7 +226,14 @@ impl Csg {
     }
 
     /// Classifies the ball of radius `r` around `c`, using and extending `known`.
-    fn eval(&self, n: u32, c: [f64; 3], r: f64, known: Known, learn: &mut Known) -> CellClass {
+    pub(super) fn eval(
+        &self,
+        n: u32,
+        c: [f64; 3],
+        r: f64,
+        known: Known,
+        learn: &mut Known,
+    ) -> CellClass {
         let node = &self.nodes[n as usize];
         let kids = &self.kids[node.first as usize..(node.first + node.len) as usize];
         match node.op {
@@ -384,7 +388,7 @@ impl Csg {
         Some([sign * g[0] / l, sign * g[1] / l, sign * g[2] / l])
     }
 
-    fn prim_is_negated(&self, prim: u32) -> bool {
+    pub(super) fn prim_is_negated(&self, prim: u32) -> bool {
         fn walk(c: &Csg, n: u32, prim: u32, neg: bool) -> Option<bool> {
             let node = &c.nodes[n as usize];
             let kids = &c.kids[node.first as usize..(node.first + node.len) as usize];
@@ -408,7 +412,7 @@ impl Csg {
         self.node_bbox(self.root)
     }
 
-    fn node_bbox(&self, n: u32) -> Option<([f64; 3], [f64; 3])> {
+    pub(super) fn node_bbox(&self, n: u32) -> Option<([f64; 3], [f64; 3])> {
         let node = &self.nodes[n as usize];
         let kids = &self.kids[node.first as usize..(node.first + node.len) as usize];
         match node.op {
@@ -465,343 +469,13 @@ impl Csg {
             Op::Not => None,
         }
     }
-
-    /// Builds the linear octree of the solid in the space of `2^depth` voxels per axis
-    /// from `origin`, with [`DEFAULT_MAX_LEAVES`].
-    ///
-    /// # Runtime
-    /// Proportional to the cells the surface may cross (about 8 × the partial cells),
-    /// times the primitives still undecided in each; parallel over subtrees (rayon).
-    ///
-    /// # Errors
-    /// [`CsgError::Octree`] when `depth` is too large; [`CsgError::TooManyLeaves`].
-    pub fn build(&self, depth: u8, origin: Voxel) -> Result<LinearOctree, CsgError> {
-        self.build_limited(depth, origin, DEFAULT_MAX_LEAVES)
-    }
-
-    /// As [`Csg::build`], stopping with [`CsgError::TooManyLeaves`] once more than
-    /// `max_leaves` leaves have been produced.
-    ///
-    /// # Errors
-    /// As [`Csg::build`].
-    pub fn build_limited(
-        &self,
-        depth: u8,
-        origin: Voxel,
-        max_leaves: usize,
-    ) -> Result<LinearOctree, CsgError> {
-        LinearOctree::empty(depth, origin)?;
-        let budget = Budget {
-            used: AtomicUsize::new(0),
-            max: max_leaves,
-            stop: AtomicBool::new(false),
-        };
-        let chunks = if depth >= PARALLEL_MIN_SIZE_LOG2 {
-            self.build_par(0, origin, depth, Known::default(), &budget)
-        } else {
-            let mut v = Vec::new();
-            self.build_cell(0, origin, depth, Known::default(), &mut v);
-            vec![v]
-        };
-        let n: usize = chunks.iter().map(Vec::len).sum();
-        if budget.stop.load(Ordering::Relaxed) || n > max_leaves {
-            return Err(CsgError::TooManyLeaves { limit: max_leaves });
-        }
-        let mut out = Vec::with_capacity(n);
-        for c in chunks {
-            out.extend_from_slice(&c);
-        }
-        // The builder emits leaves sorted and canonical (merging as it goes), so they are
-        // taken as they are; the tests check `assert_valid` on every build.
-        Ok(LinearOctree::from_parts(depth, origin, out))
-    }
-
-    /// The parallel levels: the leaves come back as a list of sorted chunks, so that
-    /// big subtrees are never copied on the way up.
-    fn build_par(
-        &self,
-        code: u64,
-        min: Voxel,
-        k: u8,
-        known: Known,
-        budget: &Budget,
-    ) -> Vec<Vec<Leaf>> {
-        if budget.stop.load(Ordering::Relaxed) {
-            return Vec::new();
-        }
-        let (c, r) = cell_ball(min, k);
-        let mut learn = known;
-        match self.eval(self.root, c, r, known, &mut learn) {
-            CellClass::Outside => Vec::new(),
-            CellClass::Inside => vec![vec![Leaf::new(code, k)]],
-            CellClass::Partial => {
-                let parts: Vec<Vec<Vec<Leaf>>> = (0..8u64)
-                    .into_par_iter()
-                    .map(|d| {
-                        let (cc, cm) = child_of(code, min, k, d);
-                        if k > PARALLEL_MIN_SIZE_LOG2 {
-                            self.build_par(cc, cm, k - 1, learn, budget)
-                        } else {
-                            let mut part = Vec::with_capacity(256);
-                            self.build_cell(cc, cm, k - 1, learn, &mut part);
-                            let n = part.len();
-                            if budget.used.fetch_add(n, Ordering::Relaxed) + n > budget.max {
-                                budget.stop.store(true, Ordering::Relaxed);
-                            }
-                            vec![part]
-                        }
-                    })
-                    .collect();
-                // Eight full children merge into this cell; nothing else can merge.
-                let full = parts.iter().all(|p| {
-                    let mut leaves = p.iter().flatten();
-                    matches!((leaves.next(), leaves.next()), (Some(l), None) if l.size_log2() == k - 1)
-                });
-                if full {
-                    return vec![vec![Leaf::new(code, k)]];
-                }
-                parts
-                    .into_iter()
-                    .flatten()
-                    .filter(|c| !c.is_empty())
-                    .collect()
-            }
-        }
-    }
-
-    /// Classifies the cell `(min, k)` with nothing known from its ancestors.
-    pub(crate) fn classify_cell(&self, min: Voxel, k: u8) -> CellClass {
-        let (c, r) = cell_ball(min, k);
-        let known = Known::default();
-        let mut learn = known;
-        self.eval(self.root, c, r, known, &mut learn)
-    }
-
-    /// Appends the leaves of the cell `(code, min, k)`, built on this thread.
-    pub(crate) fn build_subtree(&self, code: u64, min: Voxel, k: u8, out: &mut Vec<Leaf>) {
-        self.build_cell(code, min, k, Known::default(), out);
-    }
-
-    /// The sequential levels: leaves are appended to `out`, merged as they come.
-    fn build_cell(&self, code: u64, min: Voxel, k: u8, known: Known, out: &mut Vec<Leaf>) {
-        let (c, r) = cell_ball(min, k);
-        let mut learn = known;
-        match self.eval(self.root, c, r, known, &mut learn) {
-            CellClass::Outside => {}
-            CellClass::Inside => out.push(Leaf::new(code, k)),
-            CellClass::Partial if k == 0 => out.push(Leaf::new(code, 0)),
-            CellClass::Partial if k == 2 => {
-                // 64 voxels: evaluate them all at once, as bit masks in tesseral order.
-                let mask = self.eval_mask(self.root, min, learn);
-                emit_mask(code, mask, out);
-            }
-            CellClass::Partial => {
-                for d in 0..8 {
-                    let (cc, cm) = child_of(code, min, k, d);
-                    self.build_cell(cc, cm, k - 1, learn, out);
-                }
-                if let Some(last) = out.pop() {
-                    push_merging(out, last);
-                }
-            }
-        }
-    }
-}
-
-/// The code and lowest voxel of child `d` of the cell `(code, min, k)`.
-#[inline]
-fn child_of(code: u64, min: Voxel, k: u8, d: u64) -> (u64, Voxel) {
-    let half = 1i64 << (k - 1);
-    (
-        code + d * (1u64 << (3 * u32::from(k - 1))),
-        [
-            min[0] + half * (d & 1) as i64,
-            min[1] + half * ((d >> 1) & 1) as i64,
-            min[2] + half * ((d >> 2) & 1) as i64,
-        ],
-    )
-}
-
-/// The offsets of the 64 voxels of a 4x4x4 cell, in tesseral order.
-const OFFSETS_4: [[f64; 3]; 64] = {
-    let mut t = [[0.0; 3]; 64];
-    let mut b = 0;
-    while b < 64 {
-        t[b] = [
-            ((b & 1) | ((b >> 3) & 1) << 1) as f64,
-            (((b >> 1) & 1) | ((b >> 4) & 1) << 1) as f64,
-            (((b >> 2) & 1) | ((b >> 5) & 1) << 1) as f64,
-        ];
-        b += 1;
-    }
-    t
-};
-
-/// Pushes the leaves of a 4x4x4 cell whose black voxels are the set bits of `mask`
-/// (bit i = the voxel at tesseral offset i), merging full octets.
-fn emit_mask(code: u64, mask: u64, out: &mut Vec<Leaf>) {
-    if mask == u64::MAX {
-        out.push(Leaf::new(code, 2));
-        return;
-    }
-    for j in 0..8u64 {
-        let byte = (mask >> (8 * j)) & 0xff;
-        if byte == 0xff {
-            out.push(Leaf::new(code + 8 * j, 1));
-        } else {
-            let mut b = byte;
-            while b != 0 {
-                let i = u64::from(b.trailing_zeros());
-                out.push(Leaf::new(code + 8 * j + i, 0));
-                b &= b - 1;
-            }
-        }
-    }
-}
-
-impl Prim {
-    /// The 64 voxels of the 4x4x4 cell at `min`, as a bit mask in tesseral order.
-    fn mask4(&self, min: Voxel) -> u64 {
-        let l0 = self.local([
-            min[0] as f64 + 0.5,
-            min[1] as f64 + 0.5,
-            min[2] as f64 + 0.5,
-        ]);
-        let m = &self.inv;
-        let cols = [
-            [m[0][0], m[1][0], m[2][0]],
-            [m[0][1], m[1][1], m[2][1]],
-            [m[0][2], m[1][2], m[2][2]],
-        ];
-        #[inline(always)]
-        fn each(l0: [f64; 3], cols: &[[f64; 3]; 3], test: impl Fn([f64; 3]) -> bool) -> u64 {
-            let mut mask = 0u64;
-            for (b, o) in OFFSETS_4.iter().enumerate() {
-                let p = [
-                    l0[0] + o[0] * cols[0][0] + o[1] * cols[1][0] + o[2] * cols[2][0],
-                    l0[1] + o[0] * cols[0][1] + o[1] * cols[1][1] + o[2] * cols[2][1],
-                    l0[2] + o[0] * cols[0][2] + o[1] * cols[1][2] + o[2] * cols[2][2],
-                ];
-                mask |= u64::from(test(p)) << b;
-            }
-            mask
-        }
-        // One loop per shape, so that each is compiled on its own.
-        match &self.shape {
-            Shape::Sphere { r } => {
-                let r2 = r * r;
-                each(l0, &cols, |p| p[0] * p[0] + p[1] * p[1] + p[2] * p[2] <= r2)
-            }
-            Shape::Box { half } => each(l0, &cols, |p| {
-                p[0].abs() <= half[0] && p[1].abs() <= half[1] && p[2].abs() <= half[2]
-            }),
-            shape => each(l0, &cols, |p| shape.contains(p)),
-        }
-    }
-}
-
-impl Csg {
-    /// The 64 voxels of the 4x4x4 cell at `min` as a bit mask in tesseral order.
-    fn eval_mask(&self, n: u32, min: Voxel, known: Known) -> u64 {
-        let node = &self.nodes[n as usize];
-        let kids = &self.kids[node.first as usize..(node.first + node.len) as usize];
-        match node.op {
-            Op::Prim(i) => {
-                if i < 64 {
-                    let bit = 1u64 << i;
-                    if known.inside & bit != 0 {
-                        return u64::MAX;
-                    }
-                    if known.outside & bit != 0 {
-                        return 0;
-                    }
-                }
-                self.prims[i as usize].mask4(min)
-            }
-            Op::Union if self.index[n as usize].is_some() => {
-                // The voxel centres of the cell span [min + 0.5, min + 3.5].
-                let lo = min.map(|v| v as f64 + 0.5);
-                let query = (lo, lo.map(|v| v + 3.0));
-                let mut acc = 0;
-                if let Some(ix) = &self.index[n as usize] {
-                    let _ = ix.for_each_meeting(&query, |k| {
-                        acc |= self.eval_mask(k, min, known);
-                        if acc == u64::MAX {
-                            ControlFlow::Break(())
-                        } else {
-                            ControlFlow::Continue(())
-                        }
-                    });
-                }
-                acc
-            }
-            Op::Union => {
-                let mut acc = 0;
-                for &k in kids {
-                    acc |= self.eval_mask(k, min, known);
-                    if acc == u64::MAX {
-                        break;
-                    }
-                }
-                acc
-            }
-            Op::Inter | Op::Diff => {
-                let mut acc = u64::MAX;
-                for (j, &k) in kids.iter().enumerate() {
-                    let m = self.eval_mask(k, min, known);
-                    acc &= if node.op == Op::Diff && j > 0 { !m } else { m };
-                    if acc == 0 {
-                        break;
-                    }
-                }
-                acc
-            }
-            Op::Not => !self.eval_mask(kids[0], min, known),
-        }
-    }
-}
-
-struct Budget {
-    used: AtomicUsize,
-    max: usize,
-    stop: AtomicBool,
-}
-
-/// Below this cell size (log2) the build runs on one thread.
-const PARALLEL_MIN_SIZE_LOG2: u8 = 5;
-
-/// The ball holding the voxel centres of the cell `[min, min + 2^k)`: its centre and
-/// radius (0 for a single voxel).
-#[inline]
-fn cell_ball(min: Voxel, k: u8) -> ([f64; 3], f64) {
-    let half = f64::from(1u32 << k) / 2.0;
-    let c = [
-        min[0] as f64 + half,
-        min[1] as f64 + half,
-        min[2] as f64 + half,
-    ];
-    let r = if k == 0 {
-        0.0
-    } else {
-        (half - 0.5) * 3f64.sqrt()
-    };
-    (c, r)
 }
 
 #[inline]
-fn flip(c: CellClass) -> CellClass {
+pub(super) fn flip(c: CellClass) -> CellClass {
     match c {
         CellClass::Inside => CellClass::Outside,
         CellClass::Outside => CellClass::Inside,
         CellClass::Partial => CellClass::Partial,
-    }
-}
-
-impl Classifier for Csg {
-    /// Classifies the cell by the bounding-sphere test of every primitive (no pruning
-    /// across cells; [`Csg::build`] adds that).
-    fn classify(&self, min: Voxel, size_log2: u8) -> CellClass {
-        let (c, r) = cell_ball(min, size_log2);
-        self.eval(self.root, c, r, Known::default(), &mut Known::default())
     }
 }

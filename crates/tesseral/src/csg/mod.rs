@@ -23,6 +23,7 @@
 //! and its cost follows the surface: only cells the surface may cross are split.
 
 mod budget;
+mod build;
 mod colours;
 mod compile;
 mod index;
