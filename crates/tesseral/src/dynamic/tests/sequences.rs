@@ -41,50 +41,6 @@ fn random_sequences_with_the_other_block_form() {
 }
 
 #[test]
-fn small_blocks_grow_into_bitmaps_and_go_away() {
-    let mut t = DynamicOctree::new();
-    let cells: Vec<Voxel> = (0..12).map(|i| [i % 8, i / 8, 3]).collect();
-    // The first block is the root (a bitmap); its corner makes the blocks world-aligned.
-    t.insert([-1024, -1024, -1024]);
-    for (n, &c) in cells.iter().enumerate() {
-        assert!(t.insert(c));
-        assert!(!t.insert(c));
-        t.assert_valid();
-        let small = t.small.live();
-        let bitmaps = t.leaves.live();
-        // Up to eight voxels the new block is small; the ninth makes it a bitmap.
-        if n < SMALL_CAP {
-            assert_eq!((small, bitmaps), (1, 1), "after {} voxels", n + 1);
-        } else {
-            assert_eq!((small, bitmaps), (0, 2), "after {} voxels", n + 1);
-        }
-        for &d in &cells {
-            assert_eq!(t.contains(d), cells[..=n].contains(&d));
-        }
-    }
-    for (n, &c) in cells.iter().enumerate() {
-        assert!(t.remove(c));
-        assert!(!t.remove(c));
-        t.assert_valid();
-        // Down to four voxels the bitmap turns small again; the last one frees it.
-        let left = cells.len() - n - 1;
-        let forms = (t.small.live(), t.leaves.live());
-        let want = match left {
-            0 => (0, 1),
-            1..=4 => (1, 1),
-            _ => (0, 2),
-        };
-        assert_eq!(forms, want, "with {left} voxels left");
-        for &d in &cells {
-            assert_eq!(t.contains(d), cells[n + 1..].contains(&d));
-        }
-    }
-    assert_eq!(t.voxel_count(), 1);
-    assert_eq!(t.node_count(), 1); // the far voxel's block, the root again
-    assert_eq!(t.small.live(), 0);
-}
-
-#[test]
 fn random_sequences_near_two_to_the_62() {
     let e = 1i64 << 62;
     for (seed, lo) in [
