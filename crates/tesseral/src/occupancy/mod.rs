@@ -34,6 +34,8 @@ mod sensor;
 mod store;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_ray;
 
 pub use sensor::{log_odds, probability, Pose, SensorModel};
 

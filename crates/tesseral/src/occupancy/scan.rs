@@ -3,8 +3,9 @@
 
 use rayon::prelude::*;
 
-use super::ray::{walk, Masks, Scratch};
+use super::ray::{Masks, Scratch};
 use super::sensor::Pose;
+use super::store::BLOCK_LOG2;
 use super::{OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
@@ -47,16 +48,17 @@ impl OccupancyMap {
         let inv = 1.0 / res;
         let key = move |p: [f64; 3]| p.map(|c| (c * inv).floor() as i64);
         let key_origin = key(origin);
+        let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
         let cast = |s: &mut Scratch, p: &[f64; 3]| {
             let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
             let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             match max_range {
                 Some(r) if norm > r => {
                     let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
-                    walk(origin, end, key_origin, key(end), res, |c| s.miss(c));
+                    s.miss_ray(origin, end, key_origin, key(end), res);
                 }
                 _ => {
-                    walk(origin, *p, key_origin, key(*p), res, |c| s.miss(c));
+                    s.miss_ray(origin, *p, key_origin, key(*p), res);
                     s.hit(key(*p));
                 }
             }
@@ -64,7 +66,7 @@ impl OccupancyMap {
         let (scratch, skipped) = points
             .par_chunks(CHUNK)
             .fold(
-                || (Scratch::default(), 0u64),
+                || (Scratch::new(block_of_origin), 0u64),
                 |(mut s, mut skipped), chunk| {
                     for p in chunk {
                         if p.iter().all(|c| c.is_finite()) {
@@ -77,7 +79,7 @@ impl OccupancyMap {
                 },
             )
             .reduce(
-                || (Scratch::default(), 0),
+                || (Scratch::new(block_of_origin), 0),
                 |(a, n), (b, m)| (a.merge(b), n + m),
             );
         stats.skipped = skipped;
