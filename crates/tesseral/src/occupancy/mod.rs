@@ -36,6 +36,8 @@ mod store;
 mod tests;
 #[cfg(test)]
 mod tests_ray;
+#[cfg(test)]
+mod tests_store;
 
 pub use sensor::{log_odds, probability, Pose, SensorModel};
 
