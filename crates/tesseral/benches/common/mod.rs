@@ -1,5 +1,8 @@
 //! Pieces shared by the benchmark binaries.
 
+#[allow(dead_code)]
+pub mod scans;
+
 /// splitmix64: the generator the benchmarks and the C++ peer harnesses share, so both
 /// sides draw the same cells in the same order.
 pub struct SplitMix64(pub u64);

@@ -34,6 +34,10 @@ mod sensor;
 mod store;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_ray;
+#[cfg(test)]
+mod tests_store;
 
 pub use sensor::{log_odds, probability, Pose, SensorModel};
 

@@ -5,13 +5,81 @@ use rustc_hash::FxHashMap;
 
 use super::store::{BlockKey, BLOCK_LOG2};
 
+/// The state of one ray's walk (Amanatides & Woo) after its first cell.
+pub(crate) struct Dda {
+    /// ±1 or 0 per axis.
+    pub step: [i64; 3],
+    /// The ray parameter at the next border along each axis.
+    pub t_max: [f64; 3],
+    /// The ray parameter between borders along each axis.
+    pub t_delta: [f64; 3],
+    /// Steps left along each axis before the end cell's plane.
+    pub left_axis: [i64; 3],
+    /// Steps left in all before the end cell.
+    pub left: i64,
+}
+
+impl Dda {
+    /// The walk from `origin` (in cell `key_origin`) to `end` (in `key_end`), or
+    /// `None` when both lie in one cell.
+    ///
+    /// The steps left along an axis are never negative (the key of the end lies on
+    /// the side `step` goes). The walk reaches the end cell when no step is left, and
+    /// stops early when it would step past the end cell's plane along an axis, which
+    /// only float rounding can cause. (OctoMap stops once the border distance exceeds
+    /// the length, which can drop the last cell before an end point lying exactly on
+    /// a face; the count on keys cannot.)
+    #[inline(always)]
+    pub fn new(
+        origin: [f64; 3],
+        end: [f64; 3],
+        key_origin: [i64; 3],
+        key_end: [i64; 3],
+        res: f64,
+    ) -> Option<Self> {
+        if key_origin == key_end {
+            return None;
+        }
+        let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
+        let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let dir = d.map(|c| c / length);
+        let mut step = [0i64; 3];
+        let mut t_max = [f64::MAX; 3];
+        let mut t_delta = [f64::MAX; 3];
+        for i in 0..3 {
+            if dir[i] > 0.0 {
+                step[i] = 1;
+            } else if dir[i] < 0.0 {
+                step[i] = -1;
+            }
+            if step[i] != 0 {
+                // The cell's border in the ray's direction (OctoMap: centre ± res/2).
+                // (OctoMap adds the half cell rounded to `f32`, which moves the border
+                // by up to 1e-9 of a cell; we keep it exact.)
+                let border = (key_origin[i] as f64 + 0.5) * res + step[i] as f64 * res * 0.5;
+                t_max[i] = (border - origin[i]) / dir[i];
+                t_delta[i] = res / dir[i].abs();
+            }
+        }
+        let left_axis = [0, 1, 2].map(|i| (key_end[i] - key_origin[i]) * step[i]);
+        Some(Self {
+            step,
+            t_max,
+            t_delta,
+            left_axis,
+            left: left_axis[0] + left_axis[1] + left_axis[2],
+        })
+    }
+}
+
 /// One ray's walk: the cells OctoMap's `computeRayKeys(origin, end)` returns.
 ///
 /// Nothing when both ends lie in one cell; otherwise the origin's cell, then each
 /// cell entered, stopping before the end's cell (or once the walk has passed it
 /// along an axis, which only float rounding can cause). Ties between axes go as
 /// in OctoMap (x before z, y before z, y before x only when strictly smaller).
-#[inline]
+/// This is the reference form; [`Scratch::miss_ray`] is the fast one.
+#[cfg(test)]
 pub(crate) fn walk(
     origin: [f64; 3],
     end: [f64; 3],
@@ -20,58 +88,120 @@ pub(crate) fn walk(
     res: f64,
     mut visit: impl FnMut([i64; 3]),
 ) {
-    if key_origin == key_end {
+    let Some(mut w) = Dda::new(origin, end, key_origin, key_end, res) else {
         return;
-    }
+    };
     visit(key_origin);
-    let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
-    let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-    let dir = d.map(|c| c / length);
-    let mut step = [0i64; 3];
-    let mut t_max = [f64::MAX; 3];
-    let mut t_delta = [f64::MAX; 3];
-    for i in 0..3 {
-        if dir[i] > 0.0 {
-            step[i] = 1;
-        } else if dir[i] < 0.0 {
-            step[i] = -1;
-        }
-        if step[i] != 0 {
-            // The cell's border in the ray's direction (OctoMap: centre ± res/2).
-            // (OctoMap adds the half cell rounded to `f32`, which moves the border by
-            // up to 1e-9 of a cell; we keep it exact.)
-            let border = (key_origin[i] as f64 + 0.5) * res + step[i] as f64 * res * 0.5;
-            t_max[i] = (border - origin[i]) / dir[i];
-            t_delta[i] = res / dir[i].abs();
-        }
-    }
     let mut key = key_origin;
     loop {
-        let dim = if t_max[0] < t_max[1] {
-            if t_max[0] < t_max[2] {
+        let dim = if w.t_max[0] < w.t_max[1] {
+            if w.t_max[0] < w.t_max[2] {
                 0
             } else {
                 2
             }
-        } else if t_max[1] < t_max[2] {
+        } else if w.t_max[1] < w.t_max[2] {
             1
         } else {
             2
         };
-        key[dim] += step[dim];
-        t_max[dim] += t_delta[dim];
-        if key == key_end {
+        if w.left_axis[dim] == 0 {
             return;
         }
-        // Past the end cell along this axis: rounding led the walk beside it.
-        // (OctoMap stops once the border distance exceeds the length, which can
-        // drop the last cell before an end point lying exactly on a face; the
-        // test on keys cannot.)
-        if (key[dim] - key_end[dim]) * step[dim] > 0 {
+        w.left_axis[dim] -= 1;
+        w.left -= 1;
+        if w.left == 0 {
             return;
         }
+        key[dim] += w.step[dim];
+        w.t_max[dim] += w.t_delta[dim];
         visit(key);
     }
+}
+
+/// A walk inside one block: what [`leave_block`] moves.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Crossing {
+    /// As [`Dda::t_max`].
+    pub t: [f64; 3],
+    /// As [`Dda::t_delta`].
+    pub d: [f64; 3],
+    /// As [`Dda::step`].
+    pub step: [i64; 3],
+    /// The current cell's coordinates in its block.
+    pub local: [i64; 3],
+    /// As [`Dda::left_axis`].
+    pub left_axis: [i64; 3],
+    /// As [`Dda::left`].
+    pub left: i64,
+}
+
+/// Moves a walk to the first cell of the next block in one go, exactly where the
+/// step-by-step walk would be (the same `t` values, summed in the same order), and
+/// returns the axis it left the block along; or `None`, with the walk untouched,
+/// when the walk would end inside the block or on its way out.
+///
+/// The step-by-step walk takes the axis crossings in order of `t`, ties to the
+/// higher axis (z before y before x). Along each axis the crossings in the block are
+/// known without the others, so the block is left along the axis whose wrapping
+/// crossing comes first, and every other axis takes its crossings before that one.
+#[inline]
+pub(crate) fn leave_block(w: &mut Crossing) -> Option<usize> {
+    let last = (1i64 << BLOCK_LOG2) - 1;
+    let before = |(t, a): (f64, usize), (u, b): (f64, usize)| t < u || (t == u && a > b);
+    // Per axis: the crossings left in the block and the `t` of the wrapping one.
+    let mut n = [0i64; 3];
+    let mut wrap = [(f64::INFINITY, 0usize); 3];
+    for i in 0..3 {
+        if w.step[i] == 0 {
+            wrap[i] = (f64::INFINITY, i);
+            continue;
+        }
+        n[i] = if w.step[i] > 0 {
+            last - w.local[i]
+        } else {
+            w.local[i]
+        };
+        let mut t = w.t[i];
+        for _ in 0..n[i] {
+            t += w.d[i];
+        }
+        wrap[i] = (t, i);
+    }
+    let mut e = 0;
+    for i in 1..3 {
+        if before(wrap[i], wrap[e]) {
+            e = i;
+        }
+    }
+    if !wrap[e].0.is_finite() {
+        return None;
+    }
+    let mut m = [0i64; 3];
+    let mut t = w.t;
+    for i in 0..3 {
+        if i == e || w.step[i] == 0 {
+            continue;
+        }
+        while before((t[i], i), wrap[e]) {
+            t[i] += w.d[i];
+            m[i] += 1;
+        }
+    }
+    m[e] = n[e] + 1;
+    let steps = m[0] + m[1] + m[2];
+    if (0..3).any(|i| m[i] > w.left_axis[i]) || steps >= w.left {
+        return None;
+    }
+    t[e] = wrap[e].0 + w.d[e];
+    for i in 0..3 {
+        w.left_axis[i] -= m[i];
+        w.local[i] += w.step[i] * m[i];
+    }
+    w.local[e] &= last;
+    w.t = t;
+    w.left -= steps;
+    Some(e)
 }
 
 /// Hit and miss bits of one block: bit `x + 8y` of word `z`.
@@ -82,26 +212,50 @@ pub(crate) struct Masks {
     pub hit: [u64; 8],
 }
 
-/// One thread's updates of a scan: blocks in a hash map, each with its masks. Each
-/// cell is a bit, so updates are deduplicated as they are made, and the cells near
-/// the origin that every ray crosses cost a bit set, not an update.
-#[derive(Debug, Default)]
+/// Blocks per side of the dense index around the origin (a power of two).
+const NEAR_SIDE_LOG2: u32 = 6;
+const NEAR_SIDE: i64 = 1 << NEAR_SIDE_LOG2;
+const NO_SLOT: u32 = u32::MAX;
+
+/// One thread's updates of a scan: blocks, each with its masks, found through a
+/// dense index of the 64³ blocks around the origin (rays from one origin cross
+/// these most often) and a hash map beyond. Each cell is a bit, so updates are
+/// deduplicated as they are made, and the cells near the origin that every ray
+/// crosses cost a bit set, not an update.
+#[derive(Debug)]
 pub(crate) struct Scratch {
-    index: FxHashMap<BlockKey, u32>,
+    /// The lowest block of the dense index.
+    near_lo: BlockKey,
+    near: Vec<u32>,
+    far: FxHashMap<BlockKey, u32>,
     pub blocks: Vec<Masks>,
-    last: Option<(BlockKey, u32)>,
 }
 
 impl Scratch {
+    /// An empty scratch whose dense index is centred on block `centre`.
+    pub fn new(centre: BlockKey) -> Self {
+        Self {
+            near_lo: centre.map(|c| c - NEAR_SIDE / 2),
+            near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
+            far: FxHashMap::default(),
+            blocks: Vec::new(),
+        }
+    }
+
     #[inline]
     fn slot(&mut self, b: BlockKey) -> usize {
-        if let Some((k, i)) = self.last {
-            if k == b {
-                return i as usize;
-            }
-        }
+        let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
         let n = self.blocks.len() as u32;
-        let i = *self.index.entry(b).or_insert(n);
+        let i = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
+            let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
+            let i = &mut self.near[at];
+            if *i == NO_SLOT {
+                *i = n;
+            }
+            *i
+        } else {
+            *self.far.entry(b).or_insert(n)
+        };
         if i == n {
             self.blocks.push(Masks {
                 key: b,
@@ -109,15 +263,97 @@ impl Scratch {
                 hit: [0; 8],
             });
         }
-        self.last = Some((b, i));
         i as usize
     }
 
-    /// Marks a cell missed.
+    /// Marks missed the cells of a ray, as [`walk`] visits them: the walk is kept in
+    /// registers, in the cell's block-local coordinates, with one probe per block
+    /// crossed; a block whose 512 cells are all missed already is crossed in one
+    /// move ([`leave_block`]).
     #[inline]
-    pub fn miss(&mut self, c: [i64; 3]) {
-        let s = self.slot(c.map(|x| x >> BLOCK_LOG2));
-        self.blocks[s].miss[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
+    pub fn miss_ray(
+        &mut self,
+        origin: [f64; 3],
+        end: [f64; 3],
+        key_origin: [i64; 3],
+        key_end: [i64; 3],
+        res: f64,
+    ) {
+        let Some(w) = Dda::new(origin, end, key_origin, key_end, res) else {
+            return;
+        };
+        let mask = (1i64 << BLOCK_LOG2) - 1;
+        let mut block = key_origin.map(|c| c >> BLOCK_LOG2);
+        let [mut x, mut y, mut z] = key_origin.map(|c| c & mask);
+        let [sx, sy, sz] = w.step;
+        let [mut tx, mut ty, mut tz] = w.t_max;
+        let [dx, dy, dz] = w.t_delta;
+        let [mut lx, mut ly, mut lz] = w.left_axis;
+        let mut left = w.left;
+        let mut s = self.slot(block);
+        self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
+        let mut entered = true;
+        // One step along an axis: stop before passing the end cell's plane or on
+        // reaching the end cell; a new block when the local coordinate wraps.
+        macro_rules! step {
+            ($l:ident, $t:ident, $d:ident, $c:ident, $s:ident, $axis:expr) => {{
+                if $l == 0 {
+                    return;
+                }
+                $l -= 1;
+                left -= 1;
+                if left == 0 {
+                    return;
+                }
+                $t += $d;
+                $c += $s;
+                if $c & !mask != 0 {
+                    $c &= mask;
+                    block[$axis] += $s;
+                    s = self.slot(block);
+                    entered = true;
+                }
+            }};
+        }
+        loop {
+            if entered {
+                entered = false;
+                if self.blocks[s].miss.iter().all(|&m| m == !0) {
+                    let mut b = Crossing {
+                        t: [tx, ty, tz],
+                        d: [dx, dy, dz],
+                        step: [sx, sy, sz],
+                        local: [x, y, z],
+                        left_axis: [lx, ly, lz],
+                        left,
+                    };
+                    if let Some(e) = leave_block(&mut b) {
+                        [tx, ty, tz] = b.t;
+                        [x, y, z] = b.local;
+                        [lx, ly, lz] = b.left_axis;
+                        left = b.left;
+                        block[e] += b.step[e];
+                        s = self.slot(block);
+                        self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
+                        entered = true;
+                        continue;
+                    }
+                }
+            }
+            // Ties: x before z, y before z, y before x only when strictly smaller.
+            if tx < ty {
+                if tx < tz {
+                    step!(lx, tx, dx, x, sx, 0);
+                } else {
+                    step!(lz, tz, dz, z, sz, 2);
+                }
+            } else if ty < tz {
+                step!(ly, ty, dy, y, sy, 1);
+            } else {
+                step!(lz, tz, dz, z, sz, 2);
+            }
+            self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
+        }
     }
 
     /// Marks a cell hit.

@@ -3,8 +3,9 @@
 
 use rayon::prelude::*;
 
-use super::ray::{walk, Masks, Scratch};
+use super::ray::{Masks, Scratch};
 use super::sensor::Pose;
+use super::store::BLOCK_LOG2;
 use super::{OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
@@ -47,24 +48,31 @@ impl OccupancyMap {
         let inv = 1.0 / res;
         let key = move |p: [f64; 3]| p.map(|c| (c * inv).floor() as i64);
         let key_origin = key(origin);
+        let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
         let cast = |s: &mut Scratch, p: &[f64; 3]| {
             let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
             let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
             match max_range {
                 Some(r) if norm > r => {
                     let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
-                    walk(origin, end, key_origin, key(end), res, |c| s.miss(c));
+                    s.miss_ray(origin, end, key_origin, key(end), res);
                 }
                 _ => {
-                    walk(origin, *p, key_origin, key(*p), res, |c| s.miss(c));
+                    s.miss_ray(origin, *p, key_origin, key(*p), res);
                     s.hit(key(*p));
                 }
             }
         };
+        // Few chunks (one per thread alone, four per thread with more, for
+        // balance): each has its own scratch, merged at the end.
+        let threads = rayon::current_num_threads();
+        let pieces = if threads == 1 { 1 } else { 4 * threads };
+        let chunk = points.len().div_ceil(pieces).max(CHUNK);
         let (scratch, skipped) = points
-            .par_chunks(CHUNK)
+            .par_chunks(chunk)
+            .with_min_len(1)
             .fold(
-                || (Scratch::default(), 0u64),
+                || (Scratch::new(block_of_origin), 0u64),
                 |(mut s, mut skipped), chunk| {
                     for p in chunk {
                         if p.iter().all(|c| c.is_finite()) {
@@ -77,14 +85,20 @@ impl OccupancyMap {
                 },
             )
             .reduce(
-                || (Scratch::default(), 0),
+                || (Scratch::new(block_of_origin), 0),
                 |(a, n), (b, m)| (a.merge(b), n + m),
             );
         stats.skipped = skipped;
         stats.rays = stats.points - skipped;
-        let mut blocks = scratch.blocks;
-        blocks.par_sort_unstable_by_key(|m| block_code(m.key));
-        let (hits, misses) = self.apply(&blocks);
+        // The blocks in tesseral order: their codes sorted beside their places.
+        let mut order: Vec<(u128, u32)> = scratch
+            .blocks
+            .par_iter()
+            .enumerate()
+            .map(|(i, m)| (block_code(m.key), i as u32))
+            .collect();
+        order.par_sort_unstable();
+        let (hits, misses) = self.apply(&scratch.blocks, &order);
         stats.hits = hits;
         stats.misses = misses;
         stats
@@ -107,38 +121,16 @@ impl OccupancyMap {
 
     /// Applies the masks of a scan, block by block in the order given; returns the
     /// numbers of cells hit and missed.
-    fn apply(&mut self, blocks: &[Masks]) -> (u64, u64) {
+    fn apply(&mut self, blocks: &[Masks], order: &[(u128, u32)]) -> (u64, u64) {
         let fixed = self.fixed;
         let (mut hits, mut misses) = (0u64, 0u64);
         self.store.reserve(blocks.len() / 4);
-        for m in blocks {
+        for &(_, i) in order {
+            let m = &blocks[i as usize];
             let miss: [u64; 8] = std::array::from_fn(|w| m.miss[w] & !m.hit[w]);
-            let n_hit: u32 = m.hit.iter().map(|w| w.count_ones()).sum();
-            let n_miss: u32 = miss.iter().map(|w| w.count_ones()).sum();
-            hits += u64::from(n_hit);
-            misses += u64::from(n_miss);
-            if let Some(Ok(v)) = self.store.entry(m.key).map(|e| e.get()) {
-                // A clamped block that the updates only push further: unchanged.
-                if (v == fixed.min && n_hit == 0) || (v == fixed.max && n_miss == 0) {
-                    continue;
-                }
-            }
-            let cells = self.store.expand(m.key);
-            for (w, (&miss_w, &hit_w)) in miss.iter().zip(&m.hit).enumerate() {
-                let mut bits = miss_w;
-                while bits != 0 {
-                    let i = w << 6 | bits.trailing_zeros() as usize;
-                    cells[i] = fixed.apply_miss(cells[i]);
-                    bits &= bits - 1;
-                }
-                let mut bits = hit_w;
-                while bits != 0 {
-                    let i = w << 6 | bits.trailing_zeros() as usize;
-                    cells[i] = fixed.apply_hit(cells[i]);
-                    bits &= bits - 1;
-                }
-            }
-            self.store.settle(m.key, fixed);
+            hits += u64::from(m.hit.iter().map(|w| w.count_ones()).sum::<u32>());
+            misses += u64::from(miss.iter().map(|w| w.count_ones()).sum::<u32>());
+            self.store.update(m.key, &miss, &m.hit, fixed);
         }
         (hits, misses)
     }

@@ -340,7 +340,10 @@ fn pruning_keeps_clamped_blocks_as_one_entry() {
     // Blocks 0..=4 along x are all free and clamped: uniform; block 5 holds the hits.
     for bx in 0..5 {
         assert!(
-            matches!(map.store.entry([bx, 0, 0]).map(|e| e.get()), Some(Ok(_))),
+            matches!(
+                map.store.entry([bx, 0, 0]).map(|e| e.kind()),
+                Some(store::Kind::Uniform(_))
+            ),
             "block {bx}"
         );
     }

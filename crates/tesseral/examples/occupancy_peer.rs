@@ -1,0 +1,133 @@
+//! The tesseral side of `benches/occupancy/run.sh` (issue 13 §8): writes the synthetic
+//! indoor and outdoor scans for the C++ peers (Bonxai, OctoMap) and times
+//! `OccupancyMap::insert_scan` and random lookups on them.
+//!
+//! - `occupancy_peer gen DIR SCANS RAYS`: writes `DIR/indoor.scans` and
+//!   `DIR/outdoor.scans` (per scan: origin as 3 × `f64`, point count as `u64`, points
+//!   as 3 × `f64` each, little-endian).
+//! - `occupancy_peer run FILE MAX_RANGE`: builds the map at 5 cm, OctoMap's sensor
+//!   model, then looks up 10⁶ cells drawn at random from the scans' end points (the
+//!   same splitmix64 draws as the C++ drivers) and prints one `RESULT` line: scans,
+//!   rays, insertion wall and CPU seconds, rays per second (wall), the map's bytes,
+//!   occupied and free cells, lookup ns.
+//!
+//! The rayon pool size is `RAYON_NUM_THREADS` (one core: `RAYON_NUM_THREADS=1`).
+
+#[path = "../benches/common/mod.rs"]
+mod common;
+
+use std::io::{Read, Write};
+use std::time::Instant;
+
+use common::scans::{scans, Scan};
+use common::SplitMix64;
+use tesseral::occupancy::{OccupancyMap, SensorModel};
+
+/// The process's CPU time in seconds (all its threads).
+fn process_cpu() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime");
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+}
+
+fn write_scans(path: &str, scans: &[Scan]) -> std::io::Result<()> {
+    let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);
+    for s in scans {
+        for c in s.origin {
+            f.write_all(&c.to_le_bytes())?;
+        }
+        f.write_all(&(s.points.len() as u64).to_le_bytes())?;
+        for p in &s.points {
+            for c in p {
+                f.write_all(&c.to_le_bytes())?;
+            }
+        }
+    }
+    f.flush()
+}
+
+fn read_scans(path: &str) -> std::io::Result<Vec<Scan>> {
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?.read_to_end(&mut bytes)?;
+    let mut words = bytes
+        .chunks_exact(8)
+        .map(|w| <[u8; 8]>::try_from(w).expect("8 bytes"));
+    let mut out = Vec::new();
+    while let Some(w) = words.next() {
+        let mut f = || f64::from_le_bytes(words.next().expect("truncated scan file"));
+        let origin = [f64::from_le_bytes(w), f(), f()];
+        let n = u64::from_le_bytes(words.next().expect("truncated scan file"));
+        let points = (0..n)
+            .map(|_| {
+                let mut f = || f64::from_le_bytes(words.next().expect("truncated scan file"));
+                [f(), f(), f()]
+            })
+            .collect();
+        out.push(Scan { origin, points });
+    }
+    Ok(out)
+}
+
+fn main() -> std::io::Result<()> {
+    let args: Vec<String> = std::env::args().collect();
+    let arg = |i: usize| -> &str {
+        args.get(i).map_or_else(
+            || panic!("usage: occupancy_peer gen DIR SCANS RAYS | run FILE MAX_RANGE"),
+            String::as_str,
+        )
+    };
+    match arg(1) {
+        "gen" => {
+            let (count, rays) = (
+                arg(3).parse().expect("SCANS"),
+                arg(4).parse().expect("RAYS"),
+            );
+            for (name, outdoor) in [("indoor", false), ("outdoor", true)] {
+                write_scans(
+                    &format!("{}/{name}.scans", arg(2)),
+                    &scans(outdoor, count, rays),
+                )?;
+            }
+        }
+        "run" => {
+            let sc = read_scans(arg(2))?;
+            let max_range: f64 = arg(3).parse().expect("MAX_RANGE");
+            let rays: usize = sc.iter().map(|s| s.points.len()).sum();
+            let mut map = OccupancyMap::new(0.05, SensorModel::octomap()).expect("map");
+            let (t, c) = (Instant::now(), process_cpu());
+            for s in &sc {
+                map.insert_scan(s.origin, &s.points, Some(max_range));
+            }
+            let (wall, cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
+            let mut r = SplitMix64(7);
+            let cells: Vec<[i64; 3]> = (0..1_000_000)
+                .map(|_| {
+                    let s = &sc[(r.next() % sc.len() as u64) as usize];
+                    map.cell_of(s.points[(r.next() % s.points.len() as u64) as usize])
+                })
+                .collect();
+            let t = Instant::now();
+            let known = cells
+                .iter()
+                .filter(|&&c| map.log_odds(std::hint::black_box(c)).is_some())
+                .count();
+            let lookup = t.elapsed().as_secs_f64();
+            println!(
+                "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known}",
+                sc.len(),
+                rays as f64 / wall,
+                map.bytes(),
+                map.occupied_count(),
+                map.free_count(),
+                lookup * 1e3,
+            );
+        }
+        other => panic!("unknown command {other}: gen or run"),
+    }
+    Ok(())
+}
