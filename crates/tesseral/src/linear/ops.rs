@@ -14,6 +14,7 @@
 
 use rayon::prelude::*;
 
+use super::bricked::{self, Bricked};
 use super::merge::{difference, intersection, symmetric_difference, union};
 use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};
 
@@ -79,6 +80,9 @@ impl LinearOctree {
         };
         let a = self.expand_to(depth, origin);
         let (b, _) = other.resample(depth, origin)?;
+        if self.has_bricked() || other.has_bricked() {
+            a.build_bricks();
+        }
         Ok(a.set_op_same_space(&b, op))
     }
 
@@ -121,7 +125,7 @@ impl LinearOctree {
     /// As [`LinearOctree::set_op`], when the spaces differ and aligning them fails.
     pub fn same_voxels(&self, other: &Self) -> Result<bool, OctreeError> {
         if self.depth == other.depth && self.origin == other.origin {
-            return Ok(self.leaves == other.leaves);
+            return Ok(self == other);
         }
         if self.voxel_count() != other.voxel_count() {
             return Ok(false);
@@ -144,11 +148,17 @@ impl LinearOctree {
     #[must_use]
     pub fn complement(&self) -> Self {
         let full = [Leaf::new(0, self.depth)];
-        let min = split_min_leaves(self.leaves.len());
+        if self.has_bricked() {
+            let full = Bricked::from_leaves(&full);
+            let out = bricked::set_op(&full, self.bricked(), SetOp::Difference);
+            return Self::from_bricked(self.depth, self.origin, out);
+        }
+        let leaves = self.leaves();
+        let min = split_min_leaves(leaves.len());
         let mut leaves = merge_cell(
             SetOp::Difference,
             Part::Leaves(&full),
-            Part::Leaves(&self.leaves),
+            Part::Leaves(leaves),
             0,
             self.depth,
             min,
@@ -167,11 +177,16 @@ impl LinearOctree {
             self.depth == other.depth && self.origin == other.origin,
             "set_op_same_space on different spaces"
         );
-        let min = split_min_leaves(self.leaves.len() + other.leaves.len());
+        if self.has_bricked() || other.has_bricked() {
+            let out = bricked::set_op(self.bricked(), other.bricked(), op);
+            return Self::from_bricked(self.depth, self.origin, out);
+        }
+        let (a, b) = (self.leaves(), other.leaves());
+        let min = split_min_leaves(a.len() + b.len());
         let mut leaves = merge_cell(
             op,
-            Part::Leaves(&self.leaves),
-            Part::Leaves(&other.leaves),
+            Part::Leaves(a),
+            Part::Leaves(b),
             0,
             self.depth,
             min,
