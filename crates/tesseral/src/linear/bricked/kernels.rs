@@ -1,56 +1,74 @@
-//! The set operations on the bricked form: one merge of the two sorted entry
-//! lists, as the leaf-list kernels of `merge.rs` do, with the bottom three levels
-//! combined word by word.
+//! The set operations on one level of the bricked form: one merge of the two sorted
+//! entry lists, as the leaf-list kernels of `merge.rs` do, generic over the payload
+//! of a mixed cell (a brick's mask, or a chunk's own entries).
 //!
-//! Overlapping entries are equal bricks, or nested with the outer one a leaf of side
-//! 8 or more (a brick contains nothing smaller: entries start on multiples of 512).
-//! Each step of a kernel:
-//! - **two bricks** at one code combine their masks (`|`, `&`, `& !`, `^`); a mask
-//!   that comes out empty is dropped, one that comes out full (union, symmetric
-//!   difference) becomes a leaf of side 8 and may complete its parent;
+//! Overlapping entries are equal mixed cells, or nested with the outer one a leaf
+//! (a mixed cell contains no entry of its level: entries start on multiples of the
+//! cell's codes). Each step of a kernel:
+//! - **two mixed cells** at one code combine their payloads ([`Payload::combine`]:
+//!   masks word by word, chunks by these kernels one level down); a result that
+//!   comes out empty is dropped, one that comes out full (union, symmetric
+//!   difference) becomes a leaf of the cell's side and may complete its parent;
 //! - **a run** of entries of one operand that ends before the other's current entry
 //!   (or lies inside one leaf of it) is found by galloping and copied or skipped,
-//!   with its masks, as two slices;
+//!   with its payloads, as two slices (a chunk is shared, not copied);
 //! - **a leaf holding entries of the other operand** is kept, dropped, or cut around
-//!   them (the gaps greedily as maximal blocks, all of side 8 or more), a brick
-//!   inside it leaving its complement.
+//!   them (the gaps greedily as maximal blocks, all of the cell's side or more), a
+//!   mixed cell inside it leaving its complement.
 //!
 //! The results are canonical for the reasons the leaf kernels' are, each checked
 //! against a `HashSet` model in `tests.rs`.
 
 use super::super::merge::{emit_gap, ending_by, inside, push_m, span2};
 use super::super::{push_merging, Leaf, SetOp};
-use super::{bricks_in, is_brick, Bricked, Mask, BRICK_CODES, FULL};
+use super::{bricks_in, is_brick, Level};
+
+/// What combining two mixed cells gives.
+pub(crate) enum Combined<P> {
+    /// No voxel.
+    Empty,
+    /// Every voxel of the cell.
+    Full,
+    /// Some: the payload.
+    Mixed(P),
+}
+
+/// The contents of a mixed cell of side `2^LOG2`.
+pub(crate) trait Payload: Clone {
+    /// The cell's side, log2.
+    const LOG2: u8;
+    /// The cell's codes, `8^LOG2`.
+    const CODES: u64 = 1 << (3 * Self::LOG2 as u32);
+    /// `op` of two payloads of the cell at `code`.
+    fn combine(op: SetOp, code: u64, a: &Self, b: &Self) -> Combined<Self>;
+    /// The complement within the cell at `code` (mixed, as the payload is).
+    fn complement(&self, code: u64) -> Self;
+}
 
 /// The code span `[start, end)` of an entry.
 #[inline(always)]
-fn span(item: Leaf) -> (u64, u64) {
+fn span<P: Payload>(item: Leaf) -> (u64, u64) {
     if is_brick(item) {
         let s = item.packed() >> 1;
-        (s, s + BRICK_CODES)
+        (s, s + P::CODES)
     } else {
         span2(item)
     }
 }
 
-#[inline(always)]
-fn combine(a: &Mask, b: &Mask, f: impl Fn(u64, u64) -> u64) -> Mask {
-    std::array::from_fn(|w| f(a[w], b[w]))
-}
-
-/// One operand being read: its entries and masks, and how far each is read.
-struct Cursor<'a> {
+/// One operand being read: its entries and payloads, and how far each is read.
+struct Cursor<'a, P> {
     items: &'a [Leaf],
-    masks: &'a [Mask],
+    payloads: &'a [P],
     i: usize,
     m: usize,
 }
 
-impl<'a> Cursor<'a> {
-    fn new(t: &'a Bricked) -> Self {
+impl<'a, P: Payload> Cursor<'a, P> {
+    fn new(t: &'a Level<P>) -> Self {
         Self {
             items: &t.items,
-            masks: &t.masks,
+            payloads: &t.payloads,
             i: 0,
             m: 0,
         }
@@ -66,21 +84,21 @@ impl<'a> Cursor<'a> {
         self.items[self.i]
     }
 
-    /// Takes the next `n` entries, returning them and their masks.
+    /// Takes the next `n` entries, returning them and their payloads.
     #[inline(always)]
-    fn take(&mut self, n: usize) -> (&'a [Leaf], &'a [Mask]) {
+    fn take(&mut self, n: usize) -> (&'a [Leaf], &'a [P]) {
         let items = &self.items[self.i..self.i + n];
         let c = bricks_in(items);
-        let masks = &self.masks[self.m..self.m + c];
+        let payloads = &self.payloads[self.m..self.m + c];
         self.i += n;
         self.m += c;
-        (items, masks)
+        (items, payloads)
     }
 
-    /// Takes the current entry, a brick.
+    /// Takes the current entry, a mixed cell.
     #[inline(always)]
-    fn take_brick(&mut self) -> &'a Mask {
-        let m = &self.masks[self.m];
+    fn take_mixed(&mut self) -> &'a P {
+        let m = &self.payloads[self.m];
         self.i += 1;
         self.m += 1;
         m
@@ -94,7 +112,7 @@ impl<'a> Cursor<'a> {
     }
 
     /// The number of entries from the current one that end by code `at` (a
-    /// multiple of 512).
+    /// multiple of the cell's codes).
     #[inline(always)]
     fn ending_by(&self, at: u64) -> usize {
         ending_by(&self.items[self.i..], at)
@@ -107,33 +125,35 @@ impl<'a> Cursor<'a> {
     }
 
     /// Everything not yet read.
-    fn rest(&mut self) -> (&'a [Leaf], &'a [Mask]) {
+    fn rest(&mut self) -> (&'a [Leaf], &'a [P]) {
         self.take(self.items.len() - self.i)
     }
 }
 
-impl Bricked {
+impl<P: Payload> Level<P> {
     #[inline(always)]
-    fn push_brick(&mut self, code_item: Leaf, m: Mask) {
-        self.items.push(code_item);
-        self.masks.push(m);
+    fn push_mixed(&mut self, item: Leaf, m: P) {
+        self.items.push(item);
+        self.payloads.push(m);
     }
 
-    /// Pushes the combined mask of the brick at `item`: dropped when empty, a leaf
-    /// of side 8 (merged with its siblings) when full.
+    /// Pushes a combined cell: dropped when empty, a leaf (merged with its
+    /// siblings) when full.
     #[inline(always)]
-    fn push_combined(&mut self, item: Leaf, m: Mask) {
-        if m == FULL {
-            push_merging(&mut self.items, Leaf::new(item.packed() >> 1, 3));
-        } else if m != [0; 8] {
-            self.push_brick(item, m);
+    fn push_combined(&mut self, item: Leaf, c: Combined<P>) {
+        match c {
+            Combined::Empty => {}
+            Combined::Full => {
+                push_merging(&mut self.items, Leaf::new(item.packed() >> 1, P::LOG2));
+            }
+            Combined::Mixed(m) => self.push_mixed(item, m),
         }
     }
 
     /// Appends entries of one canonical operand, merging at their front only (as
     /// `merge::push_run`: a run never completes a parent by itself).
     #[inline]
-    fn push_run(&mut self, (items, masks): (&[Leaf], &[Mask])) {
+    fn push_run(&mut self, (items, payloads): (&[Leaf], &[P])) {
         let mut foreign_end = self.items.len();
         let mut k = 0;
         while k < items.len() && self.items.len() - foreign_end < 7 {
@@ -145,27 +165,27 @@ impl Bricked {
             k += 1;
         }
         self.items.extend_from_slice(&items[k..]);
-        self.masks.extend_from_slice(masks);
+        self.payloads.extend_from_slice(payloads);
     }
 
     /// Appends entries with no merging (intersection, difference).
     #[inline]
-    fn push_plain(&mut self, (items, masks): (&[Leaf], &[Mask])) {
+    fn push_plain(&mut self, (items, payloads): (&[Leaf], &[P])) {
         self.items.extend_from_slice(items);
-        self.masks.extend_from_slice(masks);
+        self.payloads.extend_from_slice(payloads);
     }
 
     /// Appends the leaf `[start, end)` cut around `holes` (entries inside it): each
-    /// gap as maximal blocks, each brick hole leaving its complement.
-    fn push_cut(&mut self, (start, end): (u64, u64), (holes, masks): (&[Leaf], &[Mask]), merge: bool) {
+    /// gap as maximal blocks, each mixed hole leaving its complement.
+    fn push_cut(&mut self, (start, end): (u64, u64), (holes, payloads): (&[Leaf], &[P]), merge: bool) {
         let mut pos = start;
-        let mut masks = masks.iter();
+        let mut payloads = payloads.iter();
         for &h in holes {
-            let (s, e) = span(h);
+            let (s, e) = span::<P>(h);
             emit_gap(&mut self.items, pos, s, merge);
             if is_brick(h) {
-                let m = masks.next().expect("one mask per brick");
-                self.push_brick(h, m.map(|w| !w));
+                let m = payloads.next().expect("one payload per mixed cell");
+                self.push_mixed(h, m.complement(s));
             }
             pos = e;
         }
@@ -173,13 +193,13 @@ impl Bricked {
     }
 }
 
-/// The set operation `op` of two bricked forms of one space.
-pub(crate) fn set_op(a: &Bricked, b: &Bricked, op: SetOp) -> Bricked {
-    // Union and intersection keep at most every input entry and mask; a difference
-    // may cut more and grows. The unused tail is given back.
-    let mut out = Bricked {
+/// The set operation `op` of two levels of one space (or of one chunk cell).
+pub(crate) fn level_op<P: Payload>(a: &Level<P>, b: &Level<P>, op: SetOp) -> Level<P> {
+    // Union and intersection keep at most every input entry and payload; a
+    // difference may cut more and grows. The unused tail is given back.
+    let mut out = Level {
         items: Vec::with_capacity(a.items.len() + b.items.len() + 8),
-        masks: Vec::with_capacity(a.masks.len() + b.masks.len()),
+        payloads: Vec::with_capacity(a.payloads.len() + b.payloads.len()),
     };
     let (x, y) = (Cursor::new(a), Cursor::new(b));
     match op {
@@ -189,7 +209,7 @@ pub(crate) fn set_op(a: &Bricked, b: &Bricked, op: SetOp) -> Bricked {
         SetOp::SymmetricDifference => symmetric_difference(x, y, &mut out),
     }
     out.items.shrink_to_fit();
-    out.masks.shrink_to_fit();
+    out.payloads.shrink_to_fit();
     out
 }
 
@@ -199,15 +219,15 @@ fn holds(x: Leaf, (xs, xe): (u64, u64), (ys, ye): (u64, u64)) -> bool {
     !is_brick(x) && xs <= ys && ye <= xe
 }
 
-fn union(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
+fn union<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mut Level<P>) {
     while a.live() && b.live() {
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
-            let m = combine(a.take_brick(), b.take_brick(), |p, q| p | q);
-            out.push_combined(x, m);
+            let c = P::combine(SetOp::Union, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            out.push_combined(x, c);
             continue;
         }
-        let (sx, sy) = (span(x), span(y));
+        let (sx, sy) = (span::<P>(x), span::<P>(y));
         if sx.1 <= sy.0 {
             let run = a.take(a.ending_by(sy.0));
             out.push_run(run);
@@ -226,18 +246,16 @@ fn union(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
     out.push_run(b.rest());
 }
 
-fn intersection(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
+fn intersection<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mut Level<P>) {
     while a.live() && b.live() {
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
-            // Never full: both masks are mixed.
-            let m = combine(a.take_brick(), b.take_brick(), |p, q| p & q);
-            if m != [0; 8] {
-                out.push_brick(x, m);
-            }
+            // Never full: both cells are mixed.
+            let c = P::combine(SetOp::Intersection, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            out.push_combined(x, c);
             continue;
         }
-        let (sx, sy) = (span(x), span(y));
+        let (sx, sy) = (span::<P>(x), span::<P>(y));
         if sx.1 <= sy.0 {
             a.take(a.ending_by(sy.0));
         } else if sy.1 <= sx.0 {
@@ -254,18 +272,16 @@ fn intersection(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
     }
 }
 
-fn difference(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
+fn difference<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mut Level<P>) {
     while a.live() && b.live() {
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
-            // Never full: the first mask is mixed.
-            let m = combine(a.take_brick(), b.take_brick(), |p, q| p & !q);
-            if m != [0; 8] {
-                out.push_brick(x, m);
-            }
+            // Never full: the first cell is mixed.
+            let c = P::combine(SetOp::Difference, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            out.push_combined(x, c);
             continue;
         }
-        let (sx, sy) = (span(x), span(y));
+        let (sx, sy) = (span::<P>(x), span::<P>(y));
         if sx.1 <= sy.0 {
             let run = a.take(a.ending_by(sy.0));
             out.push_plain(run);
@@ -285,15 +301,24 @@ fn difference(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
     out.push_plain(a.rest());
 }
 
-fn symmetric_difference(mut a: Cursor<'_>, mut b: Cursor<'_>, out: &mut Bricked) {
+fn symmetric_difference<P: Payload>(
+    mut a: Cursor<'_, P>,
+    mut b: Cursor<'_, P>,
+    out: &mut Level<P>,
+) {
     while a.live() && b.live() {
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
-            let m = combine(a.take_brick(), b.take_brick(), |p, q| p ^ q);
-            out.push_combined(x, m);
+            let c = P::combine(
+                SetOp::SymmetricDifference,
+                x.packed() >> 1,
+                a.take_mixed(),
+                b.take_mixed(),
+            );
+            out.push_combined(x, c);
             continue;
         }
-        let (sx, sy) = (span(x), span(y));
+        let (sx, sy) = (span::<P>(x), span::<P>(y));
         if sx.1 <= sy.0 {
             let run = a.take(a.ending_by(sy.0));
             out.push_run(run);
