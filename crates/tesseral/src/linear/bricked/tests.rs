@@ -244,3 +244,110 @@ fn empty_and_tiny_operands_match_the_model() {
     let rest: Model = &all - &corners;
     check_all_ops(5, &corners, &rest, Held::Both).unwrap();
 }
+
+/// A solid of a depth-`depth` space (7 or 8) that reaches the top level: `big`
+/// blocks of side 32 to 128 (leaves of the top level, which hold the other
+/// operand's chunks, or chunks of one operand only), small blocks, and noise of
+/// `density` percent in one random 16³ cube.
+fn chunky(depth: u8, big: u32, density: u64, seed: u64) -> Model {
+    let mut s = seed;
+    let side = 1i64 << depth;
+    let mut m = Model::new();
+    let block = |m: &mut Model, k: u32, s: &mut u64| {
+        let bs = 1i64 << k;
+        let p = [0, 1, 2].map(|_| (next(s) % (side / bs) as u64) as i64 * bs);
+        for x in 0..bs {
+            for y in 0..bs {
+                for z in 0..bs {
+                    m.insert([p[0] + x, p[1] + y, p[2] + z]);
+                }
+            }
+        }
+    };
+    for _ in 0..big {
+        let k = 5 + (next(&mut s) % 3) as u32;
+        block(&mut m, k.min(u32::from(depth) - 1), &mut s);
+    }
+    for _ in 0..6 {
+        let k = (next(&mut s) % 5) as u32;
+        block(&mut m, k, &mut s);
+    }
+    let lo = [0, 1, 2].map(|_| (next(&mut s) % (side as u64 - 16)) as i64);
+    for x in 0..16 {
+        for y in 0..16 {
+            for z in 0..16 {
+                if next(&mut s) % 100 < density {
+                    m.insert([lo[0] + x, lo[1] + y, lo[2] + z]);
+                }
+            }
+        }
+    }
+    m
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(6))]
+
+    /// Operands with several chunks and leaves of the top level: chunks combined,
+    /// shared whole, dropped, cut out of a leaf (their complement), and chunks that
+    /// come out full merging into leaves of side 64 and more.
+    #[test]
+    fn chunks_and_top_leaves_match_the_model(
+        big_a in 0u32..4, big_b in 0u32..4, da in 0u64..90, db in 0u64..90,
+        sa: u64, sb: u64, h: u8, complementary: bool,
+    ) {
+        let depth = 7;
+        let ma = chunky(depth, big_a, da, sa);
+        let mb = if complementary {
+            // Every chunk that both hold comes out full in their union.
+            let all = solid(depth, [0; 3], 1 << depth, 0, 100, 0);
+            &all - &ma
+        } else {
+            chunky(depth, big_b, db, sb)
+        };
+        let (a, b) = operands(depth, &ma, &mb, held(h));
+        for op in OPS {
+            for (x, y, mx, my) in [(&a, &b, &ma, &mb), (&b, &a, &mb, &ma)] {
+                let r = x.set_op(y, op).unwrap();
+                check_result(&r, depth, &model_op(op, mx, my))?;
+            }
+        }
+        check_result(&a.complement(), depth, &(&solid(depth, [0; 3], 128, 0, 100, 0) - &ma))?;
+    }
+}
+
+/// Larger random solids (spheres of random centres and radii, clipped or not, with
+/// blocks added and cut out) at depths 9 and 10: the bricked path gives the leaf
+/// path's trees (which `tests_merge.rs` checks against the model), chained too.
+#[test]
+fn bricked_path_matches_the_leaf_path_on_larger_solids() {
+    let mut s = 5;
+    for case in 0..12 {
+        let depth = 9 + (case % 2) as u8;
+        let side = (1u64 << depth) as f64;
+        let mut sphere = || {
+            let c = [0, 1, 2].map(|_| (next(&mut s) % 1000) as f64 / 1000.0 * side);
+            let r = 8.0 + (next(&mut s) % 1000) as f64 / 1000.0 * side / 2.5;
+            LinearOctree::from_classifier(depth, [0; 3], &ball(c, r)).unwrap()
+        };
+        let (a, b, c) = (sphere(), sphere(), sphere());
+        let (ab, bb, cb) = (a.clone(), b.clone(), c.clone());
+        for t in [&ab, &bb, &cb] {
+            t.build_bricks();
+        }
+        for op in OPS {
+            let leaf = a.set_op(&b, op).unwrap();
+            let brick = ab.set_op(&bb, op).unwrap();
+            brick.assert_valid();
+            assert!(brick.has_bricked());
+            for op2 in OPS {
+                let leaf2 = leaf.set_op(&c, op2).unwrap();
+                let brick2 = brick.set_op(&cb, op2).unwrap();
+                brick2.assert_valid();
+                assert_eq!(brick2.leaves(), leaf2.leaves(), "case {case} {op:?} {op2:?}");
+            }
+            assert_eq!(brick.leaves(), leaf.leaves(), "case {case} {op:?}");
+            brick.assert_valid();
+        }
+    }
+}
