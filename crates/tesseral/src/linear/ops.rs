@@ -183,14 +183,7 @@ impl LinearOctree {
         }
         let (a, b) = (self.leaves(), other.leaves());
         let min = split_min_leaves(a.len() + b.len());
-        let mut leaves = merge_cell(
-            op,
-            Part::Leaves(a),
-            Part::Leaves(b),
-            0,
-            self.depth,
-            min,
-        );
+        let mut leaves = merge_cell(op, Part::Leaves(a), Part::Leaves(b), 0, self.depth, min);
         leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }

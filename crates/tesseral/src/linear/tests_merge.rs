@@ -44,7 +44,14 @@ pub(crate) fn next(s: &mut u64) -> u64 {
 /// A random solid in the sub-cube `[lo, lo + side)^3` of a depth-`depth` space:
 /// `blocks` aligned blocks of random sizes (so leaves nest across operands) and
 /// voxels of the given density in percent (so single voxels interleave).
-pub(crate) fn solid(depth: u8, lo: [i64; 3], side: i64, blocks: u32, density: u64, seed: u64) -> Model {
+pub(crate) fn solid(
+    depth: u8,
+    lo: [i64; 3],
+    side: i64,
+    blocks: u32,
+    density: u64,
+    seed: u64,
+) -> Model {
     let mut s = seed;
     let mut m = Model::new();
     for _ in 0..blocks {

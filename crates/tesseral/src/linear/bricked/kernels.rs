@@ -177,7 +177,12 @@ impl<P: Payload> Level<P> {
 
     /// Appends the leaf `[start, end)` cut around `holes` (entries inside it): each
     /// gap as maximal blocks, each mixed hole leaving its complement.
-    fn push_cut(&mut self, (start, end): (u64, u64), (holes, payloads): (&[Leaf], &[P]), merge: bool) {
+    fn push_cut(
+        &mut self,
+        (start, end): (u64, u64),
+        (holes, payloads): (&[Leaf], &[P]),
+        merge: bool,
+    ) {
         let mut pos = start;
         let mut payloads = payloads.iter();
         for &h in holes {
@@ -223,7 +228,12 @@ fn union<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mut Level
     while a.live() && b.live() {
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
-            let c = P::combine(SetOp::Union, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            let c = P::combine(
+                SetOp::Union,
+                x.packed() >> 1,
+                a.take_mixed(),
+                b.take_mixed(),
+            );
             out.push_combined(x, c);
             continue;
         }
@@ -251,7 +261,12 @@ fn intersection<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mu
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
             // Never full: both cells are mixed.
-            let c = P::combine(SetOp::Intersection, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            let c = P::combine(
+                SetOp::Intersection,
+                x.packed() >> 1,
+                a.take_mixed(),
+                b.take_mixed(),
+            );
             out.push_combined(x, c);
             continue;
         }
@@ -277,7 +292,12 @@ fn difference<P: Payload>(mut a: Cursor<'_, P>, mut b: Cursor<'_, P>, out: &mut 
         let (x, y) = (a.item(), b.item());
         if x == y && is_brick(x) {
             // Never full: the first cell is mixed.
-            let c = P::combine(SetOp::Difference, x.packed() >> 1, a.take_mixed(), b.take_mixed());
+            let c = P::combine(
+                SetOp::Difference,
+                x.packed() >> 1,
+                a.take_mixed(),
+                b.take_mixed(),
+            );
             out.push_combined(x, c);
             continue;
         }

@@ -269,7 +269,8 @@ impl Bricked {
             let base = l.code() & !(chunk_codes - 1);
             let n = leaves[i..].partition_point(|l| l.code() < base + chunk_codes);
             top.items.push(brick_item(base));
-            top.payloads.push(Arc::new(Chunk::from_leaves(&leaves[i..i + n])));
+            top.payloads
+                .push(Arc::new(Chunk::from_leaves(&leaves[i..i + n])));
             i += n;
         }
         top.items.shrink_to_fit();
@@ -286,7 +287,10 @@ impl Bricked {
         let mut chunks = self.top.payloads.iter();
         for &item in &self.top.items {
             if is_brick(item) {
-                chunks.next().expect("one chunk per entry").leaves_into(&mut out);
+                chunks
+                    .next()
+                    .expect("one chunk per entry")
+                    .leaves_into(&mut out);
             } else {
                 out.push(item);
             }
@@ -297,7 +301,12 @@ impl Bricked {
     /// The number of leaves of the canonical leaf list.
     pub(crate) fn leaf_count(&self) -> usize {
         self.top.items.len() - self.top.payloads.len()
-            + self.top.payloads.iter().map(|c| c.leaf_count()).sum::<usize>()
+            + self
+                .top
+                .payloads
+                .iter()
+                .map(|c| c.leaf_count())
+                .sum::<usize>()
     }
 
     /// The number of black voxels.
@@ -309,7 +318,13 @@ impl Bricked {
             .filter(|l| !is_brick(**l))
             .map(|l| l.voxel_count())
             .sum();
-        blocks + self.top.payloads.iter().map(|c| c.voxel_count()).sum::<u64>()
+        blocks
+            + self
+                .top
+                .payloads
+                .iter()
+                .map(|c| c.voxel_count())
+                .sum::<u64>()
     }
 
     /// Whether no voxel is black.
@@ -339,7 +354,13 @@ impl Bricked {
         let space_end = 1u64 << (3 * u32::from(depth));
         let chunk_codes = <Arc<Chunk> as Payload>::CODES;
         assert_level(&self.top, (0, space_end), (CHUNK_LOG2, depth), "top");
-        for (item, chunk) in self.top.items.iter().filter(|l| is_brick(**l)).zip(&self.top.payloads) {
+        for (item, chunk) in self
+            .top
+            .items
+            .iter()
+            .filter(|l| is_brick(**l))
+            .zip(&self.top.payloads)
+        {
             let code = item.packed() >> 1;
             assert!(!chunk.items.is_empty(), "chunk {code} is empty");
             assert!(
@@ -378,10 +399,17 @@ fn assert_level<P: Payload>(level: &Level<P>, (lo, hi): (u64, u64), ks: (u8, u8)
         } else {
             let k = item.size_log2();
             assert!(ks.0 <= k && k <= ks.1, "{what}: leaf {i} of side 2^{k}");
-            assert_eq!(item.code() % item.voxel_count(), 0, "{what}: leaf {i} unaligned");
+            assert_eq!(
+                item.code() % item.voxel_count(),
+                0,
+                "{what}: leaf {i} unaligned"
+            );
             (item.code(), item.end())
         };
-        assert!(prev_end <= start, "{what}: entry {i} unsorted, overlapping or before its cell");
+        assert!(
+            prev_end <= start,
+            "{what}: entry {i} unsorted, overlapping or before its cell"
+        );
         assert!(end <= hi, "{what}: entry {i} outside its cell or the space");
         prev_end = end;
         if i >= 7 {

@@ -183,9 +183,15 @@ fn spheres_and_porous_blocks_match_the_model() {
     let depth = 7;
     let pairs = [
         // Unclipped: both wholly inside.
-        (ball([64.0, 64.0, 64.0], 40.0), ball([84.0, 64.0, 64.0], 40.0)),
+        (
+            ball([64.0, 64.0, 64.0], 40.0),
+            ball([84.0, 64.0, 64.0], 40.0),
+        ),
         // Clipped: the second runs past the faces x = 128 and z = 0.
-        (ball([60.0, 64.0, 64.0], 50.0), ball([110.0, 70.0, 10.0], 45.0)),
+        (
+            ball([60.0, 64.0, 64.0], 50.0),
+            ball([110.0, 70.0, 10.0], 45.0),
+        ),
     ];
     let mut cases: Vec<(LinearOctree, LinearOctree)> = pairs
         .into_iter()
@@ -344,7 +350,11 @@ fn bricked_path_matches_the_leaf_path_on_larger_solids() {
                 let leaf2 = leaf.set_op(&c, op2).unwrap();
                 let brick2 = brick.set_op(&cb, op2).unwrap();
                 brick2.assert_valid();
-                assert_eq!(brick2.leaves(), leaf2.leaves(), "case {case} {op:?} {op2:?}");
+                assert_eq!(
+                    brick2.leaves(),
+                    leaf2.leaves(),
+                    "case {case} {op:?} {op2:?}"
+                );
             }
             assert_eq!(brick.leaves(), leaf.leaves(), "case {case} {op:?}");
             brick.assert_valid();

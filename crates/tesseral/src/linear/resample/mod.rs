@@ -182,7 +182,12 @@ impl LinearOctree {
         delta: [i64; 3],
         all_inside: bool,
     ) -> Option<Vec<Leaf>> {
-        let max_k = self.leaves().iter().map(|l| l.size_log2()).max().unwrap_or(0);
+        let max_k = self
+            .leaves()
+            .iter()
+            .map(|l| l.size_log2())
+            .max()
+            .unwrap_or(0);
         // Cells of side 2^a move whole: a is the displacement's alignment, capped
         // by the new space; every leaf must fit in such a cell.
         let align = delta
@@ -211,7 +216,7 @@ impl LinearOctree {
         };
         // Runs of leaves sharing a cell, with the cell's new code.
         let mut runs: Vec<(u64, usize, usize)> = Vec::new();
-        let mut rest = &self.leaves()[..];
+        let mut rest = self.leaves();
         let mut start = 0;
         while let Some(first) = rest.first() {
             let cell = first.code() & !low;
