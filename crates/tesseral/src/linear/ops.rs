@@ -8,6 +8,10 @@
 //! only one operand has are copied or skipped as slices. On one thread the whole
 //! space is one merge; on more, large inputs are split by octant and merged in
 //! parallel with rayon.
+//!
+//! When either operand holds its bricked form (`bricked/`), the operation runs on
+//! the bricked forms instead, one merge per level with the bottom three levels
+//! combined word by word, and returns a tree in bricked form.
 
 // Per-axis loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
@@ -56,7 +60,10 @@ impl LinearOctree {
     ///
     /// # Runtime
     /// O(n + m) leaves in a shared space, in parallel for large inputs; aligning a
-    /// foreign operand costs one [`LinearOctree::resample`] of it.
+    /// foreign operand costs one [`LinearOctree::resample`] of it. When either
+    /// operand holds its bricked form ([`LinearOctree::build_bricks`]), the merge
+    /// runs on the bricked forms (O(n + m) entries and masks, chunks that only one
+    /// operand has passed on without copying) and the result is held in bricked form.
     ///
     /// # Errors
     /// [`OctreeError::DepthTooLarge`] when the grown space would exceed
