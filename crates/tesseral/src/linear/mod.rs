@@ -261,6 +261,10 @@ impl LinearOctree {
     }
 
     /// The number of black leaves (maximal blocks).
+    ///
+    /// # Runtime
+    /// O(1) when the tree holds its leaf list; otherwise O(n), counted off the
+    /// bricked form without making the list.
     #[must_use]
     pub fn leaf_count(&self) -> usize {
         match (self.leaves.get(), self.bricked.get()) {
