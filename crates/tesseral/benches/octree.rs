@@ -91,6 +91,41 @@ fn set_operations(c: &mut Criterion) {
             bch.iter(|| black_box(a9.set_op(&b9, op).unwrap()))
         });
     }
+    // The same on the bricked forms (made once, outside the loop), what the
+    // OpenVDB harness times; then making the bricked forms, and the leaf list of a
+    // bricked result.
+    let (a9b, b9b) = (a9.clone(), b9.clone());
+    a9b.build_bricks();
+    b9b.build_bricks();
+    for (name, op) in [
+        ("union_unclipped_bricked", SetOp::Union),
+        ("intersection_unclipped_bricked", SetOp::Intersection),
+        ("difference_unclipped_bricked", SetOp::Difference),
+    ] {
+        g.bench_function(name, |bch| {
+            bch.iter(|| black_box(a9b.set_op(&b9b, op).unwrap()))
+        });
+    }
+    g.bench_function("bricking_unclipped", |bch| {
+        bch.iter_batched(
+            || a9.clone(),
+            |t| {
+                t.build_bricks();
+                t
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("leaves_of_bricked_union_unclipped", |bch| {
+        bch.iter_batched(
+            || a9b.set_op(&b9b, SetOp::Union).unwrap(),
+            |t| {
+                black_box(t.leaves().len());
+                t
+            },
+            BatchSize::LargeInput,
+        )
+    });
     g.finish();
 }
 

@@ -2,15 +2,24 @@
 //! operand pairs, writes each operand's leaves for the OpenVDB side (four
 //! little-endian `i32` per leaf: x, y, z of its lowest voxel, log2 of its side), and
 //! times union, intersection and difference on `THREADS` rayon threads (best of
-//! `REPS`; on one thread the process's CPU time, on more the wall time). The timed call is `LinearOctree::set_op` on two trees in one space: it
-//! returns a new tree in canonical form (maximal blocks), its allocation included.
+//! `REPS`; on one thread the process's CPU time, on more the wall time).
+//!
+//! The timed call is `LinearOctree::set_op` on two trees in one space whose bricked
+//! forms were made outside the clock (as the OpenVDB side builds its grids outside
+//! it): it returns a new tree in canonical form, in bricked form, its allocation
+//! included. Also timed: making the two bricked forms from the leaf lists, making
+//! the result's leaf list (`leaves()`, its first call), and the same operation on
+//! the leaf lists (neither operand bricked), whose result is checked to be equal.
 //!
 //! `cargo run --release -p tesseral --example setops_peer -- DIR REPS THREADS SCENES [ONLY]`
 //! (ONLY: time the workloads whose name contains it).
 //!
-//! Prints one line per workload and operation:
-//! `RESULT <workload> <op> <ms> <voxels> <bytes/voxel> <leaves>`, where bytes/voxel
-//! is the heap size of the result's leaf list over its voxel count.
+//! Prints per workload
+//! `INPUT <workload> <voxels a> <voxels b> <leaves a> <leaves b> <ms to brick both> <bricked bytes of both>`
+//! and per operation
+//! `RESULT <workload> <op> <ms> <voxels> <bytes/voxel> <leaves> <ms leaf path> <ms leaves()> <bytes/voxel leaf path>`,
+//! where bytes/voxel is the result's heap size (bricked form only; for the leaf
+//! path its leaf list) over its voxel count.
 
 use std::io::Write;
 use std::path::Path;
@@ -167,37 +176,74 @@ fn main() {
     for (name, a, b) in work.iter().filter(|w| w.0.contains(only)) {
         export(a, &dir.join(format!("{name}.a.leaves")));
         export(b, &dir.join(format!("{name}.b.leaves")));
+        // The bricked forms: the time to make both from the leaf lists (best of
+        // REPS, each on fresh leaf-only copies made outside the clock).
+        let mut brick_ms = f64::MAX;
+        for _ in 0..reps {
+            let (x, y) = (a.clone(), b.clone());
+            let t0 = process_cpu();
+            x.build_bricks();
+            y.build_bricks();
+            brick_ms = brick_ms.min(process_cpu() - t0);
+        }
+        let (ab, bb) = (a.clone(), b.clone());
+        ab.build_bricks();
+        bb.build_bricks();
         println!(
-            "INPUT {name} {} {} {} {}",
+            "INPUT {name} {} {} {} {} {:.4} {}",
             a.voxel_count(),
             b.voxel_count(),
             a.leaf_count(),
-            b.leaf_count()
+            b.leaf_count(),
+            brick_ms * 1e3,
+            // The clones hold their leaf lists at capacity = length.
+            ab.heap_bytes() + bb.heap_bytes() - 8 * (a.leaf_count() + b.leaf_count()),
         );
         for (op_name, op) in [
             ("union", SetOp::Union),
             ("intersection", SetOp::Intersection),
             ("difference", SetOp::Difference),
         ] {
-            let mut best = f64::MAX;
-            let mut out = None;
-            for _ in 0..reps {
-                drop(out.take());
-                // One thread: the process's CPU time. More: wall time.
-                let (start, t0) = (Instant::now(), process_cpu());
-                let o = a.set_op(b, op).expect("same space");
-                let (wall, cpu) = (start.elapsed().as_secs_f64(), process_cpu() - t0);
-                best = best.min(if threads == 1 { cpu } else { wall });
-                out = Some(o);
-            }
-            let out = out.expect("reps > 0");
+            // The operation on the bricked forms (what the ratio is of).
+            let (best, out) = best_of(reps, threads, || ab.set_op(&bb, op).expect("same space"));
             let voxels = out.voxel_count();
             let bytes = out.heap_bytes() as f64 / (voxels.max(1)) as f64;
+            // The leaf list of a bricked result, made on first use.
+            let mut leaves_ms = f64::MAX;
+            for _ in 0..reps {
+                let r = ab.set_op(&bb, op).expect("same space");
+                let t0 = process_cpu();
+                std::hint::black_box(r.leaves());
+                leaves_ms = leaves_ms.min(process_cpu() - t0);
+            }
+            // The same operation on the leaf lists (neither operand bricked).
+            let (leaf_best, leaf_out) =
+                best_of(reps, threads, || a.set_op(b, op).expect("same space"));
+            assert!(leaf_out == out, "the two paths disagree");
+            let leaf_bytes = leaf_out.heap_bytes() as f64 / (voxels.max(1)) as f64;
             println!(
-                "RESULT {name} {op_name} {:.4} {voxels} {bytes:.4} {}",
+                "RESULT {name} {op_name} {:.4} {voxels} {bytes:.4} {} {:.4} {:.4} {leaf_bytes:.4}",
                 best * 1e3,
-                out.leaf_count()
+                out.leaf_count(),
+                leaf_best * 1e3,
+                leaves_ms * 1e3,
             );
         }
     }
+}
+
+/// The best time of `reps` calls of `f` (one thread: the process's CPU time; more:
+/// wall time) and the last result; each result is dropped before the next call.
+fn best_of(reps: usize, threads: usize, f: impl Fn() -> LinearOctree) -> (f64, LinearOctree) {
+    let mut best = f64::MAX;
+    let mut out = None;
+    for _ in 0..reps {
+        drop(out.take());
+        let (start, t0) = (Instant::now(), process_cpu());
+        let o = f();
+        let (wall, cpu) = (start.elapsed().as_secs_f64(), process_cpu() - t0);
+        best = best.min(if threads == 1 { cpu } else { wall });
+        out = Some(o);
+    }
+    (best, out.expect("reps > 0"))
 }

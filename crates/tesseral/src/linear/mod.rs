@@ -7,7 +7,9 @@
 //! Two equal solids in the same space therefore have equal leaf lists.
 
 mod affine;
+mod bbox;
 mod box_state;
+mod bricked;
 mod bricks;
 mod build;
 mod enumerate;
@@ -30,8 +32,11 @@ pub use node_list::{Node, NodeColour};
 pub use ops::SetOp;
 pub use transform::rotation_labels;
 
+use std::sync::OnceLock;
+
 use crate::code;
 use crate::Voxel;
+use bricked::Bricked;
 
 /// The deepest linear octree: its codes fit a `u64` ([`code::MAX_DEPTH_U64`]).
 pub const MAX_DEPTH: u8 = code::MAX_DEPTH_U64 as u8;
@@ -77,6 +82,12 @@ pub enum OctreeError {
 
 /// A solid as a sorted list of maximal black blocks (a linear octree).
 ///
+/// The tree holds its leaves in one or both of two forms (see ARCHITECTURE.md,
+/// "Bricked set operations"): the leaf list that [`LinearOctree::leaves`] returns,
+/// and a bricked form (leaves of side 8 or more, and each mixed 8³ cell as a
+/// 512-bit mask) on which the set operations run. Each form is made from the other
+/// on first use and kept.
+///
 /// ```
 /// use tesseral::linear::LinearOctree;
 /// let voxels = (0..2).flat_map(|x| (0..2).flat_map(move |y| (0..2).map(move |z| [x, y, z])));
@@ -85,11 +96,40 @@ pub enum OctreeError {
 /// assert_eq!(tree.voxel_count(), 8);
 /// assert!(tree.contains([1, 1, 1]) && !tree.contains([2, 0, 0]));
 /// ```
-#[derive(Debug, Clone, PartialEq, Eq, Hash)]
+#[derive(Debug, Clone)]
 pub struct LinearOctree {
     depth: u8,
     origin: Voxel,
-    leaves: Vec<Leaf>,
+    /// The leaf list; set at construction, or made from `bricked` on first use.
+    leaves: OnceLock<Vec<Leaf>>,
+    /// The bricked form; set by a set operation, or made from `leaves` on first use.
+    /// At least one of the two is always set.
+    bricked: OnceLock<Bricked>,
+}
+
+impl PartialEq for LinearOctree {
+    fn eq(&self, other: &Self) -> bool {
+        if self.depth != other.depth || self.origin != other.origin {
+            return false;
+        }
+        // Both forms are canonical, so either one compares the solids.
+        match (self.bricked.get(), other.bricked.get()) {
+            (Some(a), Some(b)) if self.leaves.get().is_none() || other.leaves.get().is_none() => {
+                a == b
+            }
+            _ => self.leaves() == other.leaves(),
+        }
+    }
+}
+
+impl Eq for LinearOctree {}
+
+impl std::hash::Hash for LinearOctree {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.depth.hash(state);
+        self.origin.hash(state);
+        self.leaves().hash(state);
+    }
 }
 
 impl LinearOctree {
@@ -99,11 +139,7 @@ impl LinearOctree {
     /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
     pub fn empty(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
         check_space(depth, origin)?;
-        Ok(Self {
-            depth,
-            origin,
-            leaves: Vec::new(),
-        })
+        Ok(Self::from_parts(depth, origin, Vec::new()))
     }
 
     /// A tree whose whole space is black.
@@ -112,11 +148,7 @@ impl LinearOctree {
     /// [`OctreeError::DepthTooLarge`] when `depth > MAX_DEPTH`.
     pub fn full(depth: u8, origin: Voxel) -> Result<Self, OctreeError> {
         check_space(depth, origin)?;
-        Ok(Self {
-            depth,
-            origin,
-            leaves: vec![Leaf::new(0, depth)],
-        })
+        Ok(Self::from_parts(depth, origin, vec![Leaf::new(0, depth)]))
     }
 
     /// Builds a tree from leaves that are already sorted and disjoint (not necessarily
@@ -140,11 +172,7 @@ impl LinearOctree {
         for leaf in leaves {
             push_merging(&mut merged, leaf);
         }
-        Ok(Self {
-            depth,
-            origin,
-            leaves: merged,
-        })
+        Ok(Self::from_parts(depth, origin, merged))
     }
 
     /// Builds a tree from black voxels in world coordinates, in any order, duplicates
@@ -162,11 +190,7 @@ impl LinearOctree {
         voxels: impl IntoIterator<Item = Voxel>,
     ) -> Result<Self, OctreeError> {
         check_space(depth, origin)?;
-        let space = Self {
-            depth,
-            origin,
-            leaves: Vec::new(),
-        };
+        let space = Self::from_parts(depth, origin, Vec::new());
         let mut codes = voxels
             .into_iter()
             .map(|v| space.code_of(v).ok_or(OctreeError::OutOfBounds(v)))
@@ -224,26 +248,51 @@ impl LinearOctree {
 
     /// The black leaves, sorted in tesseral order.
     #[must_use]
+    ///
+    /// # Runtime
+    /// O(1), except on a tree made by a set operation, whose first call makes the
+    /// list from the bricked form (O(n), kept).
     pub fn leaves(&self) -> &[Leaf] {
-        &self.leaves
+        self.leaves.get_or_init(|| {
+            self.bricked
+                .get()
+                .expect("a tree holds its leaves in at least one form")
+                .to_leaves()
+        })
     }
 
     /// The number of black leaves (maximal blocks).
+    ///
+    /// # Runtime
+    /// O(1) when the tree holds its leaf list; otherwise O(n), counted off the
+    /// bricked form without making the list.
     #[must_use]
     pub fn leaf_count(&self) -> usize {
-        self.leaves.len()
+        match (self.leaves.get(), self.bricked.get()) {
+            (Some(l), _) => l.len(),
+            (None, Some(b)) => b.leaf_count(),
+            (None, None) => unreachable!("a tree holds its leaves in at least one form"),
+        }
     }
 
-    /// The bytes the leaf list holds on the heap (its capacity, 8 bytes a leaf).
+    /// The bytes the tree holds on the heap: the leaf list's capacity (8 bytes a
+    /// leaf) plus, when it is held, the bricked form's (8 bytes an entry, 64 a mask).
     #[must_use]
     pub fn heap_bytes(&self) -> usize {
-        self.leaves.capacity() * std::mem::size_of::<Leaf>()
+        self.leaves
+            .get()
+            .map_or(0, |l| l.capacity() * std::mem::size_of::<Leaf>())
+            + self.bricked.get().map_or(0, Bricked::heap_bytes)
     }
 
     /// Whether no voxel is black.
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.leaves.is_empty()
+        match (self.leaves.get(), self.bricked.get()) {
+            (Some(l), _) => l.is_empty(),
+            (None, Some(b)) => b.is_empty(),
+            (None, None) => unreachable!("a tree holds its leaves in at least one form"),
+        }
     }
 
     /// The number of black voxels.
@@ -252,42 +301,21 @@ impl LinearOctree {
     /// O(n) in the number of leaves.
     #[must_use]
     pub fn voxel_count(&self) -> u64 {
-        self.leaves.iter().map(|l| l.voxel_count()).sum()
+        match (self.leaves.get(), self.bricked.get()) {
+            (Some(l), _) => l.iter().map(|l| l.voxel_count()).sum(),
+            (None, Some(b)) => b.voxel_count(),
+            (None, None) => unreachable!("a tree holds its leaves in at least one form"),
+        }
     }
 
     /// The number of leaves at each depth, index 0 being the root.
     #[must_use]
     pub fn leaves_by_depth(&self) -> Vec<u64> {
         let mut counts = vec![0; usize::from(self.depth) + 1];
-        for l in &self.leaves {
+        for l in self.leaves() {
             counts[usize::from(self.depth - l.size_log2())] += 1;
         }
         counts
-    }
-
-    /// The inclusive bounding box `(min, max)` of the black voxels, or `None` when empty.
-    ///
-    /// # Runtime
-    /// Six pruned descents (one per face): cells that cannot beat the best face
-    /// found so far are skipped, so a compact solid costs O(depth · log n); at
-    /// worst O(n log n).
-    #[must_use]
-    pub fn bbox(&self) -> Option<(Voxel, Voxel)> {
-        if self.leaves.is_empty() {
-            return None;
-        }
-        let mut lo = [0i64; 3];
-        let mut hi = [0i64; 3];
-        for a in 0..3 {
-            let mut best = u64::MAX;
-            extreme(&self.leaves, 0, self.depth, [0; 3], a, false, &mut best);
-            lo[a] = self.origin[a] + best as i64;
-            let mut best = u64::MAX;
-            extreme(&self.leaves, 0, self.depth, [0; 3], a, true, &mut best);
-            // For the maximum the search minimises a reversed coordinate.
-            hi[a] = self.origin[a] + (REVERSED_TOP - best) as i64;
-        }
-        Some((lo, hi))
     }
 
     /// Whether world voxel `v` is black.
@@ -299,8 +327,9 @@ impl LinearOctree {
         let Some(c) = self.code_of(v) else {
             return false;
         };
-        let i = self.leaves.partition_point(|l| l.code() <= c);
-        i > 0 && self.leaves[i - 1].contains_code(c)
+        let leaves = self.leaves();
+        let i = leaves.partition_point(|l| l.code() <= c);
+        i > 0 && leaves[i - 1].contains_code(c)
     }
 
     /// The tesseral code of world voxel `v` relative to the origin, or `None` when `v`
@@ -332,7 +361,7 @@ impl LinearOctree {
 
     /// The black blocks in tesseral order, in world coordinates.
     pub fn blocks(&self) -> impl ExactSizeIterator<Item = Block> + '_ {
-        self.leaves.iter().map(|l| Block {
+        self.leaves().iter().map(|l| Block {
             min: self.voxel_of(l.code()),
             size_log2: l.size_log2(),
         })
@@ -340,13 +369,15 @@ impl LinearOctree {
 
     /// Every black voxel, in tesseral order.
     pub fn voxels(&self) -> impl Iterator<Item = Voxel> + '_ {
-        self.leaves
+        self.leaves()
             .iter()
             .flat_map(|l| (l.code()..l.end()).map(|c| self.voxel_of(c)))
     }
 
     /// Panics with a description of the first broken invariant: leaves sorted, disjoint,
-    /// aligned to their size, inside the space, and canonically merged.
+    /// aligned to their size, inside the space, and canonically merged; and, when the
+    /// tree holds its bricked form, that form's invariants and its agreement with the
+    /// leaves.
     ///
     /// # Runtime
     /// O(n).
@@ -362,7 +393,25 @@ impl LinearOctree {
             self.origin
         );
         let space_end = 1u64 << (3 * u32::from(self.depth));
-        for (i, l) in self.leaves.iter().enumerate() {
+        // Checked without keeping a leaf list made from the bricked form, so that
+        // the check leaves the tree as it found it.
+        let made;
+        let leaves: &[Leaf] = match (self.leaves.get(), self.bricked.get()) {
+            (Some(l), _) => l,
+            (None, Some(b)) => {
+                made = b.to_leaves();
+                &made
+            }
+            (None, None) => panic!("a tree holds neither form"),
+        };
+        if let Some(b) = self.bricked.get() {
+            b.assert_valid(self.depth);
+            assert!(
+                *b == Bricked::from_leaves(leaves),
+                "the bricked form and the leaves disagree"
+            );
+        }
+        for (i, l) in leaves.iter().enumerate() {
             assert!(
                 l.size_log2() <= self.depth,
                 "leaf {i} larger than the space"
@@ -374,7 +423,7 @@ impl LinearOctree {
             );
             assert!(l.end() <= space_end, "leaf {i} outside the space");
             if i > 0 {
-                let p = self.leaves[i - 1];
+                let p = leaves[i - 1];
                 assert!(
                     p.end() <= l.code(),
                     "leaves {} and {i} unsorted or overlapping",
@@ -382,7 +431,7 @@ impl LinearOctree {
                 );
             }
             if i >= 7 {
-                let run = &self.leaves[i - 7..=i];
+                let run = &leaves[i - 7..=i];
                 assert!(
                     !completes_parent(run),
                     "leaves {}..={i} are eight unmerged siblings",
@@ -396,7 +445,18 @@ impl LinearOctree {
         Self {
             depth,
             origin,
-            leaves,
+            leaves: OnceLock::from(leaves),
+            bricked: OnceLock::new(),
+        }
+    }
+
+    /// A tree held in the bricked form only (its leaf list made on first use).
+    pub(crate) fn from_bricked(depth: u8, origin: Voxel, bricked: Bricked) -> Self {
+        Self {
+            depth,
+            origin,
+            leaves: OnceLock::new(),
+            bricked: OnceLock::from(bricked),
         }
     }
 }
@@ -412,81 +472,6 @@ fn check_space(depth: u8, origin: Voxel) -> Result<(), OctreeError> {
         return Err(OctreeError::SpaceOverflow { depth, origin });
     }
     Ok(())
-}
-
-/// The least coordinate on `axis` of a black voxel in the cell `(code, k)` whose
-/// lowest voxel is `min` (relative), over `leaves` (all inside the cell or one
-/// covering it); with `reversed`, of the coordinate counted from the top of the
-/// space. Lowers `best`; skips cells that cannot beat it.
-fn extreme(
-    leaves: &[Leaf],
-    code: u64,
-    k: u8,
-    min: [u64; 3],
-    axis: usize,
-    reversed: bool,
-    best: &mut u64,
-) {
-    if leaves.is_empty() {
-        return;
-    }
-    // The cell's own extreme on the axis, in the search's direction.
-    let cell_near = cell_near(min, k, axis, reversed);
-    if cell_near >= *best {
-        return;
-    }
-    if leaves.len() == 1 && leaves[0].size_log2() >= k {
-        *best = cell_near;
-        return;
-    }
-    let half = 1u64 << (k - 1);
-    let child = 1u64 << (3 * u32::from(k - 1));
-    let mut parts: [&[Leaf]; 8] = [&[]; 8];
-    let mut rest = leaves;
-    for (d, part) in parts.iter_mut().enumerate() {
-        let end = code + (d as u64 + 1) * child;
-        let n = rest.partition_point(|l| l.packed() < end << 1);
-        *part = &rest[..n];
-        rest = &rest[n..];
-    }
-    // Visit the near half on the axis first: it is the likelier to hold the best.
-    let near_bit = usize::from(reversed);
-    for side in [near_bit, 1 - near_bit] {
-        for (d, part) in parts.iter().enumerate() {
-            if (d >> axis) & 1 != side {
-                continue;
-            }
-            let m = [
-                min[0] + (d as u64 & 1) * half,
-                min[1] + ((d as u64 >> 1) & 1) * half,
-                min[2] + ((d as u64 >> 2) & 1) * half,
-            ];
-            extreme(
-                part,
-                code + d as u64 * child,
-                k - 1,
-                m,
-                axis,
-                reversed,
-                best,
-            );
-        }
-    }
-}
-
-/// Reversed coordinates count down from here, so that one minimising search finds
-/// both faces: the highest coordinate `c` is the least `REVERSED_TOP - c`.
-const REVERSED_TOP: u64 = u64::MAX >> 1;
-
-/// The best coordinate any voxel of the cell could give the search: the cell's
-/// lowest on `axis`, or (reversed) its highest, reversed.
-#[inline]
-fn cell_near(min: [u64; 3], k: u8, axis: usize, reversed: bool) -> u64 {
-    if reversed {
-        REVERSED_TOP - (min[axis] + (1u64 << k) - 1)
-    } else {
-        min[axis]
-    }
 }
 
 /// Whether eight leaves (sorted, disjoint) are the eight children of one parent.
@@ -544,6 +529,6 @@ pub(crate) mod tests;
 #[cfg(test)]
 mod tests_affine;
 #[cfg(test)]
-mod tests_merge;
+pub(crate) mod tests_merge;
 #[cfg(test)]
 pub(crate) mod tests_ops;

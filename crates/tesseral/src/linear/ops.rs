@@ -8,12 +8,17 @@
 //! only one operand has are copied or skipped as slices. On one thread the whole
 //! space is one merge; on more, large inputs are split by octant and merged in
 //! parallel with rayon.
+//!
+//! When either operand holds its bricked form (`bricked/`), the operation runs on
+//! the bricked forms instead, one merge per level with the bottom three levels
+//! combined word by word, and returns a tree in bricked form.
 
 // Per-axis loops index several arrays at once.
 #![allow(clippy::needless_range_loop)]
 
 use rayon::prelude::*;
 
+use super::bricked::{self, Bricked};
 use super::merge::{difference, intersection, symmetric_difference, union};
 use super::{grow, push_merging, Leaf, LinearOctree, OctreeError};
 
@@ -55,7 +60,10 @@ impl LinearOctree {
     ///
     /// # Runtime
     /// O(n + m) leaves in a shared space, in parallel for large inputs; aligning a
-    /// foreign operand costs one [`LinearOctree::resample`] of it.
+    /// foreign operand costs one [`LinearOctree::resample`] of it. When either
+    /// operand holds its bricked form ([`LinearOctree::build_bricks`]), the merge
+    /// runs on the bricked forms (O(n + m) entries and masks, chunks that only one
+    /// operand has passed on without copying) and the result is held in bricked form.
     ///
     /// # Errors
     /// [`OctreeError::DepthTooLarge`] when the grown space would exceed
@@ -79,6 +87,9 @@ impl LinearOctree {
         };
         let a = self.expand_to(depth, origin);
         let (b, _) = other.resample(depth, origin)?;
+        if self.has_bricked() || other.has_bricked() {
+            a.build_bricks();
+        }
         Ok(a.set_op_same_space(&b, op))
     }
 
@@ -121,7 +132,7 @@ impl LinearOctree {
     /// As [`LinearOctree::set_op`], when the spaces differ and aligning them fails.
     pub fn same_voxels(&self, other: &Self) -> Result<bool, OctreeError> {
         if self.depth == other.depth && self.origin == other.origin {
-            return Ok(self.leaves == other.leaves);
+            return Ok(self == other);
         }
         if self.voxel_count() != other.voxel_count() {
             return Ok(false);
@@ -144,11 +155,17 @@ impl LinearOctree {
     #[must_use]
     pub fn complement(&self) -> Self {
         let full = [Leaf::new(0, self.depth)];
-        let min = split_min_leaves(self.leaves.len());
+        if self.has_bricked() {
+            let full = Bricked::from_leaves(&full);
+            let out = bricked::set_op(&full, self.bricked(), SetOp::Difference);
+            return Self::from_bricked(self.depth, self.origin, out);
+        }
+        let leaves = self.leaves();
+        let min = split_min_leaves(leaves.len());
         let mut leaves = merge_cell(
             SetOp::Difference,
             Part::Leaves(&full),
-            Part::Leaves(&self.leaves),
+            Part::Leaves(leaves),
             0,
             self.depth,
             min,
@@ -167,15 +184,13 @@ impl LinearOctree {
             self.depth == other.depth && self.origin == other.origin,
             "set_op_same_space on different spaces"
         );
-        let min = split_min_leaves(self.leaves.len() + other.leaves.len());
-        let mut leaves = merge_cell(
-            op,
-            Part::Leaves(&self.leaves),
-            Part::Leaves(&other.leaves),
-            0,
-            self.depth,
-            min,
-        );
+        if self.has_bricked() || other.has_bricked() {
+            let out = bricked::set_op(self.bricked(), other.bricked(), op);
+            return Self::from_bricked(self.depth, self.origin, out);
+        }
+        let (a, b) = (self.leaves(), other.leaves());
+        let min = split_min_leaves(a.len() + b.len());
+        let mut leaves = merge_cell(op, Part::Leaves(a), Part::Leaves(b), 0, self.depth, min);
         leaves.shrink_to_fit();
         Self::from_parts(self.depth, self.origin, leaves)
     }

@@ -10,16 +10,16 @@ use super::merge::{self, ending_by, inside, span2};
 use super::tests_ops::ball;
 use super::*;
 
-type Model = HashSet<Voxel>;
+pub(crate) type Model = HashSet<Voxel>;
 
-const OPS: [SetOp; 4] = [
+pub(crate) const OPS: [SetOp; 4] = [
     SetOp::Union,
     SetOp::Intersection,
     SetOp::Difference,
     SetOp::SymmetricDifference,
 ];
 
-fn model_op(op: SetOp, a: &Model, b: &Model) -> Model {
+pub(crate) fn model_op(op: SetOp, a: &Model, b: &Model) -> Model {
     match op {
         SetOp::Union => a | b,
         SetOp::Intersection => a & b,
@@ -28,12 +28,12 @@ fn model_op(op: SetOp, a: &Model, b: &Model) -> Model {
     }
 }
 
-fn canonical(depth: u8, model: &Model) -> LinearOctree {
+pub(crate) fn canonical(depth: u8, model: &Model) -> LinearOctree {
     LinearOctree::from_voxels(depth, [0; 3], model.iter().copied()).unwrap()
 }
 
 /// splitmix64.
-fn next(s: &mut u64) -> u64 {
+pub(crate) fn next(s: &mut u64) -> u64 {
     *s = s.wrapping_add(0x9E37_79B9_7F4A_7C15);
     let mut z = *s;
     z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
@@ -44,7 +44,14 @@ fn next(s: &mut u64) -> u64 {
 /// A random solid in the sub-cube `[lo, lo + side)^3` of a depth-`depth` space:
 /// `blocks` aligned blocks of random sizes (so leaves nest across operands) and
 /// voxels of the given density in percent (so single voxels interleave).
-fn solid(depth: u8, lo: [i64; 3], side: i64, blocks: u32, density: u64, seed: u64) -> Model {
+pub(crate) fn solid(
+    depth: u8,
+    lo: [i64; 3],
+    side: i64,
+    blocks: u32,
+    density: u64,
+    seed: u64,
+) -> Model {
     let mut s = seed;
     let mut m = Model::new();
     for _ in 0..blocks {

@@ -110,7 +110,7 @@ impl LinearOctree {
             (1u64 << (3 * u32::from(self.depth))) - 1
         };
         let mut leaves: Vec<Leaf> = self
-            .leaves
+            .leaves()
             .iter()
             .map(|l| {
                 let k = u32::from(l.size_log2());
@@ -152,7 +152,7 @@ impl LinearOctree {
         }
         let shift = 3 * u32::from(s);
         let leaves = self
-            .leaves
+            .leaves()
             .iter()
             .map(|l| Leaf::new(l.code() << shift, l.size_log2() + s))
             .collect();
@@ -205,8 +205,8 @@ impl LinearOctree {
         let new_depth = depth.saturating_sub(s);
         let shift = 3 * u32::from(s);
         let origin = aligned_origin.map(|o| (i128::from(o).div_euclid(cell)) as i64);
-        let mut out: Vec<Leaf> = Vec::with_capacity(src.leaves.len());
-        for l in &src.leaves {
+        let mut out: Vec<Leaf> = Vec::with_capacity(src.leaves().len());
+        for l in src.leaves() {
             let code = l.code().checked_shr(shift).unwrap_or(0);
             let k = l.size_log2().saturating_sub(s);
             if out.last().is_some_and(|p| p.contains_code(code)) {
@@ -245,7 +245,7 @@ impl LinearOctree {
         }
         let mut out = Vec::new();
         crop_cell(
-            &self.leaves,
+            self.leaves(),
             [0; 3],
             self.depth,
             0,

@@ -119,7 +119,7 @@ impl LinearOctree {
     /// The general top-down resample; `delta` is the new origin minus ours.
     pub(super) fn resample_general(&self, depth: u8, delta: [i64; 3]) -> Vec<Leaf> {
         let compact = self.depth >= 2 && depth >= 2;
-        let mut index = Index::new(&self.leaves, self.depth, compact);
+        let mut index = Index::new(self.leaves(), self.depth, compact);
         // Wrap the input in gray ancestors until it is at least as deep as the
         // output (the input space becomes child 0 of each new root), so windows at
         // every output depth can be read from the index.
@@ -164,10 +164,10 @@ impl LinearOctree {
             index: &index,
             cut: Cut::new(r(2.min(depth))),
             depth,
-            input_leaves: self.leaves.len(),
+            input_leaves: self.leaves().len(),
             tables,
         };
-        let mut out = Vec::with_capacity(self.leaves.len());
+        let mut out = Vec::with_capacity(self.leaves().len());
         resampler.cell(depth, window, 0, &mut out);
         out
     }
@@ -182,7 +182,12 @@ impl LinearOctree {
         delta: [i64; 3],
         all_inside: bool,
     ) -> Option<Vec<Leaf>> {
-        let max_k = self.leaves.iter().map(|l| l.size_log2()).max().unwrap_or(0);
+        let max_k = self
+            .leaves()
+            .iter()
+            .map(|l| l.size_log2())
+            .max()
+            .unwrap_or(0);
         // Cells of side 2^a move whole: a is the displacement's alignment, capped
         // by the new space; every leaf must fit in such a cell.
         let align = delta
@@ -211,7 +216,7 @@ impl LinearOctree {
         };
         // Runs of leaves sharing a cell, with the cell's new code.
         let mut runs: Vec<(u64, usize, usize)> = Vec::new();
-        let mut rest = &self.leaves[..];
+        let mut rest = self.leaves();
         let mut start = 0;
         while let Some(first) = rest.first() {
             let cell = first.code() & !low;
@@ -226,9 +231,9 @@ impl LinearOctree {
         if !runs.is_sorted_by_key(|r| r.0) {
             runs.sort_unstable_by_key(|r| r.0);
         }
-        let mut out = Vec::with_capacity(self.leaves.len());
+        let mut out = Vec::with_capacity(self.leaves().len());
         for (cell, i, j) in runs {
-            let part = &self.leaves[i..j];
+            let part = &self.leaves()[i..j];
             if part.len() == 1 && part[0].size_log2() == a {
                 // A full cell: it may complete a parent with its new neighbours.
                 push_merging(&mut out, Leaf::new(cell, a));
