@@ -29,6 +29,7 @@ mod index;
 pub mod scene;
 mod shape;
 mod stream;
+mod stream_colours;
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -140,5 +140,9 @@ pub fn stream_set_op(
     }
     let leaves = tw.leaf_count();
     tw.finish(frame).map_err(io)?;
-    Ok(StreamSummary { leaves, voxels })
+    Ok(StreamSummary {
+        leaves,
+        voxels,
+        colours: 0,
+    })
 }

@@ -28,7 +28,7 @@ pub use dataset::{
     is_dataset, read_dataset, read_dataset_model, write_dataset, Manifest, ManifestPart, MANIFEST,
 };
 pub use merge::stream_set_op;
-pub use stream::{build_scene_dataset, write_plan_tess, StreamSummary};
+pub use stream::{build_scene_dataset, write_plan_tess, write_plan_tess_coloured, StreamSummary};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]
