@@ -222,36 +222,24 @@ fn partitioned_datasets_read_as_one_model() {
     );
 }
 
-/// `op` on two chunked `.tess` files into a `.tess` file merges the two streams;
-/// the result equals the in-memory operation voxel for voxel.
+/// `op` on two chunked, coloured `.tess` files into a `.tess` file merges the two
+/// streams; the result equals the in-memory operation voxel for voxel, colours
+/// included.
 #[test]
 fn streamed_set_operations_equal_the_in_memory_ones() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let a = scenes().join("showcase.tss");
     let b = scenes().join("fig4c-spheroid.tss");
-    // Without their colours (coloured inputs take the in-memory path). The
-    // spheroid's frame differs from the showcase's: give b a's frame by building it
-    // from a scene with a's bounds.
-    let plain = |text: String| -> String {
-        text.lines()
-            .map(|l| l.split(" colour ").next().unwrap_or(l))
-            .collect::<Vec<_>>()
-            .join("\n")
-    };
-    fs::write(d.join("a.tss"), plain(fs::read_to_string(&a).unwrap())).unwrap();
-    let text = plain(fs::read_to_string(&b).unwrap()).replace(
+    // The spheroid's frame differs from the showcase's: give b a's frame by
+    // building it from a scene with a's bounds. Both are coloured.
+    let text = fs::read_to_string(&b).unwrap().replace(
         "bounds [0, 0, 0] [1000, 1000, 1000]",
         "bounds [0, 0, 0] [1024, 1024, 1024]",
     );
     fs::write(d.join("b.tss"), text).unwrap();
-    // A scene's objects all have colours (the palette's by default): drop them
-    // through .xyz, which keeps the shape only.
-    for (scene, out) in [("a.tss", "a.tess"), ("b.tss", "b.tess")] {
-        ok(d, &["build", scene, "-o", "c.tess", "--depth", "7"]);
-        ok(d, &["convert", "c.tess", "c.xyz"]);
-        ok(d, &["convert", "c.xyz", out]);
-    }
+    ok(d, &["build", a.to_str().unwrap(), "-o", "a.tess", "--depth", "7"]);
+    ok(d, &["build", "b.tss", "-o", "b.tess", "--depth", "7"]);
     for op in ["union", "intersection", "difference", "xor"] {
         let v = json(d, &["op", op, "a.tess", "b.tess", "-o", "s.tess", "--json"]);
         assert_eq!(v["streamed"], true, "{op}");
@@ -262,6 +250,14 @@ fn streamed_set_operations_equal_the_in_memory_ones() {
         assert_eq!(
             fs::read_to_string(d.join("s.xyz")).unwrap(),
             fs::read_to_string(d.join("m.xyz")).unwrap(),
+            "{op}"
+        );
+        // The colours too, voxel for voxel (.vox writes each voxel's colour).
+        ok(d, &["op", op, "a.tess", "b.tess", "-o", "m.vox"]);
+        ok(d, &["convert", "s.tess", "s.vox"]);
+        assert_eq!(
+            fs::read(d.join("s.vox")).unwrap(),
+            fs::read(d.join("m.vox")).unwrap(),
             "{op}"
         );
     }

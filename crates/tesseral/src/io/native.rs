@@ -356,4 +356,4 @@ fn decode_v1(bytes: &[u8]) -> Result<Model, FormatError> {
 
 #[cfg(test)]
 #[path = "native_tests.rs"]
-mod tests;
+pub(crate) mod tests;

@@ -235,6 +235,24 @@ impl TessFile {
         })
     }
 
+    /// The colour regions as streams of leaves, decoded as they are read, for a
+    /// version-2 file whose only layer is colours; `None` when it has other layers
+    /// or is version 1 (read it with [`TessFile::to_model`]).
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad colour section.
+    pub fn colour_streams(
+        &self,
+    ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
+        match &self.body {
+            Body::Chunked(bytes, layout) => {
+                super::tess_colours::colour_regions(bytes, layout.sections, layout.depth)
+                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))
+            }
+            Body::Decoded(_) => Ok(None),
+        }
+    }
+
     /// The whole model, read chunk by chunk (as [`super::native::read`]).
     ///
     /// # Errors
