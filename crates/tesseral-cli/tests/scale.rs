@@ -156,7 +156,18 @@ fn streamed_builds_keep_the_scene_colours() {
     ok(d, &["convert", "s.tess", "s.vox"]);
     let want = fs::read(d.join("m.vox")).unwrap();
     assert_eq!(fs::read(d.join("s.vox")).unwrap(), want);
+    // `info` streams the file (chunks and colour regions read as streams) and
+    // says what the in-memory model of the scene says, key for key.
+    assert_eq!(
+        json(d, &["info", "s.tess", "--json"]),
+        json(d, &["info", s, "--json"])
+    );
+    assert!(ok(d, &["info", "s.tess"]).contains("colours  8 distinct"));
     ok(d, &["build", s, "--parts", "3", "-o", "ds"]);
+    assert_eq!(
+        json(d, &["info", "ds", "--json"]),
+        json(d, &["info", s, "--json"])
+    );
     ok(d, &["convert", "ds", "ds.vox"]);
     assert_eq!(fs::read(d.join("ds.vox")).unwrap(), want);
     // A render of the streamed file shows the colours: the same picture as the
