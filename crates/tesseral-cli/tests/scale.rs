@@ -103,7 +103,9 @@ fn streamed_build_budgets_and_refusals() {
     // No fixed leaf limit in memory: the memory budget decides, before the work.
     fails(
         d,
-        &["build", s, "-o", "s.xyz", "--depth", "10", "--memory", "10M"],
+        &[
+            "build", s, "-o", "s.xyz", "--depth", "10", "--memory", "10M",
+        ],
         "--memory 10.0 MiB",
     );
     assert!(!d.join("s.xyz").exists());
@@ -121,7 +123,10 @@ fn the_plain_tess_build_streams_within_the_output_estimate() {
     let scene = scenes().join("fig4c-spheroid.tss");
     let s = scene.to_str().unwrap();
     let args = ["build", s, "-o", "big.tess", "--depth", "10", "--json"];
-    let v = json(d, &[&args[..], &["--max-output", "3M", "--memory", "200M"]].concat());
+    let v = json(
+        d,
+        &[&args[..], &["--max-output", "3M", "--memory", "200M"]].concat(),
+    );
     assert_eq!(v["streamed"], true);
     let leaves = v["leaves"].as_u64().unwrap();
     assert!(leaves > 800_000, "{v}");
@@ -130,10 +135,16 @@ fn the_plain_tess_build_streams_within_the_output_estimate() {
     // The same build in memory needs about 24 bytes a leaf: over 10 MiB.
     fails(
         d,
-        &["build", s, "-o", "m.xyz", "--depth", "10", "--memory", "10M"],
+        &[
+            "build", s, "-o", "m.xyz", "--depth", "10", "--memory", "10M",
+        ],
         "--memory",
     );
-    fails(d, &[&args[..], &["--max-output", "100K"]].concat(), "--max-output");
+    fails(
+        d,
+        &[&args[..], &["--max-output", "100K"]].concat(),
+        "--max-output",
+    );
 }
 
 /// A coloured scene built streamed (a `.tess` file, and a dataset of parts) keeps its
@@ -146,7 +157,11 @@ fn streamed_builds_keep_the_scene_colours() {
     // The showcase at depth 7 (the same space, voxels 8 times larger).
     let text = fs::read_to_string(scenes().join("showcase.tss")).unwrap();
     assert!(text.contains("\ndepth 10\n"));
-    fs::write(d.join("s7.tss"), text.replace("\ndepth 10\n", "\ndepth 7\n")).unwrap();
+    fs::write(
+        d.join("s7.tss"),
+        text.replace("\ndepth 10\n", "\ndepth 7\n"),
+    )
+    .unwrap();
     let s = "s7.tss";
     let v = json(d, &["build", s, "-o", "s.tess", "--json"]);
     assert_eq!(v["streamed"], true);
@@ -249,7 +264,10 @@ fn streamed_set_operations_equal_the_in_memory_ones() {
         "bounds [0, 0, 0] [1024, 1024, 1024]",
     );
     fs::write(d.join("b.tss"), text).unwrap();
-    ok(d, &["build", a.to_str().unwrap(), "-o", "a.tess", "--depth", "7"]);
+    ok(
+        d,
+        &["build", a.to_str().unwrap(), "-o", "a.tess", "--depth", "7"],
+    );
     ok(d, &["build", "b.tss", "-o", "b.tess", "--depth", "7"]);
     for op in ["union", "intersection", "difference", "xor"] {
         let v = json(d, &["op", op, "a.tess", "b.tess", "-o", "s.tess", "--json"]);

@@ -102,13 +102,15 @@ struct Info {
     log_odds: bool,
 }
 
+/// An inclusive box of voxels.
+type BBox = ([i64; 3], [i64; 3]);
+
 /// The info of a version-2 `.tess` file with no layers but colours, read chunk by
 /// chunk from the map (the leaves never all held), the colour regions as streams.
 /// `None` for other files.
-fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<([i64; 3], [i64; 3])>)>> {
+fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
     use tesseral::io::TessFile;
-    if super::output::is_stdio(path) || !path.is_file() || tesseral::io::extension(path) != "tess"
-    {
+    if super::output::is_stdio(path) || !path.is_file() || tesseral::io::extension(path) != "tess" {
         return Ok(None);
     }
     let f = TessFile::open(path)?;
@@ -124,7 +126,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<([i64; 3], [i
     let space = tesseral::linear::LinearOctree::empty(depth, origin)?;
     let mut by_depth = vec![0u64; usize::from(depth) + 1];
     let (mut voxels, mut leaves) = (0u64, 0usize);
-    let mut bbox: Option<([i64; 3], [i64; 3])> = None;
+    let mut bbox: Option<BBox> = None;
     for l in f.leaves() {
         let l = l?;
         leaves += 1;
@@ -205,7 +207,7 @@ pub fn run(args: Args) -> Result<()> {
     print(&args, &info, bbox)
 }
 
-fn print(args: &Args, info: &Info, bbox: Option<([i64; 3], [i64; 3])>) -> Result<()> {
+fn print(args: &Args, info: &Info, bbox: Option<BBox>) -> Result<()> {
     let frame = tesseral::model::Frame::new(info.voxel_size, info.translate);
     if args.json {
         crate::outln!("{}", serde_json::to_string_pretty(&info)?)?;

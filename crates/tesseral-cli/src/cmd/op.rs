@@ -91,14 +91,12 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     }
     let a = TessFile::open(&args.a)?;
     let b = TessFile::open(&args.b)?;
-    let colours_only = |f: &TessFile| -> Result<bool> {
-        Ok(!f.has_layers() || f.colour_streams()?.is_some())
-    };
-    if !(a.is_streamed() && b.is_streamed())
-        || !colours_only(&a)?
-        || !colours_only(&b)?
-        || (a.depth(), a.origin(), a.frame()) != (b.depth(), b.origin(), b.frame())
-    {
+    let colours_only =
+        |f: &TessFile| -> Result<bool> { Ok(!f.has_layers() || f.colour_streams()?.is_some()) };
+    let same_space = (a.depth(), a.origin(), a.frame()) == (b.depth(), b.origin(), b.frame());
+    let streamable =
+        a.is_streamed() && b.is_streamed() && same_space && colours_only(&a)? && colours_only(&b)?;
+    if !streamable {
         return Ok(None);
     }
     // The colour spools' temporary files go next to the output.

@@ -42,6 +42,7 @@ pub use scene::{Scene, SceneError};
 pub use shape::Shape;
 pub(crate) use stream::clip_leaf;
 pub use stream::{StreamPlan, StreamProgress, STREAM_CELL_LOG2};
+pub use stream_colours::ColouredSink;
 
 use crate::linear::OctreeError;
 

@@ -10,6 +10,10 @@ use super::stream::{clip_leaf, Item, StreamPlan, StreamProgress};
 use super::Csg;
 use crate::linear::{push_merging, CellClass, Leaf};
 
+/// What [`StreamPlan::run_coloured`] hands its leaves to: an item's leaves and, per
+/// colour, its leaves of that colour.
+pub type ColouredSink<'a, E> = dyn FnMut(&[Leaf], &[Vec<Leaf>]) -> Result<(), E> + 'a;
+
 /// One piece of work: a plan item, and whether it counts against the window (a cell
 /// to build, or a block whose colours must be built).
 #[derive(Clone, Copy)]
@@ -34,7 +38,7 @@ impl StreamPlan {
         csg: &Csg,
         colours: &[Csg],
         window: usize,
-        sink: &mut dyn FnMut(&[Leaf], &[Vec<Leaf>]) -> Result<(), E>,
+        sink: &mut ColouredSink<'_, E>,
         progress: &mut dyn FnMut(StreamProgress),
     ) -> Result<(), E> {
         let window = window.max(1);
@@ -257,8 +261,7 @@ mod tests {
                     .flat_map(|l| l.code()..l.end())
                     .filter(|&c| in_range(c))
                     .collect();
-                let got_codes: HashSet<u64> =
-                    got.iter().flat_map(|l| l.code()..l.end()).collect();
+                let got_codes: HashSet<u64> = got.iter().flat_map(|l| l.code()..l.end()).collect();
                 assert!(got_codes == want, "colour {rgba:?} in {range:?}");
                 // Canonical: no eight siblings left unmerged.
                 let t = crate::linear::LinearOctree::from_sorted_leaves(7, [0, 0, 0], got.clone())
@@ -279,13 +282,11 @@ mod tests {
                 let voxels: Vec<[i64; 3]> = (0..rng.random_range(0..300))
                     .map(|_| [0; 3].map(|_: i64| rng.random_range(0..16)))
                     .collect();
-                sets.push(
-                    crate::linear::LinearOctree::from_voxels(4, [0, 0, 0], voxels).unwrap(),
-                );
+                sets.push(crate::linear::LinearOctree::from_voxels(4, [0, 0, 0], voxels).unwrap());
             }
             let got = intersect_leaves(sets[0].leaves(), sets[1].leaves());
-            let t = crate::linear::LinearOctree::from_sorted_leaves(4, [0, 0, 0], got.clone())
-                .unwrap();
+            let t =
+                crate::linear::LinearOctree::from_sorted_leaves(4, [0, 0, 0], got.clone()).unwrap();
             t.assert_valid();
             assert_eq!(t.leaves(), &got[..]);
             let a: HashSet<_> = sets[0].voxels().collect();

@@ -73,7 +73,10 @@ impl LeafSpool {
     /// Writes what is held and gives back the leaf count and the file, rewound.
     fn finish(mut self) -> io::Result<(u64, File)> {
         self.write_out(self.pending.len())?;
-        let mut f = self.file.into_inner().map_err(io::IntoInnerError::into_error)?;
+        let mut f = self
+            .file
+            .into_inner()
+            .map_err(io::IntoInnerError::into_error)?;
         f.rewind()?;
         Ok((self.written, f))
     }
@@ -164,14 +167,16 @@ mod tests {
             )
             .unwrap()
         };
-        let layer = Layer::from_regions(5, [0, 0, 0], [(blue, half(false)), (red, half(true))])
-            .unwrap();
+        let layer =
+            Layer::from_regions(5, [0, 0, 0], [(blue, half(false)), (red, half(true))]).unwrap();
         let frame = Frame::new(0.5, [1.0, 2.0, 3.0]);
         let model = Model {
             colors: Some(layer.clone()),
             ..Model::new(tree.clone()).with_frame(frame)
         };
-        let mut w = TessWriter::new(Vec::new(), 5, [0, 0, 0]).unwrap().with_chunk_leaves(50);
+        let mut w = TessWriter::new(Vec::new(), 5, [0, 0, 0])
+            .unwrap()
+            .with_chunk_leaves(50);
         // Give the spools unmerged voxels: they merge them.
         let mut spools = vec![
             (red, LeafSpool::new_in(dir.path()).unwrap()),

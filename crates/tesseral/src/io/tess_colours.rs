@@ -117,7 +117,10 @@ pub(crate) fn colour_regions(
         ));
     }
     if r.pos != end {
-        return Err(format!("{} unexpected byte(s) after the colours", end - r.pos));
+        return Err(format!(
+            "{} unexpected byte(s) after the colours",
+            end - r.pos
+        ));
     }
     Ok(Some(out))
 }

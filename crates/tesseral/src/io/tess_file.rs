@@ -96,7 +96,8 @@ impl TessFile {
         if version != super::native::VERSION {
             let model = super::native::decode(&bytes).map_err(err)?;
             let extras = Extras::of(&model);
-            let layers = extras.colors.is_some() || extras.free.is_some() || extras.log_odds.is_some();
+            let layers =
+                extras.colors.is_some() || extras.free.is_some() || extras.log_odds.is_some();
             return Ok(Self {
                 path: path.to_owned(),
                 body: Body::Decoded(model.tree),

@@ -276,7 +276,11 @@ pub fn read_dataset(dir: &Path) -> Result<(PartitionedOctree, Frame), PartitionE
 
 /// The parts, the frame and the parts' colour regions (all parts' regions, in
 /// order; several may hold one colour).
-type DatasetParts = (PartitionedOctree, Frame, Vec<(crate::model::Rgba, LinearOctree)>);
+type DatasetParts = (
+    PartitionedOctree,
+    Frame,
+    Vec<(crate::model::Rgba, LinearOctree)>,
+);
 
 fn read_dataset_parts(dir: &Path) -> Result<DatasetParts, PartitionError> {
     let m = read_manifest(dir)?;

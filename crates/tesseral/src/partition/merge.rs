@@ -81,13 +81,13 @@ fn intervals<'a>(leaves: impl Iterator<Item = Result<Leaf, FormatError>> + 'a) -
     })
 }
 
+/// What [`sweep`] calls with each stretch.
+type Segment<'a> = dyn FnMut(u64, u64, &[bool]) -> Result<(), PartitionError> + 'a;
+
 /// Sweeps the boundaries of `streams` (each sorted, disjoint intervals): calls
 /// `segment(lo, hi, inside)` for each stretch `[lo, hi)` over which no stream
 /// changes, `inside[i]` telling whether stream `i` covers it.
-fn sweep(
-    mut streams: Vec<Stream<'_>>,
-    segment: &mut dyn FnMut(u64, u64, &[bool]) -> Result<(), PartitionError>,
-) -> Result<(), PartitionError> {
+fn sweep(mut streams: Vec<Stream<'_>>, segment: &mut Segment<'_>) -> Result<(), PartitionError> {
     let mut cur = Vec::with_capacity(streams.len());
     for s in &mut streams {
         cur.push(s.next().transpose()?);

@@ -254,7 +254,11 @@ fn streamed_set_operations_of_files_equal_the_in_memory_ones() {
 }
 
 /// Leaves of `t` in up to three colours (some left uncoloured), as a model.
-fn coloured(rng: &mut rand_pcg::Pcg64, t: &LinearOctree, palette: &[[u8; 4]]) -> crate::model::Model {
+fn coloured(
+    rng: &mut rand_pcg::Pcg64,
+    t: &LinearOctree,
+    palette: &[[u8; 4]],
+) -> crate::model::Model {
     let mut regions: Vec<Vec<crate::linear::Leaf>> = vec![Vec::new(); palette.len()];
     for &l in t.leaves() {
         let i = rng.random_range(0..=palette.len());
@@ -266,11 +270,16 @@ fn coloured(rng: &mut rand_pcg::Pcg64, t: &LinearOctree, palette: &[[u8; 4]]) ->
         t.depth(),
         t.origin(),
         palette.iter().zip(regions).map(|(c, ls)| {
-            (*c, LinearOctree::from_sorted_leaves(t.depth(), t.origin(), ls).unwrap())
+            (
+                *c,
+                LinearOctree::from_sorted_leaves(t.depth(), t.origin(), ls).unwrap(),
+            )
         }),
     )
     .unwrap();
-    crate::model::Model::new(t.clone()).with_colors(layer).unwrap()
+    crate::model::Model::new(t.clone())
+        .with_colors(layer)
+        .unwrap()
 }
 
 /// With colours: the streamed operation gives the in-memory `Model::set_op`'s
@@ -295,8 +304,16 @@ fn streamed_set_operations_keep_colours_as_in_memory() {
             dir.path().join(format!("a{i}.tess")),
             dir.path().join(format!("b{i}.tess")),
         );
-        std::fs::write(&pa, crate::io::native::tests::encode_chunked(&ma, 1 + i % 3)).unwrap();
-        std::fs::write(&pb, crate::io::native::tests::encode_chunked(&mb, 2 + i % 2)).unwrap();
+        std::fs::write(
+            &pa,
+            crate::io::native::tests::encode_chunked(&ma, 1 + i % 3),
+        )
+        .unwrap();
+        std::fs::write(
+            &pb,
+            crate::io::native::tests::encode_chunked(&mb, 2 + i % 2),
+        )
+        .unwrap();
         let (fa, fb) = (
             crate::io::TessFile::open(&pa).unwrap(),
             crate::io::TessFile::open(&pb).unwrap(),
