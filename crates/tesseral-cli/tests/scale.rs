@@ -185,6 +185,17 @@ fn streamed_builds_keep_the_scene_colours() {
     );
     ok(d, &["convert", "ds", "ds.vox"]);
     assert_eq!(fs::read(d.join("ds.vox")).unwrap(), want);
+    // `convert` to .tess streams a .tess file or a dataset (parts joined chunk by
+    // chunk, colour regions as streams): the same file as the streamed build.
+    for (input, copy) in [("s.tess", "c.tess"), ("ds", "dc.tess")] {
+        let v = json(d, &["convert", input, copy, "--json"]);
+        assert_eq!(v["streamed"], true, "{input}");
+        assert_eq!(
+            fs::read(d.join(copy)).unwrap(),
+            fs::read(d.join("s.tess")).unwrap(),
+            "{input}"
+        );
+    }
     // A render of the streamed file shows the colours: the same picture as the
     // in-memory model's (convert builds the scene in memory).
     ok(d, &["convert", s, "m.tess"]);

@@ -23,6 +23,7 @@ pub struct LeafSpool {
     file: BufWriter<File>,
     pending: Vec<Leaf>,
     prev: u64,
+    prev_end: u64,
     written: u64,
     bytes: Vec<u8>,
 }
@@ -37,6 +38,7 @@ impl LeafSpool {
             file: BufWriter::new(tempfile::tempfile_in(dir)?),
             pending: Vec::new(),
             prev: 0,
+            prev_end: 0,
             written: 0,
             bytes: Vec::new(),
         })
@@ -54,6 +56,12 @@ impl LeafSpool {
         Ok(())
     }
 
+    /// One past the last voxel code pushed (0 before any).
+    #[must_use]
+    pub fn last_end(&self) -> u64 {
+        self.pending.last().map_or(self.prev_end, |l| l.end())
+    }
+
     /// The leaves so far (merged).
     #[must_use]
     pub fn leaf_count(&self) -> u64 {
@@ -65,6 +73,7 @@ impl LeafSpool {
         for l in self.pending.drain(..n) {
             put_varint(&mut self.bytes, l.packed() - self.prev);
             self.prev = l.packed();
+            self.prev_end = l.end();
         }
         self.written += n as u64;
         self.file.write_all(&self.bytes)

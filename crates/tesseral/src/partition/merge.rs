@@ -203,3 +203,75 @@ pub fn stream_set_op(
         colours,
     })
 }
+
+/// Concatenates `.tess` files of one space whose leaves follow each other in code
+/// order (the parts of a dataset, or one file) into one `.tess` written to `w`
+/// with `frame`, chunk by chunk, the colour regions streamed into spools in
+/// `spool_dir`: a version-2 copy that never holds the tree or a layer.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] when the spaces differ, the files overlap or are out
+/// of order, or one has layers other than colours or is version 1;
+/// [`PartitionError::Format`] for a bad chunk or a write error.
+pub fn stream_concat(
+    files: &[TessFile],
+    frame: Frame,
+    w: &mut dyn Write,
+    spool_dir: &Path,
+) -> Result<StreamSummary, PartitionError> {
+    let Some(first) = files.first() else {
+        return Err(PartitionError::Ranges("no files to join".into()));
+    };
+    let (depth, origin) = (first.depth(), first.origin());
+    if files
+        .iter()
+        .any(|f| (f.depth(), f.origin()) != (depth, origin))
+    {
+        return Err(PartitionError::Ranges(
+            "the files are in different spaces".into(),
+        ));
+    }
+    let io = |e: std::io::Error| PartitionError::Format(FormatError::io(e));
+    let bad_order = || PartitionError::Ranges("the files overlap or are out of code order".into());
+    let mut colours: Vec<(Rgba, LeafSpool)> = Vec::new();
+    let mut tw = TessWriter::new(w, depth, origin).map_err(io)?;
+    let (mut voxels, mut end) = (0u64, 0u64);
+    for f in files {
+        for l in f.leaves() {
+            let l = l?;
+            if l.code() < end {
+                return Err(bad_order());
+            }
+            end = l.end();
+            voxels += l.voxel_count();
+            tw.push(l).map_err(io)?;
+        }
+        for (c, region) in only_colours(f)? {
+            let at = match colours.iter().position(|(x, _)| *x == c) {
+                Some(i) => i,
+                None => {
+                    colours.push((c, LeafSpool::new_in(spool_dir).map_err(io)?));
+                    colours.len() - 1
+                }
+            };
+            let spool = &mut colours[at].1;
+            let mut last = spool.last_end();
+            for l in region {
+                let l = l?;
+                if l.code() < last {
+                    return Err(bad_order());
+                }
+                last = l.end();
+                spool.push(l).map_err(io)?;
+            }
+        }
+    }
+    let leaves = tw.leaf_count();
+    let n = colours.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
+    tw.finish_spooled(frame, colours).map_err(io)?;
+    Ok(StreamSummary {
+        leaves,
+        voxels,
+        colours: n,
+    })
+}
