@@ -2,9 +2,11 @@
 //! Fuzzes the chunked (version-2) `.tess` reader past its index checksum: when the
 //! bytes end like a version-2 file, the trailer's CRC is recomputed, so the fuzzer
 //! explores the index and the chunks. Whatever opens must read chunk by chunk and by
-//! code range without panicking, and agree with the whole-file decoder.
+//! code range without panicking, and agree with the whole-file decoder (colour
+//! regions read as streams included).
 use libfuzzer_sys::fuzz_target;
 use tesseral::io::{native, TessFile};
+use tesseral::linear::LinearOctree;
 
 fuzz_target!(|data: &[u8]| {
     let mut bytes = data.to_vec();
@@ -36,6 +38,26 @@ fuzz_target!(|data: &[u8]| {
     }
     if let Some(c) = chunks.get(chunks.len() / 2) {
         let _ = f.leaves_in(c.lo, c.hi).count();
+    }
+    // The colour regions read as streams hold what the decoded layer holds.
+    if let (Ok(Some(regions)), Ok(model)) = (f.colour_streams(), &whole) {
+        let mut got = Vec::new();
+        for (c, r) in regions {
+            let Ok(leaves) = r.collect::<Result<Vec<_>, _>>() else {
+                return;
+            };
+            let t = LinearOctree::from_sorted_leaves(f.depth(), f.origin(), leaves).unwrap();
+            if !t.is_empty() {
+                got.push((c, t));
+            }
+        }
+        got.sort_by_key(|(c, _)| u32::from_le_bytes(*c));
+        let want: Vec<_> = model
+            .colors
+            .as_ref()
+            .map(|l| l.regions().to_vec())
+            .unwrap_or_default();
+        assert_eq!(got, want);
     }
     if let (Ok(model), Ok(streamed)) = (whole, f.to_model()) {
         model.tree.assert_valid();

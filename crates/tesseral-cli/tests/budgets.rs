@@ -22,8 +22,10 @@ fn refused(dir: &Path, args: &[&str], needles: &[&str]) -> String {
     err
 }
 
-/// The tank at depth 16 would need hundreds of millions of leaves: refused before
-/// the build, naming --max-leaves; and --memory binds when it is the tighter.
+/// The tank at depth 16 would need hundreds of millions of leaves: an in-memory
+/// build is refused before the work, naming --memory (no fixed leaf limit); an
+/// explicit --max-leaves binds when it is the tighter. (A `.tess` output streams:
+/// see tests/scale.rs.)
 #[test]
 fn scene_builds_are_estimated_first() {
     let dir = tempfile::tempdir().unwrap();
@@ -33,13 +35,13 @@ fn scene_builds_are_estimated_first() {
     fs::write(d.join("tank.tss"), &tank).unwrap();
     refused(
         d,
-        &["build", "t16.tss", "-o", "t.tess"],
-        &["t16.tss", "--max-leaves"],
+        &["build", "t16.tss", "-o", "t.xyz"],
+        &["t16.tss", "--memory", ".tess"],
     );
-    refused(d, &["render", "t16.tss", "-o", "t.png"], &["--max-leaves"]);
+    refused(d, &["render", "t16.tss", "-o", "t.png"], &["--memory"]);
     refused(
         d,
-        &["build", "tank.tss", "-o", "t.tess", "--max-leaves", "1000"],
+        &["build", "tank.tss", "-o", "t.xyz", "--max-leaves", "1000"],
         &["--max-leaves 1000"],
     );
     refused(
@@ -53,6 +55,7 @@ fn scene_builds_are_estimated_first() {
         &["not a size"],
     );
     assert!(!d.join("t.tess").exists() && !d.join("t.png").exists());
+    assert!(!d.join("t.xyz").exists());
     // The real tank has about 7,400 leaves: a budget of 20,000 lets it through.
     let out = expect_success(&run(
         d,
@@ -60,7 +63,7 @@ fn scene_builds_are_estimated_first() {
             "build",
             "tank.tss",
             "-o",
-            "t.tess",
+            "t.xyz",
             "--max-leaves",
             "20000",
             "--json",

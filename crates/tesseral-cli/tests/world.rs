@@ -331,7 +331,7 @@ fn item_9_a_voxelization_over_budget_is_refused_before_the_work() {
     fails(
         d,
         &["convert", "oct.stl", "big.tess", "--depth", "14"],
-        "raise --max-leaves",
+        "or --memory",
     );
     // Within the budget it is built.
     ok(

@@ -1,29 +1,32 @@
-//! Work budgets, checked before the work: `--max-leaves` and `--memory`.
+//! Work budgets, checked before the work: `--memory` and, when given, `--max-leaves`.
 //!
 //! A scene build is estimated first (`Scene::estimate_leaves`, a build three levels
 //! coarser), and refused at once when the estimate is over budget; the real build
-//! then stops at the same budget if the estimate was low. `plan` estimates its
+//! then stops at the same budget if the estimate was low. An in-memory build may
+//! hold `--memory` / 24 bytes leaves (there is no fixed leaf limit); a streamed
+//! build's memory is estimated from its plan instead (`build/stream.rs`). `plan` estimates its
 //! configuration space from the region's box (`motion::estimate_plan_bytes`).
 
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use tesseral::csg::{Scene, DEFAULT_MAX_LEAVES};
+use tesseral::csg::Scene;
 use tesseral::linear::LinearOctree;
 
 use super::output::{human_bytes, parse_bytes};
 
-/// Memory per leaf while a scene is built: the leaf itself and its copy in the
-/// per-thread chunks before they are joined.
-const BUILD_BYTES_PER_LEAF: u64 = 16;
+/// Memory per leaf while a scene is built in memory: the leaf itself, its copy in
+/// the per-thread chunks before they are joined, and the colour regions (measured:
+/// about 21 bytes a leaf for the showcase at depth 12).
+const BUILD_BYTES_PER_LEAF: u64 = 24;
 
 /// The budget flags of commands that build scenes or plan.
 #[derive(clap::Args, Clone, Copy, Debug)]
 pub struct Budget {
     /// Refuse to build an octree of more leaves than this (a scene is estimated before
-    /// it is built).
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_LEAVES)]
-    pub max_leaves: usize,
+    /// it is built). Without it, only --memory bounds the leaves.
+    #[arg(long, value_name = "N")]
+    pub max_leaves: Option<usize>,
     /// The working memory the command may use, estimated before the work: bytes, or a
     /// number with K, M, G or T (powers of 1024).
     #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = parse_bytes)]
@@ -33,7 +36,7 @@ pub struct Budget {
 impl Default for Budget {
     fn default() -> Self {
         Self {
-            max_leaves: DEFAULT_MAX_LEAVES,
+            max_leaves: None,
             memory: 8 << 30,
         }
     }
@@ -43,18 +46,16 @@ impl Budget {
     /// The leaf cap: `--max-leaves`, or fewer if `--memory` cannot hold that many.
     pub fn leaf_cap(&self) -> usize {
         let by_memory = usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX);
-        self.max_leaves.min(by_memory)
+        self.max_leaves.unwrap_or(usize::MAX).min(by_memory)
     }
 
     /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
     /// amount), naming the flag that binds.
     pub fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
         let cap = self.leaf_cap();
-        let (flag, limit) = if self.max_leaves == cap {
-            ("--max-leaves", self.max_leaves.to_string())
-        } else {
-            // At 16 bytes a leaf, memory binds before the leaf count does.
-            ("--memory", human_bytes(self.memory))
+        let (flag, limit) = match self.max_leaves {
+            Some(n) if n == cap => ("--max-leaves", n.to_string()),
+            _ => ("--memory", human_bytes(self.memory)),
         };
         let count = if leaves == u64::MAX {
             format!("more than the {cap} leaves that {flag} {limit} allows")

@@ -22,10 +22,10 @@ pub struct Args {
     /// Print the size and timing as JSON on stdout.
     #[arg(long)]
     json: bool,
-    /// Stream the leaves straight to the `.tess` output, a few cells at a time, with
-    /// memory flat in the depth (checked against `--memory` before the work; the
-    /// leaf limit does not apply). A `.tess` build estimated over the leaf limit
-    /// streams without it. Colours are not written by a streaming build.
+    /// Stream the leaves and colours straight to the output, a few cells at a time,
+    /// with memory flat in the depth (checked against `--memory` before the work).
+    /// A build to a `.tess` file always streams, so this flag only asks for it: it is
+    /// an error with another format.
     #[arg(long)]
     stream: bool,
     /// Build into a partitioned dataset of K parts of about equal work: OUTPUT is a
@@ -63,17 +63,14 @@ pub fn run(args: Args) -> Result<()> {
             args.output.display()
         );
     }
-    if args.stream {
+    if is_tess {
         return run_streamed(&args, &scene);
     }
     let start = Instant::now();
-    let tree = args.budget.build_scene(&args.scene, &scene).map_err(|e| {
-        if is_tess {
-            anyhow::anyhow!("{e}; or build straight to the .tess file with --stream")
-        } else {
-            e
-        }
-    })?;
+    let tree = args
+        .budget
+        .build_scene(&args.scene, &scene)
+        .map_err(|e| anyhow::anyhow!("{e}; or build to a .tess file, which streams"))?;
     let colors = scene.colour_layer(&tree, args.budget.leaf_cap())?;
     let model = tesseral::model::Model {
         colors,
@@ -123,7 +120,7 @@ fn run_streamed(args: &Args, scene: &Scene) -> Result<()> {
             "leaves": s.leaves,
             "voxels": s.voxels,
             "build_ms": build_ms,
-            "colors": null,
+            "colors": (s.colours > 0).then_some(s.colours),
             "streamed": true,
             "estimated_leaves": s.estimate,
             "memory_estimate": s.memory_estimate,

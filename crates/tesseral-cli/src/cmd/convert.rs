@@ -121,6 +121,9 @@ pub fn run(mut args: Args) -> Result<()> {
             smooth: args.smooth,
         },
     };
+    if streamed(&args, &out)? {
+        return Ok(());
+    }
     let model = octree::read_model(&args.input, &args.budget, &read)?;
     octree::save(&out, &model, &args.limits, &write)?;
     if args.json {
@@ -142,4 +145,64 @@ pub fn run(mut args: Args) -> Result<()> {
         crate::outln!("{summary}")?;
     }
     Ok(())
+}
+
+/// A version-2 `.tess` file, or a dataset of them, into a `.tess` file, chunk by
+/// chunk with the colour regions as streams (`partition::stream_concat`): never the
+/// whole tree in memory. `false` (nothing done) for other inputs and outputs, and
+/// for files with layers other than colours.
+fn streamed(args: &Args, out: &std::path::Path) -> Result<bool> {
+    use tesseral::io::TessFile;
+    use tesseral::partition::{is_dataset, open_part, read_manifest};
+    if output_is_stdout(out) || io::extension(out) != "tess" {
+        return Ok(false);
+    }
+    let input = &args.input;
+    let (files, frame) = if is_dataset(input) {
+        let m = read_manifest(input)?;
+        let mut files = Vec::with_capacity(m.parts.len());
+        for i in 0..m.parts.len() {
+            files.push(open_part(input, &m, i)?);
+        }
+        let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
+        (files, frame)
+    } else if input.is_file() && io::extension(input) == "tess" {
+        let f = TessFile::open(input)?;
+        let frame = f.frame();
+        (vec![f], frame)
+    } else {
+        return Ok(false);
+    };
+    for f in &files {
+        if !f.is_streamed() || (f.has_layers() && f.colour_streams()?.is_none()) {
+            return Ok(false);
+        }
+    }
+    let spool_dir = match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let mut summary = tesseral::partition::StreamSummary::default();
+    io::write_atomic(out, |w| {
+        summary = tesseral::partition::stream_concat(&files, frame, w, &spool_dir)
+            .map_err(std::io::Error::other)?;
+        Ok(())
+    })
+    .map_err(|e| anyhow::anyhow!("writing {}: {e}", out.display()))?;
+    if args.json {
+        let first = &files[0];
+        let summary = serde_json::json!({
+            "input": args.input,
+            "output": out,
+            "voxels": summary.voxels,
+            "leaves": summary.leaves,
+            "depth": first.depth(),
+            "origin": first.origin(),
+            "voxel_size": frame.voxel_size,
+            "translate": frame.translate,
+            "streamed": true,
+        });
+        crate::outln!("{summary}")?;
+    }
+    Ok(true)
 }

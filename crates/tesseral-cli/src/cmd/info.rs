@@ -102,7 +102,82 @@ struct Info {
     log_odds: bool,
 }
 
+/// An inclusive box of voxels.
+type BBox = ([i64; 3], [i64; 3]);
+
+/// The info of a version-2 `.tess` file with no layers but colours, read chunk by
+/// chunk from the map (the leaves never all held), the colour regions as streams.
+/// `None` for other files.
+fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
+    use tesseral::io::TessFile;
+    if super::output::is_stdio(path) || !path.is_file() || tesseral::io::extension(path) != "tess" {
+        return Ok(None);
+    }
+    let f = TessFile::open(path)?;
+    let colours = if f.has_layers() {
+        f.colour_streams()?
+    } else {
+        Some(Vec::new())
+    };
+    let (true, Some(colours)) = (f.is_streamed(), colours) else {
+        return Ok(None);
+    };
+    let (depth, origin) = (f.depth(), f.origin());
+    let space = tesseral::linear::LinearOctree::empty(depth, origin)?;
+    let mut by_depth = vec![0u64; usize::from(depth) + 1];
+    let (mut voxels, mut leaves) = (0u64, 0usize);
+    let mut bbox: Option<BBox> = None;
+    for l in f.leaves() {
+        let l = l?;
+        leaves += 1;
+        voxels += l.voxel_count();
+        by_depth[usize::from(depth - l.size_log2())] += 1;
+        let lo = space.voxel_of(l.code());
+        let hi = lo.map(|c| c + (1i64 << l.size_log2()) - 1);
+        bbox = Some(match bbox {
+            None => (lo, hi),
+            Some((a, b)) => (
+                [0, 1, 2].map(|i| a[i].min(lo[i])),
+                [0, 1, 2].map(|i| b[i].max(hi[i])),
+            ),
+        });
+    }
+    let n_colours = colours.len();
+    let mut colored_voxels = 0u64;
+    for (_, region) in colours {
+        for l in region {
+            colored_voxels += l?.voxel_count();
+        }
+    }
+    let frame = f.frame();
+    let info = Info {
+        voxels,
+        leaves,
+        depth,
+        origin,
+        bbox_min: bbox.map(|b| b.0),
+        bbox_max: bbox.map(|b| b.1),
+        leaves_by_depth: by_depth,
+        bytes: 8 * leaves as u64,
+        voxel_size: frame.voxel_size,
+        translate: frame.translate,
+        world_min: bbox.map(|b| frame.voxel_corner(b.0)),
+        world_max: bbox.map(|b| frame.voxel_corner(b.1.map(|c| c + 1))),
+        colors: (n_colours > 0).then_some(n_colours),
+        colored_voxels,
+        free_voxels: None,
+        free_leaves: None,
+        log_odds: false,
+    };
+    Ok(Some((info, bbox)))
+}
+
 pub fn run(args: Args) -> Result<()> {
+    if !(args.tree || args.codes) {
+        if let Some((info, bbox)) = streamed(&args.file)? {
+            return print(&args, &info, bbox);
+        }
+    }
     let model = octree::read_model(&args.file, &args.budget, &Default::default())?;
     let tree = &model.tree;
     if args.tree || args.codes {
@@ -129,6 +204,11 @@ pub fn run(args: Args) -> Result<()> {
         free_leaves: model.free.as_ref().map(|f| f.leaf_count()),
         log_odds: model.log_odds.is_some(),
     };
+    print(&args, &info, bbox)
+}
+
+fn print(args: &Args, info: &Info, bbox: Option<BBox>) -> Result<()> {
+    let frame = tesseral::model::Frame::new(info.voxel_size, info.translate);
     if args.json {
         crate::outln!("{}", serde_json::to_string_pretty(&info)?)?;
         return Ok(());

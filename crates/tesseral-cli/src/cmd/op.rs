@@ -75,9 +75,10 @@ pub fn run(args: Args) -> Result<()> {
     octree::write(&args.output, &r, &args.limits, report)
 }
 
-/// Two `.tess` files of one space and frame without colours, free space or
-/// log-odds, into a `.tess` file: a merge of the two sorted streams, one chunk of
-/// each held at a time. `None` when the inputs need the in-memory path.
+/// Two version-2 `.tess` files of one space and frame, with no layers but colours,
+/// into a `.tess` file: a merge of the two sorted streams (colour regions
+/// included), one chunk of each held at a time. `None` when the inputs need the
+/// in-memory path.
 fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     use tesseral::io::TessFile;
     let tess = |p: &std::path::Path| {
@@ -90,16 +91,22 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     }
     let a = TessFile::open(&args.a)?;
     let b = TessFile::open(&args.b)?;
-    if !(a.is_streamed() && b.is_streamed())
-        || a.has_layers()
-        || b.has_layers()
-        || (a.depth(), a.origin(), a.frame()) != (b.depth(), b.origin(), b.frame())
-    {
+    let colours_only =
+        |f: &TessFile| -> Result<bool> { Ok(!f.has_layers() || f.colour_streams()?.is_some()) };
+    let same_space = (a.depth(), a.origin(), a.frame()) == (b.depth(), b.origin(), b.frame());
+    let streamable =
+        a.is_streamed() && b.is_streamed() && same_space && colours_only(&a)? && colours_only(&b)?;
+    if !streamable {
         return Ok(None);
     }
+    // The colour spools' temporary files go next to the output.
+    let spool_dir = match args.output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => std::path::PathBuf::from("."),
+    };
     let mut summary = tesseral::partition::StreamSummary::default();
     tesseral::io::write_atomic(&args.output, |w| {
-        summary = tesseral::partition::stream_set_op(&a, &b, op, a.frame(), w)
+        summary = tesseral::partition::stream_set_op(&a, &b, op, a.frame(), w, &spool_dir)
             .map_err(std::io::Error::other)?;
         Ok(())
     })
@@ -117,6 +124,7 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
                 OpArg::Difference => "difference",
                 OpArg::Xor => "xor",
             },
+            "colors": (summary.colours > 0).then_some(summary.colours),
             "streamed": true,
         });
         crate::outln!("{out}")?;

@@ -151,24 +151,19 @@ impl super::Scene {
         tree: &crate::linear::LinearOctree,
         max_leaves: usize,
     ) -> Result<Option<crate::model::Layer<crate::model::Rgba>>, super::SceneError> {
-        let parts = colour_parts(&self.solid);
+        let parts = self.colour_csgs()?;
         if parts.is_empty() {
             return Ok(None);
         }
-        let to_voxels = self.world_to_voxel();
         let mut regions = Vec::with_capacity(parts.len());
         for (c, part) in parts {
-            let err = |source| super::SceneError::Build {
-                path: self.path.clone(),
-                source,
-            };
             let region = part
-                .transform(to_voxels)
-                .compile()
-                .map_err(err)?
                 .build_limited(self.depth, [0, 0, 0], max_leaves)
-                .map_err(err)?;
-            regions.push(([c.0[0], c.0[1], c.0[2], 255], region));
+                .map_err(|source| super::SceneError::Build {
+                    path: self.path.clone(),
+                    source,
+                })?;
+            regions.push((c, region));
         }
         let layer = crate::model::Layer::from_regions(self.depth, [0, 0, 0], regions)
             .and_then(|l| l.restrict(tree))
@@ -177,6 +172,28 @@ impl super::Scene {
                 source: e.into(),
             })?;
         Ok(Some(layer))
+    }
+
+    /// The colour parts ([`colour_parts`]) in voxel coordinates, compiled, with their
+    /// colours (opaque): what [`Scene::colour_layer`](super::Scene::colour_layer)
+    /// builds, and what a streamed build builds cell by cell.
+    ///
+    /// # Errors
+    /// [`super::SceneError::Build`] when a part does not compile.
+    pub fn colour_csgs(&self) -> Result<Vec<(crate::model::Rgba, super::Csg)>, super::SceneError> {
+        let to_voxels = self.world_to_voxel();
+        colour_parts(&self.solid)
+            .into_iter()
+            .map(|(c, part)| {
+                let csg = part.transform(to_voxels).compile().map_err(|source| {
+                    super::SceneError::Build {
+                        path: self.path.clone(),
+                        source,
+                    }
+                })?;
+                Ok(([c.0[0], c.0[1], c.0[2], 255], csg))
+            })
+            .collect()
     }
 
     /// The scene as a model: its octree, its frame and its colours, within

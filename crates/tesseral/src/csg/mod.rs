@@ -30,6 +30,7 @@ mod index;
 pub mod scene;
 mod shape;
 mod stream;
+mod stream_colours;
 
 #[cfg(test)]
 pub(crate) mod tests;
@@ -42,6 +43,7 @@ pub use scene::{Scene, SceneError};
 pub use shape::Shape;
 pub(crate) use stream::clip_leaf;
 pub use stream::{StreamPlan, StreamProgress, STREAM_CELL_LOG2};
+pub use stream_colours::ColouredSink;
 
 use crate::linear::OctreeError;
 

@@ -11,8 +11,6 @@
 
 use std::ops::Range;
 
-use rayon::prelude::*;
-
 use super::{Csg, CsgError};
 use crate::linear::{push_merging, CellClass, Leaf, LinearOctree};
 use crate::Voxel;
@@ -33,8 +31,9 @@ pub struct StreamProgress {
 }
 
 #[derive(Debug, Clone, Copy)]
-enum Item {
-    Leaf(Leaf),
+pub(super) enum Item {
+    /// A block decided inside from above, with its lowest voxel.
+    Leaf { leaf: Leaf, min: Voxel },
     Cell {
         code: u64,
         min: Voxel,
@@ -47,12 +46,12 @@ enum Item {
 /// tesseral order (see the module docs).
 #[derive(Debug, Clone)]
 pub struct StreamPlan {
-    items: Vec<Item>,
-    range: Range<u64>,
-    cells: u64,
+    pub(super) items: Vec<Item>,
+    pub(super) range: Range<u64>,
+    pub(super) cells: u64,
     depth: u8,
     origin: Voxel,
-    cell_log2: u8,
+    pub(super) cell_log2: u8,
 }
 
 impl Csg {
@@ -117,7 +116,10 @@ impl Csg {
         }
         match self.classify_cell(min, k) {
             CellClass::Outside => {}
-            CellClass::Inside if contained => plan.items.push(Item::Leaf(Leaf::new(code, k))),
+            CellClass::Inside if contained => plan.items.push(Item::Leaf {
+                leaf: Leaf::new(code, k),
+                min,
+            }),
             _ => {
                 let half = 1i64 << (k - 1);
                 let child = 1u64 << (3 * u32::from(k - 1));
@@ -276,7 +278,7 @@ impl StreamPlan {
             .iter()
             .filter_map(|i| match *i {
                 Item::Cell { code, k, .. } => Some(code..code + (1u64 << (3 * u32::from(k)))),
-                Item::Leaf(_) => None,
+                Item::Leaf { .. } => None,
             })
             .collect()
     }
@@ -302,51 +304,7 @@ impl StreamPlan {
         sink: &mut dyn FnMut(&[Leaf]) -> Result<(), E>,
         progress: &mut dyn FnMut(StreamProgress),
     ) -> Result<(), E> {
-        let window = window.max(1);
-        let mut state = StreamProgress {
-            cells_total: self.cells,
-            ..StreamProgress::default()
-        };
-        let mut i = 0;
-        while i < self.items.len() {
-            // Up to `window` cells, with the leaves between them.
-            let mut j = i;
-            let mut cells = 0;
-            while j < self.items.len() && cells < window {
-                if matches!(self.items[j], Item::Cell { .. }) {
-                    cells += 1;
-                }
-                j += 1;
-            }
-            let built: Vec<Vec<Leaf>> = self.items[i..j]
-                .par_iter()
-                .with_max_len(1)
-                .map(|item| match *item {
-                    Item::Leaf(l) => vec![l],
-                    Item::Cell { code, min, k, clip } => {
-                        let mut out = Vec::new();
-                        csg.build_subtree(code, min, k, &mut out);
-                        if clip {
-                            let mut kept = Vec::with_capacity(out.len());
-                            for l in out {
-                                clip_leaf(l, &self.range, &mut kept);
-                            }
-                            kept
-                        } else {
-                            out
-                        }
-                    }
-                })
-                .collect();
-            for leaves in built {
-                state.leaves += leaves.len() as u64;
-                sink(&leaves)?;
-            }
-            state.cells_done += cells as u64;
-            progress(state);
-            i = j;
-        }
-        Ok(())
+        self.run_coloured(csg, &[], window, &mut |ls, _| sink(ls), progress)
     }
 }
 

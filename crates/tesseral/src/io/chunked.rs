@@ -22,7 +22,7 @@ const CHUNK_HEAD: usize = 32;
 const INDEX_ENTRY: usize = 32;
 pub(crate) const TRAILER_LEN: usize = 48;
 /// Leaves that may still merge into a bigger one: at most seven siblings per level.
-const MERGE_TAIL: usize = 7 * (MAX_DEPTH as usize + 1);
+pub(crate) const MERGE_TAIL: usize = 7 * (MAX_DEPTH as usize + 1);
 
 /// Where one chunk lies and what it covers: its leaves cover codes in `[lo, hi)`,
 /// `lo` the code of its first leaf and `hi` the end of its last.
@@ -188,18 +188,42 @@ impl<W: Write> TessWriter<W> {
         })
     }
 
-    pub(crate) fn finish_extras(mut self, extras: &Extras) -> io::Result<W> {
+    pub(crate) fn finish_extras(self, extras: &Extras) -> io::Result<W> {
+        self.finish_with(|emit| {
+            let mut meta = vec![0, 0];
+            let flags = put_sections(&mut meta, extras);
+            meta[..2].copy_from_slice(&flags.to_le_bytes());
+            emit(&meta)
+        })
+    }
+
+    /// Writes the remaining leaves, then the sections that `sections` emits (their
+    /// flags first), then the index and the trailer, the checksum taken as the bytes
+    /// go: the sections need not be held in memory.
+    pub(crate) fn finish_with(
+        mut self,
+        sections: impl FnOnce(&mut dyn FnMut(&[u8]) -> io::Result<()>) -> io::Result<()>,
+    ) -> io::Result<W> {
         let pending = std::mem::take(&mut self.pending);
         for chunk in pending.chunks(self.chunk_leaves) {
             self.write_chunk(chunk)?;
         }
-        let mut meta = Vec::new();
-        let flags_at = meta.len();
-        meta.extend_from_slice(&[0, 0]);
-        let flags = put_sections(&mut meta, extras);
-        meta[flags_at..flags_at + 2].copy_from_slice(&flags.to_le_bytes());
+        let mut crc = crc32fast::Hasher::new();
+        crc.update(&self.header);
         let sections_offset = self.written;
-        let index_offset = sections_offset + meta.len() as u64;
+        let mut len = 0u64;
+        {
+            let w = &mut self.w;
+            let crc = &mut crc;
+            let len = &mut len;
+            sections(&mut |b: &[u8]| {
+                crc.update(b);
+                *len += b.len() as u64;
+                w.write_all(b)
+            })?;
+        }
+        let mut meta = Vec::new();
+        let index_offset = sections_offset + len;
         for c in &self.index {
             for v in [c.offset, c.lo, c.hi, c.count] {
                 meta.extend_from_slice(&v.to_le_bytes());
@@ -214,8 +238,6 @@ impl<W: Write> TessWriter<W> {
             meta.extend_from_slice(&v.to_le_bytes());
         }
         meta.extend_from_slice(&[0; 4]);
-        let mut crc = crc32fast::Hasher::new();
-        crc.update(&self.header);
         crc.update(&meta);
         meta.extend_from_slice(&crc.finalize().to_le_bytes());
         meta.extend_from_slice(&END_MAGIC);

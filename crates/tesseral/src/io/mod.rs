@@ -33,6 +33,8 @@ mod reframe;
 pub mod scan;
 mod sections;
 mod sniff;
+mod spool;
+mod tess_colours;
 mod tess_file;
 pub mod vox;
 pub mod xyz;
@@ -44,6 +46,8 @@ pub use error::FormatError;
 pub use estimate::{estimate_image_bytes, estimate_output_bytes};
 pub use reframe::reframe;
 pub use sniff::sniff_format;
+pub use spool::LeafSpool;
+pub use tess_colours::RegionLeaves;
 pub use tess_file::TessFile;
 
 use std::fs;

@@ -248,6 +248,26 @@ pub(crate) fn decode_sections(
     Ok(extras)
 }
 
+/// The section flags and the frame of version-2 bytes, without the layers that
+/// follow the frame (see [`decode_sections`]).
+pub(crate) fn decode_frame(
+    bytes: &[u8],
+    layout: &super::chunked::Layout,
+    space: &LinearOctree,
+) -> Result<(u16, crate::model::Frame), String> {
+    let (start, end) = layout.sections;
+    let mut r = Reader {
+        bytes: &bytes[..end],
+        pos: start,
+    };
+    let flags = r.u16()?;
+    if flags & !KNOWN_FLAGS != 0 {
+        return Err(format!("unknown section flags {flags:#06x}"));
+    }
+    let frame = read_sections(&mut r, flags & super::sections::FLAG_FRAME, space)?.frame;
+    Ok((flags, frame))
+}
+
 /// Decodes version-1 bytes.
 fn decode_v1(bytes: &[u8]) -> Result<Model, FormatError> {
     let bad = |m: String| FormatError::corrupt(m);
@@ -336,4 +356,4 @@ fn decode_v1(bytes: &[u8]) -> Result<Model, FormatError> {
 
 #[cfg(test)]
 #[path = "native_tests.rs"]
-mod tests;
+pub(crate) mod tests;

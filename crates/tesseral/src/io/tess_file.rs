@@ -52,7 +52,12 @@ impl std::ops::Deref for Bytes {
 pub struct TessFile {
     path: PathBuf,
     body: Body,
+    /// Version 1: everything; version 2: the frame only (the layers are decoded
+    /// when the model is read, see [`TessFile::to_model`]).
     extras: Extras,
+    /// Version 2: whether sections past the frame (colours, free space, log-odds)
+    /// are present.
+    layers: bool,
 }
 
 impl TessFile {
@@ -91,21 +96,31 @@ impl TessFile {
         if version != super::native::VERSION {
             let model = super::native::decode(&bytes).map_err(err)?;
             let extras = Extras::of(&model);
+            let layers =
+                extras.colors.is_some() || extras.free.is_some() || extras.log_odds.is_some();
             return Ok(Self {
                 path: path.to_owned(),
                 body: Body::Decoded(model.tree),
                 extras,
+                layers,
             });
         }
         let layout = parse_layout(&bytes).map_err(|m| err(FormatError::corrupt(m)))?;
         let space =
             LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
-        let extras = super::native::decode_sections(&bytes, &layout, &space)
+        // The sections are under the index's checksum, checked above; the layers
+        // are decoded only when the model is read, so streaming a file's leaves
+        // never holds its colours.
+        let (flags, frame) = super::native::decode_frame(&bytes, &layout, &space)
             .map_err(|m| err(FormatError::corrupt(m)))?;
         Ok(Self {
             path: path.to_owned(),
             body: Body::Chunked(bytes, layout),
-            extras,
+            extras: Extras {
+                frame,
+                ..Extras::default()
+            },
+            layers: flags & !super::sections::FLAG_FRAME != 0,
         })
     }
 
@@ -142,7 +157,7 @@ impl TessFile {
     /// Whether the file carries colours, free space or log-odds.
     #[must_use]
     pub fn has_layers(&self) -> bool {
-        self.extras.colors.is_some() || self.extras.free.is_some() || self.extras.log_odds.is_some()
+        self.layers
     }
 
     /// The number of black leaves.
@@ -221,6 +236,24 @@ impl TessFile {
         })
     }
 
+    /// The colour regions as streams of leaves, decoded as they are read, for a
+    /// version-2 file whose only layer is colours; `None` when it has other layers
+    /// or is version 1 (read it with [`TessFile::to_model`]).
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad colour section.
+    pub fn colour_streams(
+        &self,
+    ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
+        match &self.body {
+            Body::Chunked(bytes, layout) => {
+                super::tess_colours::colour_regions(bytes, layout.sections, layout.depth)
+                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))
+            }
+            Body::Decoded(_) => Ok(None),
+        }
+    }
+
     /// The whole model, read chunk by chunk (as [`super::native::read`]).
     ///
     /// # Errors
@@ -232,7 +265,16 @@ impl TessFile {
         }
         let tree = LinearOctree::from_sorted_leaves(self.depth(), self.origin(), leaves)
             .map_err(FormatError::octree)?;
-        let model = self.extras.clone().into_model(tree);
+        let extras = match &self.body {
+            Body::Chunked(bytes, layout) => {
+                let space = LinearOctree::empty(layout.depth, layout.origin)
+                    .map_err(FormatError::octree)?;
+                super::native::decode_sections(bytes, layout, &space)
+                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?
+            }
+            Body::Decoded(_) => self.extras.clone(),
+        };
+        let model = extras.into_model(tree);
         super::sections::check_parts(&model)
             .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
         Ok(model)

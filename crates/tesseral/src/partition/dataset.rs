@@ -18,6 +18,7 @@ use serde::{Deserialize, Serialize};
 
 use super::{Partition, PartitionError, PartitionedOctree};
 use crate::io::{FormatError, TessFile};
+use crate::linear::LinearOctree;
 use crate::model::{Frame, Model};
 use crate::Voxel;
 
@@ -269,7 +270,21 @@ pub fn open_part(dir: &Path, m: &Manifest, i: usize) -> Result<TessFile, Partiti
 /// # Errors
 /// [`PartitionError`] naming the manifest or part at fault.
 pub fn read_dataset(dir: &Path) -> Result<(PartitionedOctree, Frame), PartitionError> {
+    let (p, frame, _) = read_dataset_parts(dir)?;
+    Ok((p, frame))
+}
+
+/// The parts, the frame and the parts' colour regions (all parts' regions, in
+/// order; several may hold one colour).
+type DatasetParts = (
+    PartitionedOctree,
+    Frame,
+    Vec<(crate::model::Rgba, LinearOctree)>,
+);
+
+fn read_dataset_parts(dir: &Path) -> Result<DatasetParts, PartitionError> {
     let m = read_manifest(dir)?;
+    let mut colours = Vec::new();
     let mut parts = Vec::with_capacity(m.parts.len());
     for (i, p) in m.parts.iter().enumerate() {
         let f = open_part(dir, &m, i)?;
@@ -284,20 +299,36 @@ pub fn read_dataset(dir: &Path) -> Result<(PartitionedOctree, Frame), PartitionE
                 ),
             });
         }
+        if let Some(layer) = model.colors {
+            colours.extend(layer.regions().iter().cloned());
+        }
         parts.push((Partition { lo: p.lo, hi: p.hi }, model.tree));
     }
     let frame = Frame::new(m.frame.voxel_size, m.frame.translate);
     Ok((
         PartitionedOctree::from_parts(m.depth, m.origin, parts)?,
         frame,
+        colours,
     ))
 }
 
-/// Reads a dataset as one model (the parts joined).
+/// Reads a dataset as one model: the parts joined, with their colours.
 ///
 /// # Errors
 /// As [`read_dataset`].
 pub fn read_dataset_model(dir: &Path) -> Result<Model, PartitionError> {
-    let (p, frame) = read_dataset(dir)?;
-    Ok(Model::new(p.concat()).with_frame(frame))
+    let (p, frame, colours) = read_dataset_parts(dir)?;
+    let (depth, origin) = (p.depth(), p.origin());
+    let colors = if colours.is_empty() {
+        None
+    } else {
+        // Layer::from_regions joins the parts' regions of one colour.
+        let layer = crate::model::Layer::from_regions(depth, origin, colours)
+            .map_err(|e| PartitionError::Ranges(e.to_string()))?;
+        Some(layer)
+    };
+    Ok(Model {
+        colors,
+        ..Model::new(p.concat()).with_frame(frame)
+    })
 }

@@ -1,14 +1,17 @@
 //! Set operations of two `.tess` files as a merge of two sorted streams: each file's
 //! leaves are read a chunk at a time as code intervals, the intervals are merged, and
 //! the result is cut back into maximal aligned blocks and written through a
-//! [`TessWriter`]. Memory: one chunk per input and the writer's chunk.
+//! [`TessWriter`]. Colour regions are streams too, merged in the same sweep.
+//! Memory: one chunk per input and the writer's chunk, and a spool buffer per
+//! colour.
 
 use std::io::Write;
+use std::path::Path;
 
 use super::{PartitionError, StreamSummary};
-use crate::io::{FormatError, TessFile, TessWriter};
+use crate::io::{FormatError, LeafSpool, TessFile, TessWriter};
 use crate::linear::{Leaf, SetOp};
-use crate::model::Frame;
+use crate::model::{Frame, Rgba};
 
 /// Runs of touching leaves joined into intervals `[start, end)`, in order.
 struct Intervals<I: Iterator<Item = Result<Leaf, FormatError>>> {
@@ -34,12 +37,11 @@ impl<I: Iterator<Item = Result<Leaf, FormatError>>> Iterator for Intervals<I> {
     }
 }
 
-/// Pushes the maximal aligned blocks of `[start, end)`, in order.
-fn push_interval<W: Write>(
-    w: &mut TessWriter<W>,
+/// Cuts `[start, end)` into maximal aligned blocks, in order, handing each to `push`.
+fn cut_interval(
     mut start: u64,
     end: u64,
-    voxels: &mut u64,
+    push: &mut dyn FnMut(Leaf) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
     while start < end {
         let mut k = 0u8;
@@ -51,21 +53,85 @@ fn push_interval<W: Write>(
             k += 1;
         }
         let leaf = Leaf::new(start, k);
-        *voxels += leaf.voxel_count();
-        w.push(leaf)?;
+        push(leaf)?;
         start = leaf.end();
     }
     Ok(())
 }
 
+/// The colour regions of `f` as streams (none without layers); an error when it
+/// has other layers or is version 1.
+fn only_colours(f: &TessFile) -> Result<Vec<(Rgba, crate::io::RegionLeaves<'_>)>, PartitionError> {
+    if !f.has_layers() {
+        return Ok(Vec::new());
+    }
+    f.colour_streams()?.ok_or_else(|| {
+        PartitionError::Ranges(
+            "an operand has layers other than colours, or is version 1: no streamed operation"
+                .into(),
+        )
+    })
+}
+
+type Stream<'a> = Box<dyn Iterator<Item = Result<(u64, u64), FormatError>> + 'a>;
+
+fn intervals<'a>(leaves: impl Iterator<Item = Result<Leaf, FormatError>> + 'a) -> Stream<'a> {
+    Box::new(Intervals {
+        leaves: leaves.peekable(),
+    })
+}
+
+/// What [`sweep`] calls with each stretch.
+type Segment<'a> = dyn FnMut(u64, u64, &[bool]) -> Result<(), PartitionError> + 'a;
+
+/// Sweeps the boundaries of `streams` (each sorted, disjoint intervals): calls
+/// `segment(lo, hi, inside)` for each stretch `[lo, hi)` over which no stream
+/// changes, `inside[i]` telling whether stream `i` covers it.
+fn sweep(mut streams: Vec<Stream<'_>>, segment: &mut Segment<'_>) -> Result<(), PartitionError> {
+    let mut cur = Vec::with_capacity(streams.len());
+    for s in &mut streams {
+        cur.push(s.next().transpose()?);
+    }
+    let mut inside = vec![false; streams.len()];
+    let mut pos = 0u64;
+    loop {
+        let mut next = u64::MAX;
+        for (i, c) in cur.iter().enumerate() {
+            let (is_in, n) = match *c {
+                Some((s, e)) if s <= pos => (true, e),
+                Some((s, _)) => (false, s),
+                None => (false, u64::MAX),
+            };
+            inside[i] = is_in;
+            next = next.min(n);
+        }
+        if next == u64::MAX {
+            return Ok(());
+        }
+        if inside.iter().any(|&b| b) {
+            segment(pos, next, &inside)?;
+        }
+        pos = next;
+        for (c, s) in cur.iter_mut().zip(&mut streams) {
+            if c.is_some_and(|(_, e)| e <= pos) {
+                *c = s.next().transpose()?;
+            }
+        }
+    }
+}
+
 /// The set operation `op` of two `.tess` files of one space, streamed into a new
-/// `.tess` written to `w` with `frame` (see the module docs).
+/// `.tess` written to `w` with `frame` (see the module docs). Colours follow the
+/// in-memory rule (`Model::set_op`): a voxel of the result keeps the first
+/// operand's colour where it has one, else the second's; each colour region is
+/// spooled to a temporary file in `spool_dir` and read from the inputs as a stream.
 ///
 /// # Runtime
-/// O(leaves of both), reading each chunk once.
+/// O((leaves of both + colour leaves) × streams), reading each chunk once.
 ///
 /// # Errors
-/// [`PartitionError::Ranges`] when the spaces differ; [`PartitionError::Format`]
+/// [`PartitionError::Ranges`] when the spaces differ, or an input has layers other
+/// than colours (free space, log-odds) or is version 1; [`PartitionError::Format`]
 /// for a bad chunk or a write error.
 pub fn stream_set_op(
     a: &TessFile,
@@ -73,6 +139,7 @@ pub fn stream_set_op(
     op: SetOp,
     frame: Frame,
     w: &mut dyn Write,
+    spool_dir: &Path,
 ) -> Result<StreamSummary, PartitionError> {
     if (a.depth(), a.origin()) != (b.depth(), b.origin()) {
         return Err(PartitionError::Ranges(format!(
@@ -83,62 +150,128 @@ pub fn stream_set_op(
             b.origin()
         )));
     }
+    let (ca, cb) = (only_colours(a)?, only_colours(b)?);
     let io = |e: std::io::Error| PartitionError::Format(FormatError::io(e));
+    // One spool per distinct colour; stream i+2 is a's region i, then b's.
+    let mut colours: Vec<Rgba> = Vec::new();
+    let mut target = Vec::new();
+    for (c, _) in ca.iter().chain(&cb) {
+        let at = colours.iter().position(|x| x == c).unwrap_or_else(|| {
+            colours.push(*c);
+            colours.len() - 1
+        });
+        target.push(at);
+    }
+    let mut spools = Vec::with_capacity(colours.len());
+    for c in &colours {
+        spools.push((*c, LeafSpool::new_in(spool_dir).map_err(io)?));
+    }
+    let na = ca.len();
+    let mut streams = vec![intervals(a.leaves()), intervals(b.leaves())];
+    streams.extend(ca.into_iter().chain(cb).map(|(_, r)| intervals(r)));
     let mut tw = TessWriter::new(w, a.depth(), a.origin()).map_err(io)?;
-    let mut ia = Intervals {
-        leaves: a.leaves().peekable(),
-    };
-    let mut ib = Intervals {
-        leaves: b.leaves().peekable(),
-    };
-    let (mut x, mut y) = (ia.next().transpose()?, ib.next().transpose()?);
     let mut voxels = 0u64;
-    // Sweep the boundaries: at each point, which operands are inside decides.
     let keep = |in_a: bool, in_b: bool| match op {
         SetOp::Union => in_a || in_b,
         SetOp::Intersection => in_a && in_b,
         SetOp::Difference => in_a && !in_b,
         SetOp::SymmetricDifference => in_a != in_b,
     };
-    let mut pos = 0u64;
-    let mut open: Option<u64> = None;
-    loop {
-        // The next boundary after `pos`, and whether each operand covers [pos, next).
-        let (in_a, next_a) = match x {
-            Some((s, e)) if s <= pos => (true, e),
-            Some((s, _)) => (false, s),
-            None => (false, u64::MAX),
-        };
-        let (in_b, next_b) = match y {
-            Some((s, e)) if s <= pos => (true, e),
-            Some((s, _)) => (false, s),
-            None => (false, u64::MAX),
-        };
-        let next = next_a.min(next_b);
-        let k = keep(in_a, in_b);
-        match (k, open) {
-            (true, None) => open = Some(pos),
-            (false, Some(s)) => {
-                push_interval(&mut tw, s, pos, &mut voxels).map_err(io)?;
-                open = None;
-            }
-            _ => {}
+    sweep(streams, &mut |lo, hi, inside| {
+        if !keep(inside[0], inside[1]) {
+            return Ok(());
         }
-        if next == u64::MAX {
-            break;
+        voxels += hi - lo;
+        cut_interval(lo, hi, &mut |l| tw.push(l)).map_err(io)?;
+        let regions = &inside[2..];
+        let first = regions[..na]
+            .iter()
+            .position(|&x| x)
+            .or_else(|| regions[na..].iter().position(|&x| x).map(|j| na + j));
+        if let Some(j) = first {
+            let spool = &mut spools[target[j]].1;
+            cut_interval(lo, hi, &mut |l| spool.push(l)).map_err(io)?;
         }
-        pos = next;
-        if x.is_some_and(|(_, e)| e <= pos) {
-            x = ia.next().transpose()?;
-        }
-        if y.is_some_and(|(_, e)| e <= pos) {
-            y = ib.next().transpose()?;
-        }
+        Ok(())
+    })?;
+    let leaves = tw.leaf_count();
+    let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
+    tw.finish_spooled(frame, spools).map_err(io)?;
+    Ok(StreamSummary {
+        leaves,
+        voxels,
+        colours,
+    })
+}
+
+/// Concatenates `.tess` files of one space whose leaves follow each other in code
+/// order (the parts of a dataset, or one file) into one `.tess` written to `w`
+/// with `frame`, chunk by chunk, the colour regions streamed into spools in
+/// `spool_dir`: a version-2 copy that never holds the tree or a layer.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] when the spaces differ, the files overlap or are out
+/// of order, or one has layers other than colours or is version 1;
+/// [`PartitionError::Format`] for a bad chunk or a write error.
+pub fn stream_concat(
+    files: &[TessFile],
+    frame: Frame,
+    w: &mut dyn Write,
+    spool_dir: &Path,
+) -> Result<StreamSummary, PartitionError> {
+    let Some(first) = files.first() else {
+        return Err(PartitionError::Ranges("no files to join".into()));
+    };
+    let (depth, origin) = (first.depth(), first.origin());
+    if files
+        .iter()
+        .any(|f| (f.depth(), f.origin()) != (depth, origin))
+    {
+        return Err(PartitionError::Ranges(
+            "the files are in different spaces".into(),
+        ));
     }
-    if let Some(s) = open {
-        push_interval(&mut tw, s, pos, &mut voxels).map_err(io)?;
+    let io = |e: std::io::Error| PartitionError::Format(FormatError::io(e));
+    let bad_order = || PartitionError::Ranges("the files overlap or are out of code order".into());
+    let mut colours: Vec<(Rgba, LeafSpool)> = Vec::new();
+    let mut tw = TessWriter::new(w, depth, origin).map_err(io)?;
+    let (mut voxels, mut end) = (0u64, 0u64);
+    for f in files {
+        for l in f.leaves() {
+            let l = l?;
+            if l.code() < end {
+                return Err(bad_order());
+            }
+            end = l.end();
+            voxels += l.voxel_count();
+            tw.push(l).map_err(io)?;
+        }
+        for (c, region) in only_colours(f)? {
+            let at = match colours.iter().position(|(x, _)| *x == c) {
+                Some(i) => i,
+                None => {
+                    colours.push((c, LeafSpool::new_in(spool_dir).map_err(io)?));
+                    colours.len() - 1
+                }
+            };
+            let spool = &mut colours[at].1;
+            let mut last = spool.last_end();
+            for l in region {
+                let l = l?;
+                if l.code() < last {
+                    return Err(bad_order());
+                }
+                last = l.end();
+                spool.push(l).map_err(io)?;
+            }
+        }
     }
     let leaves = tw.leaf_count();
-    tw.finish(frame).map_err(io)?;
-    Ok(StreamSummary { leaves, voxels })
+    let n = colours.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
+    tw.finish_spooled(frame, colours).map_err(io)?;
+    Ok(StreamSummary {
+        leaves,
+        voxels,
+        colours: n,
+    })
 }

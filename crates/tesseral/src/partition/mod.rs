@@ -25,10 +25,11 @@ mod merge;
 mod stream;
 
 pub use dataset::{
-    is_dataset, read_dataset, read_dataset_model, write_dataset, Manifest, ManifestPart, MANIFEST,
+    is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, write_dataset,
+    Manifest, ManifestPart, MANIFEST,
 };
-pub use merge::stream_set_op;
-pub use stream::{build_scene_dataset, write_plan_tess, StreamSummary};
+pub use merge::{stream_concat, stream_set_op};
+pub use stream::{build_scene_dataset, write_plan_tess, write_plan_tess_coloured, StreamSummary};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]

@@ -7,8 +7,8 @@ use std::path::Path;
 use super::dataset::{write_manifest, ManifestPart};
 use super::{balanced_ranges, Partition, PartitionError};
 use crate::csg::{Csg, Scene, StreamPlan, StreamProgress};
-use crate::io::TessWriter;
-use crate::model::Frame;
+use crate::io::{LeafSpool, TessWriter};
+use crate::model::{Frame, Rgba};
 
 /// What a streaming build wrote.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -17,6 +17,8 @@ pub struct StreamSummary {
     pub leaves: u64,
     /// Black voxels.
     pub voxels: u64,
+    /// Colour regions written (colours with at least one voxel).
+    pub colours: u64,
 }
 
 /// Runs `plan` into a `.tess` file (version 2) written to `w`, with `frame`:
@@ -32,28 +34,65 @@ pub fn write_plan_tess(
     window: usize,
     progress: &mut dyn FnMut(StreamProgress),
 ) -> io::Result<StreamSummary> {
+    write_plan_tess_coloured(plan, csg, &[], frame, w, window, Path::new("."), progress)
+}
+
+/// As [`write_plan_tess`], with the colour parts `colours` (see
+/// [`crate::csg::Scene::colour_csgs`]) built in the same cells
+/// ([`StreamPlan::run_coloured`]) and written as the file's colour section, through
+/// one [`LeafSpool`] per colour: temporary files in `spool_dir`.
+///
+/// # Errors
+/// Any I/O error of `w` or of the spools.
+#[allow(clippy::too_many_arguments)]
+pub fn write_plan_tess_coloured(
+    plan: &StreamPlan,
+    csg: &Csg,
+    colours: &[(Rgba, Csg)],
+    frame: Frame,
+    w: &mut dyn Write,
+    window: usize,
+    spool_dir: &Path,
+    progress: &mut dyn FnMut(StreamProgress),
+) -> io::Result<StreamSummary> {
     let mut tw = TessWriter::new(w, plan.depth(), plan.origin())?;
+    let mut spools = Vec::with_capacity(colours.len());
+    for (c, _) in colours {
+        spools.push((*c, LeafSpool::new_in(spool_dir)?));
+    }
+    let csgs: Vec<Csg> = colours.iter().map(|(_, c)| c.clone()).collect();
     let mut voxels = 0u64;
-    plan.run::<io::Error>(
+    plan.run_coloured::<io::Error>(
         csg,
+        &csgs,
         window,
-        &mut |ls| {
+        &mut |ls, coloured| {
             for &l in ls {
                 voxels += l.voxel_count();
                 tw.push(l)?;
+            }
+            for ((_, spool), leaves) in spools.iter_mut().zip(coloured) {
+                for &l in leaves {
+                    spool.push(l)?;
+                }
             }
             Ok(())
         },
         progress,
     )?;
     let leaves = tw.leaf_count();
-    tw.finish(frame)?;
-    Ok(StreamSummary { leaves, voxels })
+    let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
+    tw.finish_spooled(frame, spools)?;
+    Ok(StreamSummary {
+        leaves,
+        voxels,
+        colours,
+    })
 }
 
 /// Builds `scene` into the directory `dir` as `k` parts of about equal work (the
 /// ranges cut the work cells of the streaming plan evenly), each streamed to its
-/// own `.tess` file, then the manifest. Each part is written atomically and the
+/// own `.tess` file with its colours, then the manifest. Each part is written atomically and the
 /// manifest last, so a crash leaves no manifest naming a missing part.
 ///
 /// # Errors
@@ -67,6 +106,7 @@ pub fn build_scene_dataset(
 ) -> Result<Vec<ManifestPart>, PartitionError> {
     let scene_err = |e: crate::csg::SceneError| PartitionError::Ranges(e.to_string());
     let csg = scene.csg().map_err(scene_err)?;
+    let colours = scene.colour_csgs().map_err(scene_err)?;
     // Sample where the surface lies with about 64 k cells or more: 4 + log4(k)
     // levels below the root.
     let levels = (4 + (usize::BITS - k.max(1).leading_zeros()).div_ceil(2)) as u8;
@@ -90,9 +130,16 @@ pub fn build_scene_dataset(
         let path = dir.join(&name);
         let mut summary = StreamSummary::default();
         crate::io::write_atomic(&path, |w| {
-            summary = write_plan_tess(&plan, &csg, scene.frame(), w, window, &mut |s| {
-                progress(i, s);
-            })?;
+            summary = write_plan_tess_coloured(
+                &plan,
+                &csg,
+                &colours,
+                scene.frame(),
+                w,
+                window,
+                dir,
+                &mut |s| progress(i, s),
+            )?;
             Ok(())
         })?;
         parts.push(ManifestPart::of_file(

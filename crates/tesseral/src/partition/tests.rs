@@ -242,13 +242,97 @@ fn streamed_set_operations_of_files_equal_the_in_memory_ones() {
             SetOp::SymmetricDifference,
         ] {
             let mut out = Vec::new();
-            let s = stream_set_op(&fa, &fb, op, Frame::default(), &mut out).unwrap();
+            let s = stream_set_op(&fa, &fb, op, Frame::default(), &mut out, dir.path()).unwrap();
             let got = crate::io::native::decode(&out).unwrap().tree;
             got.assert_valid();
             let want = a.set_op_same_space(&b, op);
             assert_eq!(voxels(&got), voxels(&want), "{op:?}");
             assert_eq!(got.leaf_count(), want.leaf_count(), "{op:?}");
             assert_eq!(s.voxels, want.voxel_count());
+        }
+    }
+}
+
+/// Leaves of `t` in up to three colours (some left uncoloured), as a model.
+fn coloured(
+    rng: &mut rand_pcg::Pcg64,
+    t: &LinearOctree,
+    palette: &[[u8; 4]],
+) -> crate::model::Model {
+    let mut regions: Vec<Vec<crate::linear::Leaf>> = vec![Vec::new(); palette.len()];
+    for &l in t.leaves() {
+        let i = rng.random_range(0..=palette.len());
+        if i < palette.len() {
+            regions[i].push(l);
+        }
+    }
+    let layer = crate::model::Layer::from_regions(
+        t.depth(),
+        t.origin(),
+        palette.iter().zip(regions).map(|(c, ls)| {
+            (
+                *c,
+                LinearOctree::from_sorted_leaves(t.depth(), t.origin(), ls).unwrap(),
+            )
+        }),
+    )
+    .unwrap();
+    crate::model::Model::new(t.clone())
+        .with_colors(layer)
+        .unwrap()
+}
+
+/// With colours: the streamed operation gives the in-memory `Model::set_op`'s
+/// model (tree and colour layer), for operands with shared and distinct colours,
+/// and for one operand without colours.
+#[test]
+fn streamed_set_operations_keep_colours_as_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(23);
+    let (red, green, blue) = ([255, 0, 0, 255], [0, 255, 0, 255], [0, 0, 255, 255]);
+    for i in 0..40 {
+        let depth = rng.random_range(1..=5);
+        let a = random_tree(&mut rng, depth);
+        let b = random_tree(&mut rng, depth);
+        let ma = coloured(&mut rng, &a, &[red, green]);
+        let mb = if i % 4 == 3 {
+            crate::model::Model::new(b.clone())
+        } else {
+            coloured(&mut rng, &b, &[green, blue])
+        };
+        let (pa, pb) = (
+            dir.path().join(format!("a{i}.tess")),
+            dir.path().join(format!("b{i}.tess")),
+        );
+        std::fs::write(
+            &pa,
+            crate::io::native::tests::encode_chunked(&ma, 1 + i % 3),
+        )
+        .unwrap();
+        std::fs::write(
+            &pb,
+            crate::io::native::tests::encode_chunked(&mb, 2 + i % 2),
+        )
+        .unwrap();
+        let (fa, fb) = (
+            crate::io::TessFile::open(&pa).unwrap(),
+            crate::io::TessFile::open(&pb).unwrap(),
+        );
+        for op in [
+            SetOp::Union,
+            SetOp::Intersection,
+            SetOp::Difference,
+            SetOp::SymmetricDifference,
+        ] {
+            let mut out = Vec::new();
+            stream_set_op(&fa, &fb, op, Frame::default(), &mut out, dir.path()).unwrap();
+            let got = crate::io::native::decode(&out).unwrap();
+            got.assert_valid();
+            let want = ma.set_op(&mb, op).unwrap();
+            assert_eq!(got.tree, want.tree, "{op:?}");
+            // An empty layer and no layer both mean no colours.
+            let want_colors = want.colors.filter(|l| !l.is_empty());
+            assert_eq!(got.colors, want_colors, "{op:?} {i}");
         }
     }
 }

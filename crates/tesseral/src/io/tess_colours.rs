@@ -1,0 +1,126 @@
+//! The colour regions of a `.tess` file read as streams: each region's leaves
+//! decoded from the mapped bytes as they are needed, so a streamed command (the
+//! merge of two files, see `partition::stream_set_op`) never holds a layer.
+
+use super::leafstream::Reader;
+use super::sections::{FLAG_COLOR_LAYER, FLAG_FRAME};
+use super::FormatError;
+use crate::linear::Leaf;
+use crate::model::Rgba;
+
+/// The leaves of one colour region, decoded lazily and checked as
+/// [`super::leafstream::read_leaves`] checks them.
+pub struct RegionLeaves<'a> {
+    r: Reader<'a>,
+    left: u64,
+    packed: u64,
+    prev_end: Option<u64>,
+    space_end: u64,
+    depth: u8,
+    failed: bool,
+}
+
+impl Iterator for RegionLeaves<'_> {
+    type Item = Result<Leaf, FormatError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.left == 0 || self.failed {
+            return None;
+        }
+        self.left -= 1;
+        let r = self.step();
+        self.failed = r.is_err();
+        Some(r.map_err(|m| FormatError::corrupt(format!("colour section: {m}"))))
+    }
+}
+
+impl RegionLeaves<'_> {
+    fn step(&mut self) -> Result<Leaf, String> {
+        let delta = self.r.varint()?;
+        if self.prev_end.is_some() && delta == 0 {
+            return Err("a leaf repeats the leaf before it".into());
+        }
+        self.packed = self
+            .packed
+            .checked_add(delta)
+            .ok_or_else(|| "a leaf code overflows".to_string())?;
+        let leaf = Leaf::from_packed(self.packed);
+        let k = leaf.size_log2();
+        if self.packed.trailing_ones() != 3 * u32::from(k)
+            || k > self.depth
+            || self.packed >> 63 != 0
+            || leaf.end() > self.space_end
+        {
+            return Err(format!("invalid leaf {:#x}", self.packed));
+        }
+        if self.prev_end.is_some_and(|e| e > leaf.code()) {
+            return Err("a leaf overlaps or precedes the one before it".into());
+        }
+        self.prev_end = Some(leaf.end());
+        Ok(leaf)
+    }
+}
+
+/// The colour regions of the sections `bytes[start..end]` of a version-2 file in a
+/// depth-`depth` space: `None` when the sections hold more than a frame and a
+/// colour layer (a legacy colour list, free space or log-odds).
+pub(crate) fn colour_regions(
+    bytes: &[u8],
+    (start, end): (usize, usize),
+    depth: u8,
+) -> Result<Option<Vec<(Rgba, RegionLeaves<'_>)>>, String> {
+    let mut r = Reader {
+        bytes: &bytes[..end],
+        pos: start,
+    };
+    let flags = r.u16()?;
+    if flags & !(FLAG_FRAME | FLAG_COLOR_LAYER) != 0 {
+        return Ok(None);
+    }
+    if flags & FLAG_FRAME != 0 {
+        r.take(32)?;
+    }
+    let mut out = Vec::new();
+    if flags & FLAG_COLOR_LAYER == 0 {
+        return Ok(Some(out));
+    }
+    let count = r.u64()?;
+    if count > (end - r.pos) as u64 / 12 {
+        return Err(format!("colour region count {count} cannot fit"));
+    }
+    for i in 0..count {
+        let v = r.take(4)?;
+        let rgba = [v[0], v[1], v[2], v[3]];
+        let leaves = r.u64()?;
+        let at = r.pos;
+        // Skip the region's varints to find the next region.
+        for _ in 0..leaves {
+            while r.u8()? & 0x80 != 0 {}
+        }
+        if out.iter().any(|(c, _): &(Rgba, _)| *c == rgba) {
+            return Err(format!("colour region {i}: repeats a colour"));
+        }
+        out.push((
+            rgba,
+            RegionLeaves {
+                r: Reader {
+                    bytes: &bytes[..r.pos],
+                    pos: at,
+                },
+                left: leaves,
+                packed: 0,
+                prev_end: None,
+                space_end: 1u64 << (3 * u32::from(depth)),
+                depth,
+                failed: false,
+            },
+        ));
+    }
+    if r.pos != end {
+        return Err(format!(
+            "{} unexpected byte(s) after the colours",
+            end - r.pos
+        ));
+    }
+    Ok(Some(out))
+}
