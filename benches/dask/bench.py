@@ -1,0 +1,72 @@
+"""Depth-13 build on a Dask LocalCluster of 2 workers against one process.
+
+    target/venv/bin/python benches/dask/bench.py [--scene scenes/fig4c-spheroid.tss]
+        [--depth 13] [--parts 8] [--workers 2]
+
+Both sides run the same tasks (`tesseral.dask.write(tesseral.dask.build(scene,
+depth, parts=K), dir)`: build each code range, write its .tess, then the
+manifest) and must write the same dataset (the manifests, CRC-32s included, are
+compared). One process: Dask's synchronous scheduler in this process, each part
+built with all cores (rayon). Cluster: a LocalCluster of N worker processes with
+one thread each and RAYON_NUM_THREADS=1, started before the clock. Prints both
+times, the speed-up and the load average (the machine may be shared).
+"""
+
+import argparse
+import os
+import pathlib
+import shutil
+import tempfile
+import time
+
+import dask
+import distributed
+
+import tesseral
+import tesseral.dask as tdask
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def run(scene, depth, parts, out, **kw):
+    t0 = time.perf_counter()
+    manifest = tdask.write(tdask.build(scene, depth, parts=parts), out, **kw)
+    return time.perf_counter() - t0, manifest
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--scene", default=str(ROOT / "scenes" / "fig4c-spheroid.tss"))
+    ap.add_argument("--depth", type=int, default=13)
+    ap.add_argument("--parts", type=int, default=8)
+    ap.add_argument("--workers", type=int, default=2)
+    a = ap.parse_args()
+    scene = tesseral.Scene.read(a.scene)
+    tmp = pathlib.Path(tempfile.mkdtemp(prefix="tesseral-dask-bench-"))
+    try:
+        print(f"scene {a.scene}, depth {a.depth}, {a.parts} parts, cores {os.cpu_count()}")
+        print(f"load average before: {os.getloadavg()}")
+        one, m1 = run(scene, a.depth, a.parts, tmp / "one", scheduler="sync")
+        leaves = sum(p["leaves"] for p in m1["parts"])
+        print(f"one process:  {one:8.2f} s  ({leaves:,} leaves, {leaves / one / 1e6:.2f} M leaves/s)")
+        print(f"load average: {os.getloadavg()}")
+        with distributed.LocalCluster(
+            n_workers=a.workers,
+            threads_per_worker=1,
+            processes=True,
+            dashboard_address=None,
+            env={"RAYON_NUM_THREADS": "1"},
+        ) as cluster, distributed.Client(cluster):
+            two, m2 = run(scene, a.depth, a.parts, tmp / "cluster")
+        print(f"LocalCluster ({a.workers} workers × 1 thread): {two:8.2f} s  ({leaves / two / 1e6:.2f} M leaves/s)")
+        print(f"load average after: {os.getloadavg()}")
+        assert m1 == m2, "the two runs wrote different datasets"
+        per_part = [p["leaves"] for p in m1["parts"]]
+        print(f"leaves per part: min {min(per_part):,}, max {max(per_part):,}")
+        print(f"speed-up (one process / cluster): {one / two:.2f}x")
+    finally:
+        shutil.rmtree(tmp)
+
+
+if __name__ == "__main__":
+    main()
