@@ -7,9 +7,9 @@ Both sides run the same tasks (`tesseral.dask.write(tesseral.dask.build(scene,
 depth, parts=K), dir)`: build each code range, write its .tess, then the
 manifest) and must write the same dataset (the manifests, CRC-32s included, are
 compared). One process: Dask's synchronous scheduler in this process, each part
-built with all cores (rayon). Cluster: a LocalCluster of N worker processes with
-one thread each and RAYON_NUM_THREADS=1, started before the clock. Prints both
-times, the speed-up and the load average (the machine may be shared).
+built with all cores (rayon). Cluster: a LocalCluster of 1, then N, worker
+processes with one thread each and RAYON_NUM_THREADS=1, started before the clock.
+Prints the times, the speed-ups and the load average (the machine may be shared).
 """
 
 import argparse
@@ -50,20 +50,26 @@ def main():
         leaves = sum(p["leaves"] for p in m1["parts"])
         print(f"one process:  {one:8.2f} s  ({leaves:,} leaves, {leaves / one / 1e6:.2f} M leaves/s)")
         print(f"load average: {os.getloadavg()}")
-        with distributed.LocalCluster(
-            n_workers=a.workers,
-            threads_per_worker=1,
-            processes=True,
-            dashboard_address=None,
-            env={"RAYON_NUM_THREADS": "1"},
-        ) as cluster, distributed.Client(cluster):
-            two, m2 = run(scene, a.depth, a.parts, tmp / "cluster")
-        print(f"LocalCluster ({a.workers} workers × 1 thread): {two:8.2f} s  ({leaves / two / 1e6:.2f} M leaves/s)")
-        print(f"load average after: {os.getloadavg()}")
-        assert m1 == m2, "the two runs wrote different datasets"
+        times = {}
+        for n in sorted({1, a.workers}):
+            with distributed.LocalCluster(
+                n_workers=n,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                env={"RAYON_NUM_THREADS": "1"},
+            ) as cluster, distributed.Client(cluster):
+                t, m = run(scene, a.depth, a.parts, tmp / f"cluster{n}")
+            assert m == m1, "the runs wrote different datasets"
+            times[n] = t
+            print(f"LocalCluster ({n} worker(s) x 1 thread): {t:8.2f} s  ({leaves / t / 1e6:.2f} M leaves/s)")
+            print(f"load average: {os.getloadavg()}")
         per_part = [p["leaves"] for p in m1["parts"]]
         print(f"leaves per part: min {min(per_part):,}, max {max(per_part):,}")
-        print(f"speed-up (one process / cluster): {one / two:.2f}x")
+        two = times[a.workers]
+        print(f"speed-up, one process / LocalCluster of {a.workers}: {one / two:.2f}x")
+        if a.workers != 1:
+            print(f"speed-up, LocalCluster of 1 / of {a.workers}: {times[1] / two:.2f}x")
     finally:
         shutil.rmtree(tmp)
 

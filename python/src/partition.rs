@@ -25,7 +25,10 @@ type Vec3 = (i64, i64, i64);
 type Bbox = Option<(Vec3, Vec3)>;
 
 fn ranges_in(ranges: &[(u64, u64)]) -> Vec<Partition> {
-    ranges.iter().map(|&(lo, hi)| Partition { lo, hi }).collect()
+    ranges
+        .iter()
+        .map(|&(lo, hi)| Partition { lo, hi })
+        .collect()
 }
 
 fn ranges_out(ranges: &[Partition]) -> Vec<(u64, u64)> {
@@ -268,9 +271,8 @@ pub fn partition_write_part<'py>(
     tree: &Octree,
 ) -> PyResult<Bound<'py, PyDict>> {
     let (t, frame) = (&tree.model.tree, tree.model.frame);
-    std::fs::create_dir_all(&dir).map_err(|e| {
-        pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", dir.display()))
-    })?;
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", dir.display())))?;
     let e = py
         .allow_threads(|| part::write_part(&dir, i, Partition { lo, hi }, t, frame))
         .map_err(partition_error)?;
@@ -302,7 +304,9 @@ pub fn partition_write_manifest(
         .collect();
     LinearOctree::empty(depth, [origin.0, origin.1, origin.2]).map_err(errors::octree)?;
     if !(voxel_size.is_finite() && voxel_size > 0.0) {
-        return Err(PyValueError::new_err("voxel_size must be positive and finite"));
+        return Err(PyValueError::new_err(
+            "voxel_size must be positive and finite",
+        ));
     }
     let frame = Frame::new(voxel_size, [translate.0, translate.1, translate.2]);
     let origin = [origin.0, origin.1, origin.2];

@@ -48,10 +48,7 @@ impl Scene {
     }
 
     /// Pickling: the source text and path.
-    fn __reduce__<'py>(
-        &self,
-        py: Python<'py>,
-    ) -> PyResult<(Bound<'py, PyAny>, (String, PathBuf))> {
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String, PathBuf))> {
         let f = py.get_type::<Scene>().getattr("_from_text")?;
         Ok((f, (self.text.clone(), self.path.clone())))
     }
