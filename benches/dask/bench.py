@@ -34,12 +34,60 @@ def run(scene, depth, parts, out, **kw):
     return time.perf_counter() - t0, manifest
 
 
+def shuffle(tmp, leaves, workers):
+    """Reads the one-process dataset back and times, in one process and on the
+    LocalCluster: translate by an offset aligned to nothing (every leaf moves to
+    another range) then write; union of the dataset with that translation then
+    write."""
+    by = (1001, -7, 333)
+    for label, kw, cluster in [
+        ("one process", {"scheduler": "sync"}, None),
+        (f"LocalCluster of {workers}", {}, workers),
+    ]:
+        ctx = (
+            distributed.LocalCluster(
+                n_workers=cluster,
+                threads_per_worker=1,
+                processes=True,
+                dashboard_address=None,
+                env={"RAYON_NUM_THREADS": "1"},
+            )
+            if cluster
+            else None
+        )
+        client = distributed.Client(ctx) if ctx else None
+        try:
+            src = tdask.read(tmp / "one")
+            t0 = time.perf_counter()
+            m = tdask.write(tdask.translate(src, by), tmp / f"moved-{cluster}", **kw)
+            t1 = time.perf_counter()
+            n = sum(p["leaves"] for p in m["parts"])
+            print(f"{label}: translate {leaves:,} leaves by {by} -> {n:,}: {t1 - t0:.2f} s ({leaves / (t1 - t0) / 1e6:.2f} M leaves/s in)")
+            moved = tdask.read(tmp / f"moved-{cluster}")
+            src = tdask.read(tmp / "one")
+            t0 = time.perf_counter()
+            m = tdask.write(tdask.op(src, moved, "union"), tmp / f"union-{cluster}", **kw)
+            t1 = time.perf_counter()
+            u = sum(p["leaves"] for p in m["parts"])
+            print(f"{label}: union of {leaves:,} and {n:,} leaves -> {u:,}: {t1 - t0:.2f} s ({(leaves + n) / (t1 - t0) / 1e6:.2f} M leaves/s in)")
+            print(f"load average: {os.getloadavg()}")
+        finally:
+            if client:
+                client.close()
+                ctx.close()
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--scene", default=str(ROOT / "scenes" / "fig4c-spheroid.tss"))
     ap.add_argument("--depth", type=int, default=13)
     ap.add_argument("--parts", type=int, default=8)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument(
+        "--shuffle",
+        action="store_true",
+        help="also time translate (a shuffle) and union of the dataset, for the per-part rates",
+    )
     a = ap.parse_args()
     scene = tesseral.Scene.read(a.scene)
     tmp = pathlib.Path(tempfile.mkdtemp(prefix="tesseral-dask-bench-"))
@@ -50,6 +98,8 @@ def main():
         leaves = sum(p["leaves"] for p in m1["parts"])
         print(f"one process:  {one:8.2f} s  ({leaves:,} leaves, {leaves / one / 1e6:.2f} M leaves/s)")
         print(f"load average: {os.getloadavg()}")
+        if a.shuffle:
+            shuffle(tmp, leaves, a.workers)
         times = {}
         for n in sorted({1, a.workers}):
             with distributed.LocalCluster(

@@ -89,6 +89,10 @@ def test_build_equals_the_single_process_build(client):
         assert ((codes >= lo) & (codes < hi)).all()
     want = scene.build(7)
     same(parts.compute(), want)
+    assert len(client.scheduler_info()["workers"]) == 2
+    kept = parts.persist()  # computed once, held by the workers
+    assert kept.ranges == parts.ranges
+    same(kept.compute(), want)
     # Another depth, from a path.
     coarse = tdask.build(ROOT / "scenes" / "tank.tss", 6, parts=3).compute()
     same(coarse, tesseral.Scene.read(str(ROOT / "scenes" / "tank.tss")).build(6))
@@ -126,6 +130,9 @@ def test_translate_is_a_shuffle_equal_to_the_single_process_one(client):
             codes, _ = t.leaves()
             assert ((codes >= lo) & (codes < hi)).all()
         same(moved.compute(), want)
+        kept = moved.persist()
+        assert dask.compute(kept.ranges)[0] == ranges
+        same(kept.compute(), want)
     # A translated operand (ranges from a task) in a set operation.
     moved = tdask.translate(pa, (2, 1, -1))
     same(
@@ -221,3 +228,17 @@ def test_bad_arguments_are_named():
         tdask.op(p, other, "union").compute(scheduler="sync")
     with pytest.raises(OSError, match="manifest.json"):
         tdask.read(ROOT / "scenes")
+
+
+def test_without_dask_the_error_says_what_to_install():
+    code = (
+        "import sys; sys.modules['dask'] = None\n"
+        "import tesseral\n"
+        "try:\n"
+        "    import tesseral.dask\n"
+        "except ImportError as e:\n"
+        "    assert 'pip install' in str(e), e\n"
+        "else:\n"
+        "    raise SystemExit('imported without dask')\n"
+    )
+    subprocess.run([sys.executable, "-c", code], check=True)
