@@ -82,6 +82,17 @@ fn pieces_join_into_their_union() {
         got.assert_valid();
         assert_eq!(voxels(&got), want);
     }
+    // Disjoint pieces (a tree cut into ranges, shuffled): the one-pass join.
+    for _ in 0..60 {
+        let depth = rng.random_range(1..=6);
+        let tree = random_tree(&mut rng, depth);
+        let p = PartitionedOctree::split(&tree, &random_ranges(&mut rng, depth)).unwrap();
+        let mut pieces: Vec<LinearOctree> = p.parts().iter().map(|(_, t)| t.clone()).collect();
+        pieces.reverse();
+        let got = join_pieces(depth, [0; 3], pieces).unwrap();
+        got.assert_valid();
+        assert_eq!(got, tree);
+    }
     let a = LinearOctree::from_voxels(2, [0; 3], [[1, 1, 1]]).unwrap();
     let b = LinearOctree::from_voxels(3, [0; 3], [[1, 1, 1]]).unwrap();
     assert!(join_pieces(2, [0; 3], vec![a.clone(), b.clone()]).is_err());
