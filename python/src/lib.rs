@@ -11,6 +11,7 @@ mod errors;
 mod motion;
 mod occupancy;
 mod octree;
+mod partition;
 mod rsmc;
 mod scene;
 
@@ -33,6 +34,7 @@ fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(calc::decode, m)?)?;
     m.add_function(wrap_pyfunction!(calc::add, m)?)?;
     m.add_function(wrap_pyfunction!(calc::sub, m)?)?;
+    partition::register(m)?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

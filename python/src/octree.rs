@@ -121,6 +121,31 @@ impl Octree {
             .map_err(errors::format)
     }
 
+    /// The octree as `.tess` bytes (the native format, with the frame, colours and
+    /// free space): what pickling sends.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> Bound<'py, PyBytes> {
+        let m = &self.model;
+        let bytes = py.allow_threads(|| tesseral::io::native::encode(m));
+        PyBytes::new(py, &bytes)
+    }
+
+    /// An octree from `.tess` bytes (as `to_bytes` gives).
+    #[staticmethod]
+    fn from_bytes(py: Python<'_>, data: &[u8]) -> PyResult<Octree> {
+        py.allow_threads(|| tesseral::io::native::decode(data))
+            .map(Octree::new)
+            .map_err(errors::format)
+    }
+
+    /// Pickling: the `.tess` bytes, read back by `Octree.from_bytes`.
+    fn __reduce__<'py>(
+        &self,
+        py: Python<'py>,
+    ) -> PyResult<(Bound<'py, PyAny>, (Bound<'py, PyBytes>,))> {
+        let f = py.get_type::<Octree>().getattr("from_bytes")?;
+        Ok((f, (self.to_bytes(py),)))
+    }
+
     /// Writes the octree, atomically, in the format named by the extension.
     fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
         let m = &self.model;

@@ -1,6 +1,6 @@
 //! `tesseral.Scene` and `tesseral.render`.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
@@ -17,6 +17,9 @@ use crate::octree::Octree;
 #[pyclass(module = "tesseral", frozen)]
 pub struct Scene {
     scene: CsgScene,
+    /// The source text and its path, kept for pickling.
+    text: String,
+    path: PathBuf,
 }
 
 #[pymethods]
@@ -24,17 +27,30 @@ impl Scene {
     /// Parses scene text; errors raise SceneError with `line` and `column`.
     #[staticmethod]
     fn parse(py: Python<'_>, text: &str) -> PyResult<Scene> {
-        CsgScene::parse(text, Path::new("<scene>"))
-            .map(|scene| Scene { scene })
-            .map_err(|e| errors::scene(py, e))
+        Scene::from_text(py, text.to_owned(), PathBuf::from("<scene>"))
     }
 
     /// Reads a `.tss` file.
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
-        CsgScene::read(&path)
-            .map(|scene| Scene { scene })
-            .map_err(|e| errors::scene(py, e))
+        let scene = CsgScene::read(&path).map_err(|e| errors::scene(py, e))?;
+        // It parsed, so it was read and is UTF-8.
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display()))
+        })?;
+        Ok(Scene { scene, text, path })
+    }
+
+    /// The scene parsed from `text` as if read from `path` (pickling's way back).
+    #[staticmethod]
+    fn _from_text(py: Python<'_>, text: String, path: PathBuf) -> PyResult<Scene> {
+        Scene::from_text(py, text, path)
+    }
+
+    /// Pickling: the source text and path.
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<(Bound<'py, PyAny>, (String, PathBuf))> {
+        let f = py.get_type::<Scene>().getattr("_from_text")?;
+        Ok((f, (self.text.clone(), self.path.clone())))
     }
 
     /// Builds the scene's octree with its frame and colours, at the scene's depth or
@@ -74,7 +90,14 @@ impl Scene {
 }
 
 impl Scene {
-    fn at_depth(&self, depth: Option<u8>) -> PyResult<CsgScene> {
+    fn from_text(py: Python<'_>, text: String, path: PathBuf) -> PyResult<Scene> {
+        let scene = CsgScene::parse(&text, &path).map_err(|e| errors::scene(py, e))?;
+        Ok(Scene { scene, text, path })
+    }
+
+    /// The scene at its own depth or at `depth` (1 to 16: the same bounds, coarser
+    /// or finer voxels).
+    pub fn at_depth(&self, depth: Option<u8>) -> PyResult<CsgScene> {
         let mut s = self.scene.clone();
         if let Some(d) = depth {
             if !(1..=16).contains(&d) {

@@ -116,7 +116,12 @@ impl ManifestPart {
     }
 }
 
-pub(crate) fn write_manifest(
+/// Writes the manifest of a dataset whose parts are written (atomically; write it
+/// last, so that no manifest names a missing part).
+///
+/// # Errors
+/// [`PartitionError::Format`] when the file cannot be written.
+pub fn write_manifest(
     dir: &Path,
     depth: u8,
     origin: Voxel,
@@ -155,17 +160,44 @@ pub fn write_dataset(
     std::fs::create_dir_all(dir).map_err(|e| FormatError::io(e).with_path(dir))?;
     let mut parts = Vec::new();
     for (i, (p, t)) in tree.parts().iter().enumerate() {
-        let name = part_name(i);
-        crate::io::write_model(&dir.join(&name), &Model::new(t.clone()).with_frame(frame))?;
-        parts.push(ManifestPart::of_file(
-            dir,
-            name,
-            *p,
-            t.leaf_count() as u64,
-            t.voxel_count(),
-        )?);
+        parts.push(write_part(dir, i, *p, t, frame)?);
     }
     write_manifest(dir, tree.depth(), tree.origin(), frame, &parts)
+}
+
+/// Writes part `i` of a dataset (`part-0000i.tess` in `dir`, atomically) and
+/// returns its manifest entry. The leaves must lie in `range`.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] for leaves outside the range;
+/// [`PartitionError::Format`] for a file that cannot be written.
+pub fn write_part(
+    dir: &Path,
+    i: usize,
+    range: Partition,
+    tree: &LinearOctree,
+    frame: Frame,
+) -> Result<ManifestPart, PartitionError> {
+    if tree.leaves().first().is_some_and(|l| l.code() < range.lo)
+        || tree.leaves().last().is_some_and(|l| l.end() > range.hi)
+    {
+        return Err(PartitionError::Ranges(format!(
+            "part {i} has leaves outside its range [{}, {})",
+            range.lo, range.hi
+        )));
+    }
+    let name = part_name(i);
+    crate::io::write_model(
+        &dir.join(&name),
+        &Model::new(tree.clone()).with_frame(frame),
+    )?;
+    ManifestPart::of_file(
+        dir,
+        name,
+        range,
+        tree.leaf_count() as u64,
+        tree.voxel_count(),
+    )
 }
 
 /// Whether `path` is a dataset directory (holds a manifest).
@@ -265,6 +297,32 @@ pub fn open_part(dir: &Path, m: &Manifest, i: usize) -> Result<TessFile, Partiti
     Ok(f)
 }
 
+/// Reads part `i` of a dataset, checked against the manifest (CRC, space, range,
+/// leaf and voxel counts), with the manifest's frame.
+///
+/// # Errors
+/// [`PartitionError`] naming the part file.
+pub fn read_part(dir: &Path, m: &Manifest, i: usize) -> Result<Model, PartitionError> {
+    let p = m.parts.get(i).ok_or_else(|| PartitionError::Manifest {
+        path: dir.join(MANIFEST),
+        message: format!("no part {i} (the manifest has {})", m.parts.len()),
+    })?;
+    let f = open_part(dir, m, i)?;
+    let model = f.to_model()?;
+    if model.tree.voxel_count() != p.voxels {
+        return Err(PartitionError::Manifest {
+            path: dir.join(&p.file),
+            message: format!(
+                "{} voxels where the manifest says {}",
+                model.tree.voxel_count(),
+                p.voxels
+            ),
+        });
+    }
+    let frame = Frame::new(m.frame.voxel_size, m.frame.translate);
+    Ok(model.with_frame(frame))
+}
+
 /// Reads a whole dataset: the partitioned octree and its frame.
 ///
 /// # Errors
@@ -287,19 +345,8 @@ fn read_dataset_parts(dir: &Path) -> Result<DatasetParts, PartitionError> {
     let mut colours = Vec::new();
     let mut parts = Vec::with_capacity(m.parts.len());
     for (i, p) in m.parts.iter().enumerate() {
-        let f = open_part(dir, &m, i)?;
-        let model = f.to_model()?;
-        if model.tree.voxel_count() != p.voxels {
-            return Err(PartitionError::Manifest {
-                path: dir.join(&p.file),
-                message: format!(
-                    "{} voxels where the manifest says {}",
-                    model.tree.voxel_count(),
-                    p.voxels
-                ),
-            });
-        }
-        if let Some(layer) = model.colors {
+        let model = read_part(dir, &m, i)?;
+        if let Some(layer) = &model.colors {
             colours.extend(layer.regions().iter().cloned());
         }
         parts.push((Partition { lo: p.lo, hi: p.hi }, model.tree));

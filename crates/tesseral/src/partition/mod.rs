@@ -22,14 +22,21 @@ use crate::Voxel;
 
 pub mod dataset;
 mod merge;
+mod shuffle;
 mod stream;
 
 pub use dataset::{
-    is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, write_dataset,
-    Manifest, ManifestPart, MANIFEST,
+    is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, read_part,
+    write_dataset, write_manifest, write_part, Manifest, ManifestPart, MANIFEST,
 };
 pub use merge::{stream_concat, stream_set_op};
-pub use stream::{build_scene_dataset, write_plan_tess, write_plan_tess_coloured, StreamSummary};
+pub use shuffle::{
+    balanced_ranges_exact, join_pieces, set_op_part, translated_sample, translated_space,
+    union_bbox, SAMPLE_PER_PART,
+};
+pub use stream::{
+    build_scene_dataset, scene_ranges, write_plan_tess, write_plan_tess_coloured, StreamSummary,
+};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]
@@ -292,20 +299,8 @@ impl PartitionedOctree {
             .parts
             .par_iter()
             .zip(other.parts.par_iter())
-            .map(|((p, a), (_, b))| {
-                // The merge of two clipped parts need not come out canonical (eight
-                // siblings from the two operands); one pass merges them.
-                let r = a.set_op_same_space(b, op);
-                let mut leaves = Vec::with_capacity(r.leaf_count());
-                for &l in r.leaves() {
-                    push_merging(&mut leaves, l);
-                }
-                (
-                    *p,
-                    LinearOctree::from_parts(self.depth, self.origin, leaves),
-                )
-            })
-            .collect();
+            .map(|((p, a), (_, b))| Ok((*p, set_op_part(a, b, op)?)))
+            .collect::<Result<_, PartitionError>>()?;
         Ok(Self {
             depth: self.depth,
             origin: self.origin,
@@ -316,3 +311,5 @@ impl PartitionedOctree {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_shuffle;

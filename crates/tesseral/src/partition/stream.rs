@@ -90,6 +90,27 @@ pub fn write_plan_tess_coloured(
     })
 }
 
+/// The `k` (or fewer) ranges of about equal work into which `build_scene_dataset`
+/// cuts `scene`: the work cells of a streaming plan with about 64 k cells or more
+/// (4 + log4(k) levels below the root), cut evenly.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] for a scene that does not compile.
+pub fn scene_ranges(scene: &Scene, k: usize) -> Result<Vec<Partition>, PartitionError> {
+    let csg = scene
+        .csg()
+        .map_err(|e| PartitionError::Ranges(e.to_string()))?;
+    csg_ranges(&csg, scene.depth, k)
+}
+
+fn csg_ranges(csg: &Csg, depth: u8, k: usize) -> Result<Vec<Partition>, PartitionError> {
+    let levels = (4 + (usize::BITS - k.max(1).leading_zeros()).div_ceil(2)) as u8;
+    let sample = csg
+        .stream_plan_cells(depth, [0, 0, 0], 0..u64::MAX, depth.saturating_sub(levels))
+        .map_err(|e| PartitionError::Ranges(e.to_string()))?;
+    Ok(balanced_ranges(depth, k, &sample.cell_ranges()))
+}
+
 /// Builds `scene` into the directory `dir` as `k` parts of about equal work (the
 /// ranges cut the work cells of the streaming plan evenly), each streamed to its
 /// own `.tess` file with its colours, then the manifest. Each part is written atomically and the
@@ -107,19 +128,7 @@ pub fn build_scene_dataset(
     let scene_err = |e: crate::csg::SceneError| PartitionError::Ranges(e.to_string());
     let csg = scene.csg().map_err(scene_err)?;
     let colours = scene.colour_csgs().map_err(scene_err)?;
-    // Sample where the surface lies with about 64 k cells or more: 4 + log4(k)
-    // levels below the root.
-    let levels = (4 + (usize::BITS - k.max(1).leading_zeros()).div_ceil(2)) as u8;
-    let sample = csg
-        .stream_plan_cells(
-            scene.depth,
-            [0, 0, 0],
-            0..u64::MAX,
-            scene.depth.saturating_sub(levels),
-        )
-        .map_err(|e| PartitionError::Ranges(e.to_string()))?;
-    let ranges: Vec<Partition> = balanced_ranges(scene.depth, k, &sample.cell_ranges());
-    drop(sample);
+    let ranges = csg_ranges(&csg, scene.depth, k)?;
     std::fs::create_dir_all(dir).map_err(|e| crate::io::FormatError::io(e).with_path(dir))?;
     let mut parts = Vec::with_capacity(ranges.len());
     for (i, p) in ranges.iter().enumerate() {

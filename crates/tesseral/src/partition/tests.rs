@@ -9,7 +9,7 @@ use rand::{Rng, SeedableRng};
 use super::*;
 use crate::model::Frame;
 
-fn random_tree(rng: &mut rand_pcg::Pcg64, depth: u8) -> LinearOctree {
+pub(super) fn random_tree(rng: &mut rand_pcg::Pcg64, depth: u8) -> LinearOctree {
     let side = 1i64 << depth;
     let n = rng.random_range(0..400);
     let blob = rng.random_range(1..=side);
@@ -31,7 +31,7 @@ fn random_tree(rng: &mut rand_pcg::Pcg64, depth: u8) -> LinearOctree {
     t
 }
 
-fn random_ranges(rng: &mut rand_pcg::Pcg64, depth: u8) -> Vec<Partition> {
+pub(super) fn random_ranges(rng: &mut rand_pcg::Pcg64, depth: u8) -> Vec<Partition> {
     let end = 1u64 << (3 * u32::from(depth));
     let k = rng.random_range(1..8);
     let mut cuts: Vec<u64> = (0..k).map(|_| rng.random_range(1..end)).collect();
@@ -43,7 +43,7 @@ fn random_ranges(rng: &mut rand_pcg::Pcg64, depth: u8) -> Vec<Partition> {
         .collect()
 }
 
-fn voxels(t: &LinearOctree) -> HashSet<[i64; 3]> {
+pub(super) fn voxels(t: &LinearOctree) -> HashSet<[i64; 3]> {
     t.voxels().collect()
 }
 

@@ -312,6 +312,36 @@ impl LinearOctree {
         let moved_origin = add_voxel(self.origin, by)?;
         self.resample_moved(moved_origin, None, self.depth, self.origin)
     }
+
+    /// The tree translated by `by` and written into the space `(depth, origin)`:
+    /// voxels that land outside it are dropped, and their number is returned. One
+    /// pass (no intermediate space); a partitioned translation moves each part
+    /// straight into the whole result's space this way.
+    ///
+    /// # Runtime
+    /// As [`LinearOctree::translate`].
+    ///
+    /// # Errors
+    /// [`OctreeError::DepthTooLarge`] for a bad space; [`OctreeError::Overflow`]
+    /// when a coordinate overflows.
+    ///
+    /// ```
+    /// use tesseral::linear::LinearOctree;
+    /// let a = LinearOctree::from_voxels(2, [0, 0, 0], [[0, 0, 0], [3, 0, 0]]).unwrap();
+    /// let (b, dropped) = a.translate_into([1, 0, 0], 3, [0, 0, 0]).unwrap();
+    /// assert_eq!((b.depth(), b.voxel_count(), dropped), (3, 2, 0));
+    /// assert!(b.contains([4, 0, 0]));
+    /// ```
+    pub fn translate_into(
+        &self,
+        by: [i64; 3],
+        depth: u8,
+        origin: Voxel,
+    ) -> Result<(Self, u64), OctreeError> {
+        super::check_space(depth, origin)?;
+        let moved_origin = add_voxel(self.origin, by)?;
+        self.resample_moved(moved_origin, None, depth, origin)
+    }
 }
 
 fn add_voxel(a: Voxel, b: [i64; 3]) -> Result<Voxel, OctreeError> {

@@ -1,0 +1,373 @@
+//! The steps of a partitioned run, one call each, for `tesseral.dask`'s tasks:
+//! balanced ranges of a scene, building one code range, a set operation of two
+//! parts, splitting, joining, the two halves of a translation's shuffle, and the
+//! parts and manifest of a dataset on disk (the library's dataset code, so a dataset
+//! written here is the one `tesseral build --parts` writes).
+//!
+//! Ranges cross as lists of `(lo, hi)` pairs; parts as `Octree`s, each in the whole
+//! space with its leaves inside its range.
+
+use std::path::PathBuf;
+
+use numpy::{IntoPyArray, PyArray1, PyReadonlyArray1};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+use tesseral::linear::{LinearOctree, SetOp};
+use tesseral::model::{Frame, Model};
+use tesseral::partition::{self as part, ManifestPart, Partition, PartitionedOctree};
+
+use crate::errors;
+use crate::octree::Octree;
+use crate::scene::Scene;
+
+type Vec3 = (i64, i64, i64);
+type Bbox = Option<(Vec3, Vec3)>;
+
+fn ranges_in(ranges: &[(u64, u64)]) -> Vec<Partition> {
+    ranges
+        .iter()
+        .map(|&(lo, hi)| Partition { lo, hi })
+        .collect()
+}
+
+fn ranges_out(ranges: &[Partition]) -> Vec<(u64, u64)> {
+    ranges.iter().map(|p| (p.lo, p.hi)).collect()
+}
+
+fn set_op(name: &str) -> PyResult<SetOp> {
+    match name {
+        "union" => Ok(SetOp::Union),
+        "intersection" => Ok(SetOp::Intersection),
+        "difference" => Ok(SetOp::Difference),
+        "xor" | "symmetric_difference" => Ok(SetOp::SymmetricDifference),
+        _ => Err(PyValueError::new_err(format!(
+            "operation {name:?}: expected 'union', 'intersection', 'difference' or 'xor'"
+        ))),
+    }
+}
+
+fn same_frame(a: Frame, b: Frame) -> PyResult<()> {
+    if a == b {
+        Ok(())
+    } else {
+        Err(errors::octree(format!(
+            "the parts have different frames (voxel size {} at {:?}, voxel size {} at {:?})",
+            a.voxel_size, a.translate, b.voxel_size, b.translate
+        )))
+    }
+}
+
+fn model(tree: LinearOctree, frame: Frame) -> Octree {
+    Octree::new(Model::new(tree).with_frame(frame))
+}
+
+/// About `k` ranges of equal work for building `scene` at `depth` (those of
+/// `tesseral build --parts k`).
+#[pyfunction]
+pub fn partition_scene_ranges(
+    py: Python<'_>,
+    scene: &Scene,
+    depth: Option<u8>,
+    k: usize,
+) -> PyResult<Vec<(u64, u64)>> {
+    let s = scene.at_depth(depth)?;
+    let r = py
+        .allow_threads(|| part::scene_ranges(&s, k))
+        .map_err(errors::octree)?;
+    Ok(ranges_out(&r))
+}
+
+/// The part of `scene` at `depth` in the codes `[lo, hi)`, with the scene's frame
+/// (no colours).
+#[pyfunction]
+pub fn partition_build_range(
+    py: Python<'_>,
+    scene: &Scene,
+    depth: Option<u8>,
+    lo: u64,
+    hi: u64,
+) -> PyResult<Octree> {
+    let s = scene.at_depth(depth)?;
+    let csg = s.csg().map_err(|e| errors::scene(py, e))?;
+    let tree = py
+        .allow_threads(|| csg.build_range(s.depth, [0, 0, 0], lo..hi))
+        .map_err(errors::octree)?;
+    Ok(model(tree, s.frame()))
+}
+
+/// The set operation `op` of two parts cut to the same range.
+#[pyfunction]
+pub fn partition_set_op(py: Python<'_>, a: &Octree, b: &Octree, op: &str) -> PyResult<Octree> {
+    let op = set_op(op)?;
+    same_frame(a.model.frame, b.model.frame)?;
+    let (ta, tb) = (&a.model.tree, &b.model.tree);
+    let tree = py
+        .allow_threads(|| part::set_op_part(ta, tb, op))
+        .map_err(errors::octree)?;
+    Ok(model(tree, a.model.frame))
+}
+
+/// The tree cut into `ranges` (which tile its space in order), one Octree per range.
+#[pyfunction]
+pub fn partition_split(
+    py: Python<'_>,
+    tree: &Octree,
+    ranges: Vec<(u64, u64)>,
+) -> PyResult<Vec<Octree>> {
+    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    let ranges = ranges_in(&ranges);
+    let p = py
+        .allow_threads(|| PartitionedOctree::split(t, &ranges))
+        .map_err(errors::octree)?;
+    Ok(p.parts()
+        .iter()
+        .map(|(_, t)| model(t.clone(), frame))
+        .collect())
+}
+
+/// The union of pieces of one space and frame (at least one).
+#[pyfunction]
+pub fn partition_join(py: Python<'_>, pieces: Vec<Octree>) -> PyResult<Octree> {
+    let first = pieces
+        .first()
+        .ok_or_else(|| PyValueError::new_err("partition_join needs at least one piece"))?;
+    let (depth, origin, frame) = (
+        first.model.tree.depth(),
+        first.model.tree.origin(),
+        first.model.frame,
+    );
+    for p in &pieces {
+        same_frame(frame, p.model.frame)?;
+    }
+    let trees: Vec<LinearOctree> = pieces.into_iter().map(|p| p.model.tree).collect();
+    let tree = py
+        .allow_threads(|| part::join_pieces(depth, origin, trees))
+        .map_err(errors::octree)?;
+    Ok(model(tree, frame))
+}
+
+/// The space of the whole tree (of space `depth`, `origin`, whose parts have the
+/// bounding boxes `bboxes`) translated by `by`: `(depth, origin)`.
+#[pyfunction]
+pub fn partition_translated_space(
+    depth: u8,
+    origin: Vec3,
+    bboxes: Vec<Bbox>,
+    by: Vec3,
+) -> PyResult<(u8, Vec3)> {
+    let v = |p: Vec3| [p.0, p.1, p.2];
+    let bbox = part::union_bbox(bboxes.into_iter().map(|b| b.map(|(lo, hi)| (v(lo), v(hi)))));
+    let (d, o) = part::translated_space(depth, v(origin), bbox, v(by)).map_err(errors::octree)?;
+    Ok((d, (o[0], o[1], o[2])))
+}
+
+/// Sorted codes, in the space `(depth, origin)`, of about `max` leaves of `tree`
+/// moved by `by` (a sample for balancing the ranges of a translation).
+#[pyfunction]
+pub fn partition_translated_sample<'py>(
+    py: Python<'py>,
+    tree: &Octree,
+    by: Vec3,
+    depth: u8,
+    origin: Vec3,
+    max: usize,
+) -> Bound<'py, PyArray1<u64>> {
+    let t = &tree.model.tree;
+    let codes = py.allow_threads(|| {
+        part::translated_sample(
+            t,
+            [by.0, by.1, by.2],
+            depth,
+            [origin.0, origin.1, origin.2],
+            max,
+        )
+    });
+    codes.into_pyarray(py)
+}
+
+/// Exactly `k` ranges of the depth-`depth` space (fewer only when it has fewer
+/// codes), balanced on the sorted sample `codes`.
+#[pyfunction]
+pub fn partition_balanced_ranges(
+    depth: u8,
+    k: usize,
+    codes: PyReadonlyArray1<'_, u64>,
+) -> PyResult<Vec<(u64, u64)>> {
+    LinearOctree::empty(depth, [0; 3]).map_err(errors::octree)?;
+    let mut c = codes.as_array().to_vec();
+    c.sort_unstable();
+    Ok(ranges_out(&part::balanced_ranges_exact(depth, k, &c)))
+}
+
+/// `tree` moved by `by` into the space `(depth, origin)` and cut into `ranges`.
+#[pyfunction]
+pub fn partition_translate_split(
+    py: Python<'_>,
+    tree: &Octree,
+    by: Vec3,
+    depth: u8,
+    origin: Vec3,
+    ranges: Vec<(u64, u64)>,
+) -> PyResult<Vec<Octree>> {
+    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    let ranges = ranges_in(&ranges);
+    let p = py
+        .allow_threads(|| -> Result<_, String> {
+            let (moved, dropped) = t
+                .translate_into([by.0, by.1, by.2], depth, [origin.0, origin.1, origin.2])
+                .map_err(|e| e.to_string())?;
+            if dropped > 0 {
+                return Err(format!(
+                    "{dropped} voxels land outside the space of depth {depth} at {origin:?}"
+                ));
+            }
+            PartitionedOctree::split(&moved, &ranges).map_err(|e| e.to_string())
+        })
+        .map_err(errors::octree)?;
+    Ok(p.parts()
+        .iter()
+        .map(|(_, t)| model(t.clone(), frame))
+        .collect())
+}
+
+fn entry<'py>(py: Python<'py>, e: &ManifestPart) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("file", &e.file)?;
+    d.set_item("lo", e.lo)?;
+    d.set_item("hi", e.hi)?;
+    d.set_item("leaves", e.leaves)?;
+    d.set_item("voxels", e.voxels)?;
+    d.set_item("crc32", e.crc32)?;
+    Ok(d)
+}
+
+/// A manifest entry as Python hands it back.
+#[derive(FromPyObject)]
+pub struct Entry {
+    #[pyo3(item)]
+    file: String,
+    #[pyo3(item)]
+    lo: u64,
+    #[pyo3(item)]
+    hi: u64,
+    #[pyo3(item)]
+    leaves: u64,
+    #[pyo3(item)]
+    voxels: u64,
+    #[pyo3(item)]
+    crc32: u32,
+}
+
+/// Writes part `i` (range `[lo, hi)`) of a dataset in `dir` (created if missing);
+/// returns its manifest entry as a dict.
+#[pyfunction]
+pub fn partition_write_part<'py>(
+    py: Python<'py>,
+    dir: PathBuf,
+    i: usize,
+    lo: u64,
+    hi: u64,
+    tree: &Octree,
+) -> PyResult<Bound<'py, PyDict>> {
+    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    std::fs::create_dir_all(&dir)
+        .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", dir.display())))?;
+    let e = py
+        .allow_threads(|| part::write_part(&dir, i, Partition { lo, hi }, t, frame))
+        .map_err(partition_error)?;
+    entry(py, &e)
+}
+
+/// Writes the manifest of a dataset whose parts are written: the space
+/// (`depth`, `origin`), the frame (`voxel_size`, `translate`) and the entries.
+#[pyfunction]
+pub fn partition_write_manifest(
+    py: Python<'_>,
+    dir: PathBuf,
+    depth: u8,
+    origin: Vec3,
+    voxel_size: f64,
+    translate: (f64, f64, f64),
+    entries: Vec<Entry>,
+) -> PyResult<()> {
+    let parts: Vec<ManifestPart> = entries
+        .into_iter()
+        .map(|e| ManifestPart {
+            file: e.file,
+            lo: e.lo,
+            hi: e.hi,
+            leaves: e.leaves,
+            voxels: e.voxels,
+            crc32: e.crc32,
+        })
+        .collect();
+    LinearOctree::empty(depth, [origin.0, origin.1, origin.2]).map_err(errors::octree)?;
+    if !(voxel_size.is_finite() && voxel_size > 0.0) {
+        return Err(PyValueError::new_err(
+            "voxel_size must be positive and finite",
+        ));
+    }
+    let frame = Frame::new(voxel_size, [translate.0, translate.1, translate.2]);
+    let origin = [origin.0, origin.1, origin.2];
+    py.allow_threads(|| part::write_manifest(&dir, depth, origin, frame, &parts))
+        .map_err(partition_error)
+}
+
+/// A dataset's manifest, checked: {"depth", "origin", "voxel_size", "translate",
+/// "parts": [entry, …]}.
+#[pyfunction]
+pub fn partition_read_manifest(py: Python<'_>, dir: PathBuf) -> PyResult<Bound<'_, PyDict>> {
+    let m = part::read_manifest(&dir).map_err(partition_error)?;
+    let d = PyDict::new(py);
+    d.set_item("depth", m.depth)?;
+    d.set_item("origin", (m.origin[0], m.origin[1], m.origin[2]))?;
+    d.set_item("voxel_size", m.frame.voxel_size)?;
+    let t = m.frame.translate;
+    d.set_item("translate", (t[0], t[1], t[2]))?;
+    let parts = m
+        .parts
+        .iter()
+        .map(|e| entry(py, e))
+        .collect::<PyResult<Vec<_>>>()?;
+    d.set_item("parts", parts)?;
+    Ok(d)
+}
+
+/// Part `i` of the dataset in `dir`, checked against its manifest.
+#[pyfunction]
+pub fn partition_read_part(py: Python<'_>, dir: PathBuf, i: usize) -> PyResult<Octree> {
+    py.allow_threads(|| {
+        let m = part::read_manifest(&dir)?;
+        part::read_part(&dir, &m, i)
+    })
+    .map(Octree::new)
+    .map_err(partition_error)
+}
+
+/// File errors as `FormatError`/`OSError`, the rest as `FormatError` too (they name
+/// the manifest or part at fault).
+fn partition_error(e: part::PartitionError) -> PyErr {
+    match e {
+        part::PartitionError::Format(f) => errors::format(f),
+        other => errors::FormatError::new_err(other.to_string()),
+    }
+}
+
+/// Registers the functions above.
+pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(partition_scene_ranges, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_build_range, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_set_op, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_split, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_join, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_translated_space, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_translated_sample, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_balanced_ranges, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_translate_split, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_write_part, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_write_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_read_manifest, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_read_part, m)?)?;
+    Ok(())
+}
