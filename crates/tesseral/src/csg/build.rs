@@ -61,7 +61,7 @@ impl Csg {
         }
         // The builder emits leaves sorted and canonical (merging as it goes), so they are
         // taken as they are; the tests check `assert_valid` on every build.
-        Ok(LinearOctree::from_parts(depth, origin, out))
+        Ok(LinearOctree::from_parts(depth, origin, out).with_bricks())
     }
 
     /// The parallel levels: the leaves come back as a list of sorted chunks, so that

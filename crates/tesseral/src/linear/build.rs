@@ -74,7 +74,7 @@ impl LinearOctree {
         let space = Self::from_parts(depth, origin, Vec::new());
         let mut leaves = Vec::new();
         build_cell(&space, classifier, 0, depth, &mut leaves);
-        Ok(Self::from_parts(depth, origin, leaves))
+        Ok(Self::from_parts(depth, origin, leaves).with_bricks())
     }
 }
 

@@ -197,7 +197,10 @@ impl LinearOctree {
             .collect::<Result<Vec<u64>, _>>()?;
         sort::sort_u64(&mut codes);
         codes.dedup();
-        Self::from_sorted_leaves(depth, origin, codes.into_iter().map(|c| Leaf::new(c, 0)))
+        Ok(
+            Self::from_sorted_leaves(depth, origin, codes.into_iter().map(|c| Leaf::new(c, 0)))?
+                .with_bricks(),
+        )
     }
 
     /// Builds a tree from black voxels, choosing the smallest space that holds them:

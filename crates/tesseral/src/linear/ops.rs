@@ -61,7 +61,9 @@ impl LinearOctree {
     /// # Runtime
     /// O(n + m) leaves in a shared space, in parallel for large inputs; aligning a
     /// foreign operand costs one [`LinearOctree::resample`] of it. When either
-    /// operand holds its bricked form ([`LinearOctree::build_bricks`]), the merge
+    /// operand holds its bricked form ([`LinearOctree::build_bricks`]; the trees from
+    /// [`LinearOctree::from_classifier`], [`LinearOctree::from_voxels`] and scene
+    /// builds hold it from the start), the merge
     /// runs on the bricked forms (O(n + m) entries and masks, chunks that only one
     /// operand has passed on without copying) and the result is held in bricked form.
     ///

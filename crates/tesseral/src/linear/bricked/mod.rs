@@ -455,6 +455,15 @@ impl LinearOctree {
         self
     }
 
+    /// `self` with its bricked form made: what the constructors of new solids
+    /// (`from_classifier`, `from_voxels`, a scene's build) return, so that set
+    /// operations on the trees a user builds run on bricks from the first one.
+    #[must_use]
+    pub(crate) fn with_bricks(self) -> Self {
+        self.bricked();
+        self
+    }
+
     /// Whether the tree holds its bricked form.
     pub(crate) fn has_bricked(&self) -> bool {
         self.bricked.get().is_some()
