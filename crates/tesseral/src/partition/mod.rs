@@ -28,7 +28,7 @@ pub use dataset::{
     is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, write_dataset,
     Manifest, ManifestPart, MANIFEST,
 };
-pub use merge::{stream_concat, stream_set_op};
+pub use merge::{stream_concat, stream_set_op, stream_set_op_in};
 pub use stream::{build_scene_dataset, write_plan_tess, write_plan_tess_coloured, StreamSummary};
 
 /// Errors of partitioned octrees and datasets.
