@@ -302,3 +302,45 @@ fn streamed_set_operations_equal_the_in_memory_ones() {
         );
     }
 }
+
+/// Runs the binary in `dir` with its address space capped at `mib` MiB (`ulimit
+/// -v`), two threads and two malloc arenas, so the cap bounds what it allocates.
+fn run_capped(dir: &Path, args: &[&str], mib: u64) -> std::process::Output {
+    std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {}; exec \"$0\" \"$@\"", mib * 1024))
+        .arg(env!("CARGO_BIN_EXE_tesseral"))
+        .args(args)
+        .env("RAYON_NUM_THREADS", "2")
+        .env("MALLOC_ARENA_MAX", "2")
+        .current_dir(dir)
+        .output()
+        .expect("run tesseral")
+}
+
+/// Bounded memory: the spheroid at depth 12 (14.5 M leaves, with its colours)
+/// builds streamed within a 256 MiB address space; the in-memory build of the same
+/// scene (to .xyz) cannot, so the cap does bound the work.
+#[test]
+fn a_streamed_build_fits_in_a_small_address_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("fig4c-spheroid.tss");
+    let s = scene.to_str().unwrap();
+    let out = run_capped(
+        d,
+        &["build", s, "-o", "s.tess", "--depth", "12", "--json"],
+        256,
+    );
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["leaves"], 14_520_164);
+    assert_eq!(v["colors"], 1);
+    let out = run_capped(d, &["build", s, "-o", "m.xyz", "--depth", "12"], 256);
+    assert!(!out.status.success());
+    assert!(!d.join("m.xyz").exists());
+}

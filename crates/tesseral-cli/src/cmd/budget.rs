@@ -10,7 +10,7 @@
 use std::path::Path;
 
 use anyhow::{bail, Result};
-use tesseral::csg::Scene;
+use tesseral::csg::{Scene, DEFAULT_MAX_LEAVES};
 use tesseral::linear::LinearOctree;
 
 use super::output::{human_bytes, parse_bytes};
@@ -52,10 +52,30 @@ impl Budget {
     /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
     /// amount), naming the flag that binds.
     pub fn refuse(&self, what: &str, leaves: u64) -> anyhow::Error {
-        let cap = self.leaf_cap();
-        let (flag, limit) = match self.max_leaves {
-            Some(n) if n == cap => ("--max-leaves", n.to_string()),
-            _ => ("--memory", human_bytes(self.memory)),
+        self.refuse_at(what, leaves, self.leaf_cap())
+    }
+
+    /// The leaf cap of a world's bodies (`simulate`): `--max-leaves`, by default
+    /// the library's [`DEFAULT_MAX_LEAVES`] (a body costs far more than a leaf's
+    /// 24 bytes once collision structures are built), or fewer if `--memory`
+    /// cannot hold that many.
+    pub fn world_leaf_cap(&self) -> usize {
+        self.max_leaves
+            .unwrap_or(DEFAULT_MAX_LEAVES)
+            .min(self.memory_leaf_cap())
+    }
+
+    fn memory_leaf_cap(&self) -> usize {
+        usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX)
+    }
+
+    /// As [`Budget::refuse`], for the cap `cap`: `--memory` binds when it allows no
+    /// more than `cap`, else `--max-leaves` (given, or its default).
+    pub fn refuse_at(&self, what: &str, leaves: u64, cap: usize) -> anyhow::Error {
+        let (flag, limit) = if cap >= self.memory_leaf_cap() {
+            ("--memory", human_bytes(self.memory))
+        } else {
+            ("--max-leaves", cap.to_string())
         };
         let count = if leaves == u64::MAX {
             format!("more than the {cap} leaves that {flag} {limit} allows")

@@ -105,21 +105,44 @@ struct Info {
 /// An inclusive box of voxels.
 type BBox = ([i64; 3], [i64; 3]);
 
-/// The info of a version-2 `.tess` file with no layers but colours, read chunk by
-/// chunk from the map (the leaves never all held), the colour regions as streams.
-/// `None` for other files.
+/// The info of a version-2 `.tess` file with no layers but colours, or of a dataset
+/// of them, read chunk by chunk from the maps (the leaves never all held), part
+/// after part, the colour regions as streams. `None` for other files.
 fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
     use tesseral::io::TessFile;
-    if super::output::is_stdio(path) || !path.is_file() || tesseral::io::extension(path) != "tess" {
+    use tesseral::partition::{is_dataset, open_part, read_manifest};
+    if super::output::is_stdio(path) {
         return Ok(None);
     }
-    let f = TessFile::open(path)?;
-    let colours = if f.has_layers() {
-        f.colour_streams()?
+    let dataset = is_dataset(path);
+    let (files, frame) = if dataset {
+        let m = read_manifest(path)?;
+        let mut files = Vec::with_capacity(m.parts.len());
+        for i in 0..m.parts.len() {
+            files.push(open_part(path, &m, i)?);
+        }
+        let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
+        (files, frame)
+    } else if path.is_file() && tesseral::io::extension(path) == "tess" {
+        let f = TessFile::open(path)?;
+        let frame = f.frame();
+        (vec![f], frame)
     } else {
-        Some(Vec::new())
+        return Ok(None);
     };
-    let (true, Some(colours)) = (f.is_streamed(), colours) else {
+    let mut colours = Vec::new();
+    for f in &files {
+        let streams = if f.has_layers() {
+            f.colour_streams()?
+        } else {
+            Some(Vec::new())
+        };
+        let (true, Some(streams)) = (f.is_streamed(), streams) else {
+            return Ok(None);
+        };
+        colours.extend(streams);
+    }
+    let Some(f) = files.first() else {
         return Ok(None);
     };
     let (depth, origin) = (f.depth(), f.origin());
@@ -127,7 +150,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
     let mut by_depth = vec![0u64; usize::from(depth) + 1];
     let (mut voxels, mut leaves) = (0u64, 0usize);
     let mut bbox: Option<BBox> = None;
-    for l in f.leaves() {
+    for l in files.iter().flat_map(|f| f.leaves()) {
         let l = l?;
         leaves += 1;
         voxels += l.voxel_count();
@@ -142,14 +165,16 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
             ),
         });
     }
-    let n_colours = colours.len();
+    let mut distinct: Vec<tesseral::model::Rgba> = colours.iter().map(|(c, _)| *c).collect();
+    distinct.sort_unstable();
+    distinct.dedup();
+    let n_colours = distinct.len();
     let mut colored_voxels = 0u64;
     for (_, region) in colours {
         for l in region {
             colored_voxels += l?.voxel_count();
         }
     }
-    let frame = f.frame();
     let info = Info {
         voxels,
         leaves,
@@ -163,7 +188,9 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
         translate: frame.translate,
         world_min: bbox.map(|b| frame.voxel_corner(b.0)),
         world_max: bbox.map(|b| frame.voxel_corner(b.1.map(|c| c + 1))),
-        colors: (n_colours > 0).then_some(n_colours),
+        // As the in-memory model says: a file's colour layer even when empty, a
+        // dataset's joined layer only when some part has a colour.
+        colors: (n_colours > 0 || (!dataset && files[0].has_layers())).then_some(n_colours),
         colored_voxels,
         free_voxels: None,
         free_leaves: None,

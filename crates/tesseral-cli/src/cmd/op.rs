@@ -106,7 +106,7 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     };
     let mut summary = tesseral::partition::StreamSummary::default();
     tesseral::io::write_atomic(&args.output, |w| {
-        summary = tesseral::partition::stream_set_op(&a, &b, op, a.frame(), w, &spool_dir)
+        summary = tesseral::partition::stream_set_op_in(&a, &b, op, a.frame(), w, &spool_dir)
             .map_err(std::io::Error::other)?;
         Ok(())
     })

@@ -131,10 +131,12 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(page) = &view_page {
         output::guard("--view", page, &["html"], &[&args.world])?;
     }
-    let cap = args.budget.leaf_cap() as u64;
-    let wf = match read_world_limited(&args.world, cap, args.allow_outside) {
+    let cap = args.budget.world_leaf_cap();
+    let wf = match read_world_limited(&args.world, cap as u64, args.allow_outside) {
         Err(WorldError::TooManyLeaves { path, leaves, .. }) => {
-            return Err(args.budget.refuse(&path.display().to_string(), leaves))
+            return Err(args
+                .budget
+                .refuse_at(&path.display().to_string(), leaves, cap))
         }
         r => r.context("reading the world file")?,
     };

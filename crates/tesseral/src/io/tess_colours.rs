@@ -9,7 +9,7 @@ use crate::linear::Leaf;
 use crate::model::Rgba;
 
 /// The leaves of one colour region, decoded lazily and checked as
-/// [`super::leafstream::read_leaves`] checks them.
+/// the whole-file reader checks them (packing, size, bounds, order).
 pub struct RegionLeaves<'a> {
     r: Reader<'a>,
     left: u64,

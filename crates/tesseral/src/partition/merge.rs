@@ -120,6 +120,20 @@ fn sweep(mut streams: Vec<Stream<'_>>, segment: &mut Segment<'_>) -> Result<(), 
     }
 }
 
+/// [`stream_set_op_in`] with the colour spools in the system's temporary folder.
+///
+/// # Errors
+/// As [`stream_set_op_in`].
+pub fn stream_set_op(
+    a: &TessFile,
+    b: &TessFile,
+    op: SetOp,
+    frame: Frame,
+    w: &mut dyn Write,
+) -> Result<StreamSummary, PartitionError> {
+    stream_set_op_in(a, b, op, frame, w, &std::env::temp_dir())
+}
+
 /// The set operation `op` of two `.tess` files of one space, streamed into a new
 /// `.tess` written to `w` with `frame` (see the module docs). Colours follow the
 /// in-memory rule (`Model::set_op`): a voxel of the result keeps the first
@@ -133,7 +147,7 @@ fn sweep(mut streams: Vec<Stream<'_>>, segment: &mut Segment<'_>) -> Result<(), 
 /// [`PartitionError::Ranges`] when the spaces differ, or an input has layers other
 /// than colours (free space, log-odds) or is version 1; [`PartitionError::Format`]
 /// for a bad chunk or a write error.
-pub fn stream_set_op(
+pub fn stream_set_op_in(
     a: &TessFile,
     b: &TessFile,
     op: SetOp,

@@ -242,7 +242,7 @@ fn streamed_set_operations_of_files_equal_the_in_memory_ones() {
             SetOp::SymmetricDifference,
         ] {
             let mut out = Vec::new();
-            let s = stream_set_op(&fa, &fb, op, Frame::default(), &mut out, dir.path()).unwrap();
+            let s = stream_set_op(&fa, &fb, op, Frame::default(), &mut out).unwrap();
             let got = crate::io::native::decode(&out).unwrap().tree;
             got.assert_valid();
             let want = a.set_op_same_space(&b, op);
@@ -325,7 +325,7 @@ fn streamed_set_operations_keep_colours_as_in_memory() {
             SetOp::SymmetricDifference,
         ] {
             let mut out = Vec::new();
-            stream_set_op(&fa, &fb, op, Frame::default(), &mut out, dir.path()).unwrap();
+            stream_set_op_in(&fa, &fb, op, Frame::default(), &mut out, dir.path()).unwrap();
             let got = crate::io::native::decode(&out).unwrap();
             got.assert_valid();
             let want = ma.set_op(&mb, op).unwrap();
