@@ -250,3 +250,11 @@ def test_without_dask_the_error_says_what_to_install():
         "    raise SystemExit('imported without dask')\n"
     )
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+def test_operands_in_different_spaces_are_named(client):
+    scene = tesseral.Scene.read(str(ROOT / "scenes" / "tank.tss"))
+    parts = tdask.build(scene, parts=3)
+    moved = tdask.translate(parts, (10**6, 0, 0))  # grows the space
+    with pytest.raises(Exception, match="different spaces"):
+        tdask.op(parts, moved, "union").compute()

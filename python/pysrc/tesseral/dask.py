@@ -126,10 +126,23 @@ def _join(*pieces: Octree) -> Octree:
 
 
 def _op_pieces(a: Octree, kind: str, *pieces: Octree) -> Octree:
+    for p in pieces:
+        _same_space(p, (a.depth, a.origin))
     return _ext.partition_set_op(a, _ext.partition_join(list(pieces)), kind)
 
 
-def _clip(tree: Octree, lo: int, hi: int) -> Octree:
+def _same_space(tree: Octree, space) -> None:
+    depth, origin = space
+    if (tree.depth, tuple(tree.origin)) != (depth, tuple(origin)):
+        raise _ext.OctreeError(
+            f"the operands are in different spaces (depth {depth} origin {tuple(origin)}, "
+            f"depth {tree.depth} origin {tuple(tree.origin)}): combine them whole, or "
+            "build both in one space"
+        )
+
+
+def _clip(tree: Octree, lo: int, hi: int, space) -> Octree:
+    _same_space(tree, space)
     end = 1 << (3 * tree.depth)
     if hi > end:
         raise _ext.OctreeError(
@@ -141,7 +154,9 @@ def _clip(tree: Octree, lo: int, hi: int) -> Octree:
     return _ext.partition_split(tree, ranges)[ranges.index((lo, hi))]
 
 
-def _split(tree: Octree, ranges: Sequence[Range]) -> List[Octree]:
+def _split(tree: Octree, ranges: Sequence[Range], space=None) -> List[Octree]:
+    if space is not None:
+        _same_space(tree, space)
     return _ext.partition_split(tree, list(ranges))
 
 
@@ -246,6 +261,7 @@ def op(a: Parts, b: Parts, operation: str = "union") -> Parts:
     if operation not in OPERATIONS:
         raise ValueError(f"operation {operation!r}: expected one of {', '.join(OPERATIONS)}")
     known = isinstance(a.ranges, list) and isinstance(b.ranges, list)
+    space = dask.delayed(_space)(a.octrees[0])
     if known and a.ranges == b.ranges:
         out = [
             dask.delayed(_op_pieces)(x, operation, y)
@@ -257,7 +273,7 @@ def op(a: Parts, b: Parts, operation: str = "union") -> Parts:
         # Cut only the parts of b that meet each range of a.
         for j, r in enumerate(a.ranges):
             pieces = [
-                dask.delayed(_clip)(bt, r[0], r[1])
+                dask.delayed(_clip)(bt, r[0], r[1], space)
                 for q, bt in zip(b.ranges, b.octrees)
                 if _overlaps(q, r)
             ]
@@ -265,7 +281,7 @@ def op(a: Parts, b: Parts, operation: str = "union") -> Parts:
     else:
         # a's ranges are a task: a full shuffle of b to them.
         k = len(a)
-        cut = [dask.delayed(_split, nout=k)(bt, a.ranges) for bt in b.octrees]
+        cut = [dask.delayed(_split, nout=k)(bt, a.ranges, space) for bt in b.octrees]
         for j in range(k):
             pieces = [c[j] for c in cut]
             out.append(dask.delayed(_op_pieces)(a.octrees[j], operation, *pieces))
