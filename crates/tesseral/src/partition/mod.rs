@@ -35,10 +35,10 @@ pub use shuffle::{
     balanced_ranges_exact, join_pieces, set_op_part, translated_sample, translated_space,
     union_bbox, SAMPLE_PER_PART,
 };
-pub use translate::{stream_translate, stream_translate_in, StreamTranslation, RUN_LEAVES};
 pub use stream::{
     build_scene_dataset, scene_ranges, write_plan_tess, write_plan_tess_coloured, StreamSummary,
 };
+pub use translate::{stream_translate, stream_translate_in, StreamTranslation, RUN_LEAVES};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]

@@ -41,8 +41,8 @@ fn streamed_translation_equals_the_in_memory_one() {
             rng.random_range(-9..9),
             rng.random_range(-9..9),
         ];
-        let t = LinearOctree::from_sorted_leaves(depth, origin, t.leaves().iter().copied())
-            .unwrap();
+        let t =
+            LinearOctree::from_sorted_leaves(depth, origin, t.leaves().iter().copied()).unwrap();
         let frame = Frame::new(0.25, [1.0, -2.0, 0.5]);
         let model = if i % 5 == 4 {
             Model::new(t.clone())
@@ -67,6 +67,7 @@ fn streamed_translation_equals_the_in_memory_one() {
                     "space, {i} by {by:?}"
                 );
                 assert_eq!((s.depth, s.origin), (got.tree.depth(), got.tree.origin()));
+                assert_eq!(s.bbox, got.tree.bbox());
                 assert_eq!(got.tree, want.tree, "{i} by {by:?} run {run}");
                 let moved: HashSet<[i64; 3]> = voxels(&t)
                     .into_iter()

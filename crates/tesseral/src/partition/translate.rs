@@ -38,6 +38,8 @@ pub struct StreamTranslation {
     pub depth: u8,
     /// The lowest voxel of the result's space.
     pub origin: Voxel,
+    /// The inclusive bounding box of the result's voxels (`None` when empty).
+    pub bbox: Option<(Voxel, Voxel)>,
     /// Leaves, voxels and colour regions written.
     pub summary: StreamSummary,
 }
@@ -270,6 +272,12 @@ pub fn stream_translate_in(
     Ok(StreamTranslation {
         depth: to.0,
         origin: to.1,
+        bbox: bbox.map(|(lo, hi)| {
+            (
+                std::array::from_fn(|a| lo[a] + by[a]),
+                std::array::from_fn(|a| hi[a] + by[a]),
+            )
+        }),
         summary: StreamSummary {
             leaves,
             voxels,
