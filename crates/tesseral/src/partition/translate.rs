@@ -69,13 +69,16 @@ impl Runs {
         if leaves.is_empty() {
             return Ok(());
         }
-        self.bytes.clear();
-        for l in leaves {
-            self.bytes.extend_from_slice(&l.packed().to_le_bytes());
+        // A batch's pieces can be many: write them a slice at a time.
+        for part in leaves.chunks(CURSOR_LEAVES) {
+            self.bytes.clear();
+            for l in part {
+                self.bytes.extend_from_slice(&l.packed().to_le_bytes());
+            }
+            self.file.write_all(&self.bytes)?;
         }
-        self.file.write_all(&self.bytes)?;
         self.runs.push((self.end, leaves.len() as u64));
-        self.end += self.bytes.len() as u64;
+        self.end += (leaves.len() * LEAF_BYTES) as u64;
         Ok(())
     }
 
