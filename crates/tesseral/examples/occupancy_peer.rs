@@ -15,25 +15,16 @@
 
 #[path = "../benches/common/mod.rs"]
 mod common;
+#[path = "common/mod.rs"]
+mod shared;
 
 use std::io::{Read, Write};
 use std::time::Instant;
 
 use common::scans::{scans, Scan};
 use common::SplitMix64;
+use shared::process_cpu;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
-
-/// The process's CPU time in seconds (all its threads).
-fn process_cpu() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    assert_eq!(rc, 0, "clock_gettime");
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
 
 fn write_scans(path: &str, scans: &[Scan]) -> std::io::Result<()> {
     let mut f = std::io::BufWriter::new(std::fs::File::create(path)?);

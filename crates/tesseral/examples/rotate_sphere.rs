@@ -10,7 +10,7 @@ use std::time::Instant;
 use tesseral::linear::rotation_matrix;
 
 mod common;
-use common::sphere;
+use common::{process_cpu, sphere};
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -25,10 +25,10 @@ fn main() {
     let (mut best, mut best_cpu) = (f64::MAX, f64::MAX);
     let mut out = None;
     for _ in 0..5 {
-        let (start, cpu) = (Instant::now(), cpu_seconds());
+        let (start, cpu) = (Instant::now(), process_cpu());
         let o = pool.install(|| tree.affine(m, [0.0; 3]).expect("rotate"));
         best = best.min(start.elapsed().as_secs_f64());
-        best_cpu = best_cpu.min(cpu_seconds() - cpu);
+        best_cpu = best_cpu.min(process_cpu() - cpu);
         out = Some(o);
     }
     let out = out.expect("five runs");
@@ -41,16 +41,4 @@ fn main() {
         out.voxel_count(),
         out.leaf_count()
     );
-}
-
-/// The CPU time of the whole process (every thread), in seconds.
-fn cpu_seconds() -> f64 {
-    let mut t = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `t` is a valid timespec for the call to fill.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) };
-    assert_eq!(rc, 0, "clock_gettime");
-    t.tv_sec as f64 + t.tv_nsec as f64 * 1e-9
 }

@@ -25,20 +25,8 @@ use std::io::Write;
 use std::path::Path;
 use std::time::Instant;
 
-/// The process's CPU time in seconds (all its threads). The machine is shared, so
-/// wall time would count other processes' turns on the core; both sides read this
-/// clock, and since it sums every thread, no work done off the calling thread is
-/// missed.
-fn process_cpu() -> f64 {
-    let mut ts = libc::timespec {
-        tv_sec: 0,
-        tv_nsec: 0,
-    };
-    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
-    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
-    assert_eq!(rc, 0, "clock_gettime");
-    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
-}
+mod common;
+use common::process_cpu;
 
 use tesseral::csg::Scene;
 use tesseral::linear::{CellClass, LinearOctree, SetOp};

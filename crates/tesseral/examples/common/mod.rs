@@ -1,4 +1,6 @@
-//! Solids shared by the examples (included with `mod common;`).
+//! What the examples share (included with `mod common;`): the OpenVDB harnesses'
+//! sphere, and the process's CPU time.
+#![allow(dead_code)] // each example uses part of it
 
 use tesseral::linear::{CellClass, LinearOctree};
 
@@ -33,4 +35,18 @@ pub fn sphere(r: i64) -> LinearOctree {
     let depth = (64 - (2 * r + 2).leading_zeros()) as u8;
     let half = 1i64 << (depth - 1);
     LinearOctree::from_classifier(depth, [-half; 3], &classify).expect("sphere")
+}
+
+/// The process's CPU time in seconds (all its threads). The machine may be shared,
+/// so wall time would count other processes' turns on the core; since it sums every
+/// thread, no work done off the calling thread is missed.
+pub fn process_cpu() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the clock id is a constant.
+    let rc = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    assert_eq!(rc, 0, "clock_gettime");
+    ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
 }

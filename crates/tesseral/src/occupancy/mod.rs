@@ -13,8 +13,9 @@
 //! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
 //! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]); a block
 //! is either *uniform* (all 512 cells clamped to the same value: one entry, as
-//! OctoMap prunes) or *mixed* (512 log-odds in `i16` fixed point, 1 KiB, in a
-//! pool). Unknown blocks are not stored. See `ARCHITECTURE.md` for why.
+//! OctoMap prunes), *sparse* (up to 128 known cells, each its index and its
+//! log-odds in `i16` fixed point, sorted) or *dense* (512 log-odds, 1 KiB).
+//! Unknown blocks are not stored. See `ARCHITECTURE.md` for why.
 //!
 //! ```
 //! use tesseral::occupancy::{CellState, OccupancyMap, SensorModel};
@@ -147,7 +148,8 @@ impl OccupancyMap {
     /// A cell's state.
     ///
     /// # Runtime
-    /// O(1): one hash probe and one load.
+    /// O(1): one hash probe and one load (a binary search over at most 128 cells in
+    /// a sparse block).
     #[must_use]
     pub fn state(&self, cell: [i64; 3]) -> CellState {
         match self.store.get(cell) {
@@ -187,13 +189,13 @@ impl OccupancyMap {
     }
 
     /// The number of stored entries: one per uniform block, one per known cell of a
-    /// mixed block (what OctoMap's leaf count is after pruning, at block grain).
+    /// sparse or dense block (what OctoMap's leaf count is after pruning, at block grain).
     #[must_use]
     pub fn leaf_count(&self) -> u64 {
         self.store.leaf_count()
     }
 
-    /// The number of 8×8×8 blocks stored (uniform and mixed).
+    /// The number of 8×8×8 blocks stored (uniform, sparse and dense).
     #[must_use]
     pub fn block_count(&self) -> usize {
         self.store.block_count()
@@ -215,9 +217,10 @@ impl OccupancyMap {
         out
     }
 
-    /// Checks the invariants: every uniform block is clamped, no mixed block is
-    /// uniformly clamped or all unknown, every value lies in the clamps, the pool's
-    /// free list and the index agree.
+    /// Checks the invariants: every uniform block is clamped, no dense block is
+    /// uniformly clamped or small enough to be sparse, every sparse block holds 1 to
+    /// 128 cells in order, every value lies in the clamps, the pools and the index
+    /// agree.
     ///
     /// # Panics
     /// When an invariant is broken.

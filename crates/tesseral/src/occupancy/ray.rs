@@ -119,91 +119,6 @@ pub(crate) fn walk(
     }
 }
 
-/// A walk inside one block: what [`leave_block`] moves.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) struct Crossing {
-    /// As [`Dda::t_max`].
-    pub t: [f64; 3],
-    /// As [`Dda::t_delta`].
-    pub d: [f64; 3],
-    /// As [`Dda::step`].
-    pub step: [i64; 3],
-    /// The current cell's coordinates in its block.
-    pub local: [i64; 3],
-    /// As [`Dda::left_axis`].
-    pub left_axis: [i64; 3],
-    /// As [`Dda::left`].
-    pub left: i64,
-}
-
-/// Moves a walk to the first cell of the next block in one go, exactly where the
-/// step-by-step walk would be (the same `t` values, summed in the same order), and
-/// returns the axis it left the block along; or `None`, with the walk untouched,
-/// when the walk would end inside the block or on its way out.
-///
-/// The step-by-step walk takes the axis crossings in order of `t`, ties to the
-/// higher axis (z before y before x). Along each axis the crossings in the block are
-/// known without the others, so the block is left along the axis whose wrapping
-/// crossing comes first, and every other axis takes its crossings before that one.
-#[inline]
-pub(crate) fn leave_block(w: &mut Crossing) -> Option<usize> {
-    let last = (1i64 << BLOCK_LOG2) - 1;
-    let before = |(t, a): (f64, usize), (u, b): (f64, usize)| t < u || (t == u && a > b);
-    // Per axis: the crossings left in the block and the `t` of the wrapping one.
-    let mut n = [0i64; 3];
-    let mut wrap = [(f64::INFINITY, 0usize); 3];
-    for i in 0..3 {
-        if w.step[i] == 0 {
-            wrap[i] = (f64::INFINITY, i);
-            continue;
-        }
-        n[i] = if w.step[i] > 0 {
-            last - w.local[i]
-        } else {
-            w.local[i]
-        };
-        let mut t = w.t[i];
-        for _ in 0..n[i] {
-            t += w.d[i];
-        }
-        wrap[i] = (t, i);
-    }
-    let mut e = 0;
-    for i in 1..3 {
-        if before(wrap[i], wrap[e]) {
-            e = i;
-        }
-    }
-    if !wrap[e].0.is_finite() {
-        return None;
-    }
-    let mut m = [0i64; 3];
-    let mut t = w.t;
-    for i in 0..3 {
-        if i == e || w.step[i] == 0 {
-            continue;
-        }
-        while before((t[i], i), wrap[e]) {
-            t[i] += w.d[i];
-            m[i] += 1;
-        }
-    }
-    m[e] = n[e] + 1;
-    let steps = m[0] + m[1] + m[2];
-    if (0..3).any(|i| m[i] > w.left_axis[i]) || steps >= w.left {
-        return None;
-    }
-    t[e] = wrap[e].0 + w.d[e];
-    for i in 0..3 {
-        w.left_axis[i] -= m[i];
-        w.local[i] += w.step[i] * m[i];
-    }
-    w.local[e] &= last;
-    w.t = t;
-    w.left -= steps;
-    Some(e)
-}
-
 /// Hit and miss bits of one block: bit `x + 8y` of word `z`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Masks {
@@ -268,8 +183,7 @@ impl Scratch {
 
     /// Marks missed the cells of a ray, as [`walk`] visits them: the walk is kept in
     /// registers, in the cell's block-local coordinates, with one probe per block
-    /// crossed; a block whose 512 cells are all missed already is crossed in one
-    /// move ([`leave_block`]).
+    /// crossed.
     #[inline]
     pub fn miss_ray(
         &mut self,
@@ -292,7 +206,6 @@ impl Scratch {
         let mut left = w.left;
         let mut s = self.slot(block);
         self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
-        let mut entered = true;
         // One step along an axis: stop before passing the end cell's plane or on
         // reaching the end cell; a new block when the local coordinate wraps.
         macro_rules! step {
@@ -311,35 +224,10 @@ impl Scratch {
                     $c &= mask;
                     block[$axis] += $s;
                     s = self.slot(block);
-                    entered = true;
                 }
             }};
         }
         loop {
-            if entered {
-                entered = false;
-                if self.blocks[s].miss.iter().all(|&m| m == !0) {
-                    let mut b = Crossing {
-                        t: [tx, ty, tz],
-                        d: [dx, dy, dz],
-                        step: [sx, sy, sz],
-                        local: [x, y, z],
-                        left_axis: [lx, ly, lz],
-                        left,
-                    };
-                    if let Some(e) = leave_block(&mut b) {
-                        [tx, ty, tz] = b.t;
-                        [x, y, z] = b.local;
-                        [lx, ly, lz] = b.left_axis;
-                        left = b.left;
-                        block[e] += b.step[e];
-                        s = self.slot(block);
-                        self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
-                        entered = true;
-                        continue;
-                    }
-                }
-            }
             // Ties: x before z, y before z, y before x only when strictly smaller.
             if tx < ty {
                 if tx < tz {

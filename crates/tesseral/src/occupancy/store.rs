@@ -1,5 +1,6 @@
-//! Blocks of 8×8×8 cells in a hash map: uniform blocks as one entry, mixed blocks as
-//! 512 fixed-point log-odds in a pool.
+//! Blocks of 8×8×8 cells in a hash map: uniform blocks as one entry, sparse blocks as
+//! their known cells (index and fixed-point log-odds, sorted), dense blocks as 512
+//! fixed-point log-odds.
 
 use rustc_hash::FxHashMap;
 
