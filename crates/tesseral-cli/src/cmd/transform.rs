@@ -52,6 +52,9 @@ pub struct TranslateArgs {
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
+    if streamed(&args)? {
+        return Ok(());
+    }
     let model = octree::read(&args.input)?;
     let by = match (args.by, args.by_world) {
         (Some(by), _) => by,
@@ -132,6 +135,89 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
         extra,
     };
     octree::write(&args.output, &moved, &args.limits, report)
+}
+
+/// A version-2 `.tess` file with no layers but colours, translated into a `.tess`
+/// file by an external merge (`partition::stream_translate`): never the whole tree
+/// in memory. `false` (nothing done) for other inputs, outputs and methods.
+fn streamed(args: &TranslateArgs) -> Result<bool> {
+    use tesseral::io::TessFile;
+    let tess =
+        |p: &std::path::Path| !super::output::is_stdio(p) && tesseral::io::extension(p) == "tess";
+    let linear = matches!(args.method, Method::Linear) && !args.clip;
+    if !(linear && tess(&args.input) && args.input.is_file() && tess(&args.output)) {
+        return Ok(false);
+    }
+    let f = TessFile::open(&args.input)?;
+    if !f.is_streamed() || (f.has_layers() && f.colour_streams()?.is_none()) {
+        return Ok(false);
+    }
+    let by = match (args.by, args.by_world) {
+        (Some(by), _) => by,
+        (None, Some(w)) => f
+            .frame()
+            .world_to_voxels(w)
+            .map_err(|e| anyhow::anyhow!("--by-world: {e}"))?,
+        (None, None) => anyhow::bail!("give --by or --by-world"),
+    };
+    // The runs' and colour spools' temporary files go next to the output.
+    let spool_dir = match args.output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    };
+    let mut done = None;
+    tesseral::io::write_atomic(&args.output, |w| {
+        done = Some(
+            tesseral::partition::stream_translate(&f, by, w, &spool_dir)
+                .map_err(std::io::Error::other)?,
+        );
+        Ok(())
+    })
+    .with_context(|| {
+        format!(
+            "translating {} by {} into {}",
+            args.input.display(),
+            octree::fmt_voxel(by),
+            args.output.display()
+        )
+    })?;
+    let Some(t) = done else {
+        anyhow::bail!("writing {}: nothing was written", args.output.display());
+    };
+    let frame = f.frame();
+    if args.json {
+        let out = serde_json::json!({
+            "output": args.output,
+            "voxels": t.summary.voxels,
+            "leaves": t.summary.leaves,
+            "depth": t.depth,
+            "origin": t.origin,
+            "bbox_min": t.bbox.map(|b| b.0),
+            "bbox_max": t.bbox.map(|b| b.1),
+            "voxel_size": frame.voxel_size,
+            "translate": frame.translate,
+            "by": by,
+            "method": "linear",
+            "colors": (t.summary.colours > 0).then_some(t.summary.colours),
+            "streamed": true,
+        });
+        crate::outln!("{out}")?;
+    } else {
+        let fr = if frame.is_unit() {
+            String::new()
+        } else {
+            format!(", {frame}")
+        };
+        crate::outln!(
+            "wrote {}: {} voxels, {} leaves, depth {}, origin {}{fr}",
+            args.output.display(),
+            t.summary.voxels,
+            t.summary.leaves,
+            t.depth,
+            octree::fmt_voxel(t.origin)
+        )?;
+    }
+    Ok(true)
 }
 
 /// Arguments of `tesseral rotate`.

@@ -61,7 +61,9 @@ fn cut_interval(
 
 /// The colour regions of `f` as streams (none without layers); an error when it
 /// has other layers or is version 1.
-fn only_colours(f: &TessFile) -> Result<Vec<(Rgba, crate::io::RegionLeaves<'_>)>, PartitionError> {
+pub(super) fn only_colours(
+    f: &TessFile,
+) -> Result<Vec<(Rgba, crate::io::RegionLeaves<'_>)>, PartitionError> {
     if !f.has_layers() {
         return Ok(Vec::new());
     }

@@ -24,6 +24,7 @@ pub mod dataset;
 mod merge;
 mod shuffle;
 mod stream;
+mod translate;
 
 pub use dataset::{
     is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, read_part,
@@ -37,6 +38,7 @@ pub use shuffle::{
 pub use stream::{
     build_scene_dataset, scene_ranges, write_plan_tess, write_plan_tess_coloured, StreamSummary,
 };
+pub use translate::{stream_translate, stream_translate_in, StreamTranslation, RUN_LEAVES};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]
@@ -313,3 +315,6 @@ impl PartitionedOctree {
 mod tests;
 #[cfg(test)]
 mod tests_shuffle;
+
+#[cfg(test)]
+mod tests_translate;

@@ -254,7 +254,7 @@ fn streamed_set_operations_of_files_equal_the_in_memory_ones() {
 }
 
 /// Leaves of `t` in up to three colours (some left uncoloured), as a model.
-fn coloured(
+pub(super) fn coloured(
     rng: &mut rand_pcg::Pcg64,
     t: &LinearOctree,
     palette: &[[u8; 4]],
