@@ -49,7 +49,15 @@ fn streamed_translation_equals_the_in_memory_one() {
         let by_arg = format!("--by={by}");
         let v = json(
             d,
-            &["translate", "a.tess", "-o", "s.tess", &by_arg, "--json"],
+            &[
+                "translate",
+                "a.tess",
+                "-o",
+                "s.tess",
+                &by_arg,
+                "--json",
+                "--stream",
+            ],
         );
         assert_eq!(v["streamed"], true, "{by}");
         assert_eq!(v["colors"], b["colors"], "{by}");
@@ -121,7 +129,14 @@ fn a_streamed_translation_too_far_is_refused() {
     );
     fails(
         d,
-        &["translate", "a.tess", "-o", "s.tess", "--by=4000000000,0,0"],
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "s.tess",
+            "--by=4000000000,0,0",
+            "--stream",
+        ],
         "a.tess",
     );
     let names: Vec<_> = fs::read_dir(d).unwrap().collect();
@@ -155,6 +170,8 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
     let scene = scenes().join("fig4c-spheroid.tss");
     let s = scene.to_str().unwrap();
     ok(d, &["build", s, "-o", "s.tess", "--depth", "12"]);
+    // No --stream: the in-memory estimate (48 B a leaf) passes --memory 300M, so the
+    // command chooses to stream by itself.
     let args = [
         "translate",
         "s.tess",
@@ -162,6 +179,8 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
         "t.tess",
         "--by=3,-5,7",
         "--json",
+        "--memory",
+        "300M",
     ];
     let out = run_capped(d, &args, 384);
     assert!(
@@ -190,4 +209,67 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
     );
     assert!(!out.status.success());
     assert!(out.stdout.is_empty());
+}
+
+/// A small file translates in memory unless --stream is given (it is several times
+/// faster); --stream with an input that cannot stream is an error naming the flag.
+#[test]
+fn translation_streams_when_asked_or_over_the_memory_budget() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("tank.tss");
+    ok(
+        d,
+        &[
+            "build",
+            scene.to_str().unwrap(),
+            "-o",
+            "a.tess",
+            "--depth",
+            "6",
+        ],
+    );
+    let v = json(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "m.tess",
+            "--by=3,1,2",
+            "--json",
+        ],
+    );
+    assert!(v.get("streamed").is_none() || v["streamed"] == false, "{v}");
+    let v = json(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "s.tess",
+            "--by=3,1,2",
+            "--json",
+            "--memory",
+            "1K",
+        ],
+    );
+    assert_eq!(v["streamed"], true, "{v}");
+    assert_eq!(
+        fs::read(d.join("m.tess")).unwrap(),
+        fs::read(d.join("s.tess")).unwrap()
+    );
+    ok(d, &["translate", "a.tess", "-o", "a.xyz", "--by=0,0,0"]);
+    fails(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "x.xyz",
+            "--by=1,0,0",
+            "--stream",
+        ],
+        "--stream",
+    );
 }

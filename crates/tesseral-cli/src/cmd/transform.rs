@@ -48,7 +48,24 @@ pub struct TranslateArgs {
     /// of growing the space. Only with `--method linear`.
     #[arg(long)]
     clip: bool,
+    /// Translate a version-2 `.tess` file into a `.tess` file by an external merge
+    /// (bounded memory, temporary files beside the output) even when the translation
+    /// would fit in --memory. Without it, that path is taken only when the in-memory
+    /// translation is estimated above --memory.
+    #[arg(long)]
+    stream: bool,
+    /// The working memory the translation may use in memory, estimated before the
+    /// work (about 48 bytes a leaf of the input, colours included): bytes, or a number
+    /// with K, M, G or T (powers of 1024). A version-2 `.tess` input larger than that
+    /// streams into a `.tess` output; other inputs are translated in memory.
+    #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = super::output::parse_bytes)]
+    memory: u64,
 }
+
+/// Memory per input leaf of an in-memory translation: the input (leaves and
+/// colour regions), the moved copy and its pieces before merging (measured: 2.80 GB
+/// for the 58 M-leaf depth-13 spheroid with its colours).
+const TRANSLATE_BYTES_PER_LEAF: u64 = 48;
 
 pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
@@ -145,11 +162,28 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
     let tess =
         |p: &std::path::Path| !super::output::is_stdio(p) && tesseral::io::extension(p) == "tess";
     let linear = matches!(args.method, Method::Linear) && !args.clip;
+    let refuse = |why: &str| -> Result<bool> {
+        if args.stream {
+            anyhow::bail!("--stream: {why}");
+        }
+        Ok(false)
+    };
     if !(linear && tess(&args.input) && args.input.is_file() && tess(&args.output)) {
-        return Ok(false);
+        return refuse(
+            "only a .tess file into a .tess file streams, with --method linear and without --clip",
+        );
     }
     let f = TessFile::open(&args.input)?;
     if !f.is_streamed() || (f.has_layers() && f.colour_streams()?.is_none()) {
+        return refuse(&format!(
+            "{} is not a version-2 .tess file with only colours beside its shape (convert it to .tess first)",
+            args.input.display()
+        ));
+    }
+    // In memory it is several times faster (no pieces to spool and merge): stream
+    // only when asked or when the in-memory translation would pass --memory.
+    let in_memory = f.leaf_count().saturating_mul(TRANSLATE_BYTES_PER_LEAF);
+    if !args.stream && in_memory <= args.memory {
         return Ok(false);
     }
     let by = match (args.by, args.by_world) {
