@@ -5,7 +5,7 @@ mod common;
 use std::fs;
 use std::path::{Path, PathBuf};
 
-use common::{fails, json, ok};
+use common::{fails, json, ok, run_capped};
 
 fn scenes() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
@@ -301,21 +301,6 @@ fn streamed_set_operations_equal_the_in_memory_ones() {
             "{op}"
         );
     }
-}
-
-/// Runs the binary in `dir` with its address space capped at `mib` MiB (`ulimit
-/// -v`), two threads and two malloc arenas, so the cap bounds what it allocates.
-fn run_capped(dir: &Path, args: &[&str], mib: u64) -> std::process::Output {
-    std::process::Command::new("sh")
-        .arg("-c")
-        .arg(format!("ulimit -v {}; exec \"$0\" \"$@\"", mib * 1024))
-        .arg(env!("CARGO_BIN_EXE_tesseral"))
-        .args(args)
-        .env("RAYON_NUM_THREADS", "2")
-        .env("MALLOC_ARENA_MAX", "2")
-        .current_dir(dir)
-        .output()
-        .expect("run tesseral")
 }
 
 /// Bounded memory: the spheroid at depth 12 (14.5 M leaves, with its colours)

@@ -77,3 +77,18 @@ pub fn setup() -> tempfile::TempDir {
     .unwrap();
     dir
 }
+
+/// Runs the binary in `dir` with its address space capped at `mib` MiB (`ulimit
+/// -v`), two threads and two malloc arenas, so the cap bounds what it allocates.
+pub fn run_capped(dir: &Path, args: &[&str], mib: u64) -> std::process::Output {
+    std::process::Command::new("sh")
+        .arg("-c")
+        .arg(format!("ulimit -v {}; exec \"$0\" \"$@\"", mib * 1024))
+        .arg(env!("CARGO_BIN_EXE_tesseral"))
+        .args(args)
+        .env("RAYON_NUM_THREADS", "2")
+        .env("MALLOC_ARENA_MAX", "2")
+        .current_dir(dir)
+        .output()
+        .expect("run tesseral")
+}
