@@ -4,6 +4,7 @@
 import os
 import pathlib
 import re
+import tempfile
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 
@@ -27,11 +28,14 @@ def test_the_readme_python_tour_runs():
     text = (ROOT / "README.md").read_text()
     blocks = re.findall(r"```python\n(.*?)```", text, re.S)
     assert len(blocks) >= 2
+    # Run in a scratch folder (the tour writes files) with `scenes/` reachable.
     cwd = os.getcwd()
-    os.chdir(ROOT)
-    namespace = {}
-    try:
-        for i, code in enumerate(blocks):
-            exec(compile(code, f"README.md python block {i + 1}", "exec"), namespace)
-    finally:
-        os.chdir(cwd)
+    with tempfile.TemporaryDirectory() as scratch:
+        os.symlink(ROOT / "scenes", pathlib.Path(scratch) / "scenes")
+        os.chdir(scratch)
+        namespace = {}
+        try:
+            for i, code in enumerate(blocks):
+                exec(compile(code, f"README.md python block {i + 1}", "exec"), namespace)
+        finally:
+            os.chdir(cwd)
