@@ -10,6 +10,9 @@
 // explain the difference as float rounding on a cell boundary: some ray grazes the
 // cell (touches it widened by EPS but not narrowed by EPS) or ends within EPS of its
 // faces. A difference no ray comes near is reported as unexplained.
+#include <algorithm>
+#include <map>
+#include <set>
 #include <octomap/octomap.h>
 #include <cmath>
 #include <cstdio>
@@ -150,7 +153,11 @@ int main(int argc, char** argv) {
   const float hit = A->getProbHitLog(), miss = A->getProbMissLog();
   const float lo_clamp = A->getClampingThresMinLog(), hi_clamp = A->getClampingThresMaxLog();
   const float thres = A->getOccupancyThresLog();
-  size_t sample = std::min<size_t>(argc == 6 ? atol(argv[5]) : 500, diffs.size());
+  // Every difference is classified unless a smaller sample is asked for (argv[5]).
+  size_t sample = std::min<size_t>(argc == 6 ? atol(argv[5]) : diffs.size(), diffs.size());
+  // The cell faces that decide the differences: for each differing cell, the faces
+  // (axis, world coordinate) within EPS of a ray's end point in or beside it.
+  std::map<std::pair<int, long long>, unsigned> planes;
   unsigned boundary = 0, a_wrong = 0, b_wrong = 0, both_wrong = 0, shown = 0;
   for (size_t s = 0; s < sample; s++) {
     const Diff& d = diffs[s * diffs.size() / sample];
@@ -168,10 +175,15 @@ int main(int argc, char** argv) {
     };
     // Reachable log-odds; NAN is unknown.
     std::vector<float> reach = {NAN};
+    std::set<std::pair<int, long long>> face_keys;
     for (const auto& rays : scans) {
       bool end_sure = false, end_maybe = false, cross_sure = false, cross_maybe = false;
       for (const Ray& r : rays) {
         if (!meets(r.o, r.e, wlo, whi)) continue;
+        if (inside(r.e, wlo, whi) && !inside(r.e, nlo, nhi))
+          for (int k = 0; k < 3; k++)
+            for (double f : {lo[k], hi[k]})
+              if (std::fabs(r.e(k) - f) <= eps) face_keys.insert({k, std::llround(f / res)});
         bool e_in = inside(r.e, nlo, nhi), e_near = inside(r.e, wlo, whi);
         bool through = meets(r.o, r.e, nlo, nhi);
         if (!r.cut && e_in) { end_sure = true; continue; }
@@ -205,6 +217,7 @@ int main(int argc, char** argv) {
         }
       reach.swap(next);
     }
+    for (const auto& f : face_keys) planes[f]++;
     bool can[3] = {false, false, false};
     for (float l : reach) can[std::isnan(l) ? UNKNOWN : (l > thres ? OCCUPIED : FREE)] = true;
     if (can[d.a] && can[d.b]) boundary++;
@@ -217,6 +230,13 @@ int main(int argc, char** argv) {
               can[1] ? " free" : "", can[2] ? " occupied" : "");
   }
   printf("RESULT sampled_differences %zu\n", sample);
+  // The faces most differences sit on, largest first: "x|y|z = metres (cells)".
+  std::vector<std::pair<unsigned, std::pair<int, long long>>> top;
+  for (const auto& [f, n] : planes) top.push_back({n, f});
+  std::sort(top.rbegin(), top.rend());
+  for (size_t i = 0; i < top.size() && i < 5; i++)
+    printf("RESULT face %c = %.4f m (cell face %lld): %u differing cells\n", "xyz"[top[i].second.first],
+           top[i].second.second * res, top[i].second.second, top[i].first);
   printf("RESULT boundary_rounding %u\nRESULT only_A_reachable %u\nRESULT only_B_reachable %u\nRESULT neither_reachable %u\n",
          boundary, b_wrong, a_wrong, both_wrong);
   return 0;

@@ -6,7 +6,7 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::dynamic::DynamicOctree;
-use tesseral::rsmc::{topology, Chain, DenseLattice, Lattice, Params};
+use tesseral::rsmc::{topology, Chain, Counters, DenseLattice, Lattice, Params, Sample};
 use tesseral::Voxel;
 
 use crate::arrays::{rows, to_array};
@@ -14,15 +14,6 @@ use crate::arrays::{rows, to_array};
 /// The most rows a trajectory may hold, so that `steps / sample_every` is a budget
 /// checked before the run.
 const MAX_ROWS: u64 = 10_000_000;
-
-/// One sample of the trajectory.
-struct Row {
-    step: u64,
-    area: u64,
-    volume: u64,
-    rg: f64,
-    acceptance: f64,
-}
 
 /// The start shape: `"voxel"`, `"box:AxBxC"`, or an N×3 int64 array of voxels.
 fn start_voxels(start: &Bound<'_, PyAny>) -> PyResult<Vec<Voxel>> {
@@ -42,32 +33,17 @@ fn run<L: Lattice>(
     start: &[Voxel],
     steps: u64,
     sample_every: u64,
-) -> Result<(Chain<L>, Vec<Row>), String> {
+) -> Result<(Chain<L>, Vec<Sample>), String> {
     let mut chain = Chain::new(L::empty(), params, seed, start).map_err(|e| e.to_string())?;
     let mut rows = Vec::new();
-    let mut base = (0u64, 0u64);
-    let row = |c: &Chain<L>, base: (u64, u64)| {
-        let k = c.counters();
-        let dn = k.steps - base.0;
-        Row {
-            step: k.steps,
-            area: c.area(),
-            volume: c.volume(),
-            rg: c.radius_of_gyration(),
-            acceptance: if dn == 0 {
-                0.0
-            } else {
-                (k.accepted - base.1) as f64 / dn as f64
-            },
-        }
-    };
-    rows.push(row(&chain, base));
+    let mut since = Counters::default();
+    rows.push(chain.sample(since));
     while chain.steps() < steps {
         let s = chain.steps();
         let target = steps.min((s / sample_every + 1).saturating_mul(sample_every));
         chain.run(target - s);
-        rows.push(row(&chain, base));
-        base = (chain.steps(), chain.counters().accepted);
+        rows.push(chain.sample(since));
+        since = chain.counters();
     }
     topology::check_sphere(&chain.voxels())
         .map_err(|e| format!("global topology check of the final surface: {e}"))?;
@@ -136,12 +112,15 @@ pub fn rsmc<'py>(
     let (voxels, k, area, rows) = result.map_err(PyValueError::new_err)?;
     let seconds = t0.elapsed().as_secs_f64();
     let d = PyDict::new(py);
-    let col = |f: fn(&Row) -> u64| rows.iter().map(f).collect::<Vec<u64>>();
+    let col = |f: fn(&Sample) -> u64| rows.iter().map(f).collect::<Vec<u64>>();
     d.set_item("step", col(|r| r.step).into_pyarray(py))?;
     d.set_item("area", col(|r| r.area).into_pyarray(py))?;
     d.set_item("volume", col(|r| r.volume).into_pyarray(py))?;
-    let colf = |f: fn(&Row) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
-    d.set_item("radius_of_gyration", colf(|r| r.rg).into_pyarray(py))?;
+    let colf = |f: fn(&Sample) -> f64| rows.iter().map(f).collect::<Vec<f64>>();
+    d.set_item(
+        "radius_of_gyration",
+        colf(|r| r.radius_of_gyration).into_pyarray(py),
+    )?;
     d.set_item("acceptance", colf(|r| r.acceptance).into_pyarray(py))?;
     d.set_item("voxels", to_array(py, voxels)?)?;
     d.set_item("faces", area)?;

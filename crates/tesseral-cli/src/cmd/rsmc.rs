@@ -11,7 +11,9 @@ use serde::{Deserialize, Serialize};
 use tesseral::dynamic::DynamicOctree;
 use tesseral::linear::LinearOctree;
 use tesseral::render::{self, RenderOptions};
-use tesseral::rsmc::{mesh, plot, topology, Chain, Checkpoint, DenseLattice, Lattice, Params};
+use tesseral::rsmc::{
+    mesh, plot, topology, Chain, Checkpoint, Counters, DenseLattice, Lattice, Params, Sample,
+};
 use tesseral::Voxel;
 
 use super::view::Animation;
@@ -118,13 +120,13 @@ struct CliCheckpoint {
     base_accepted: u64,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-struct Row {
-    step: u64,
-    area: u64,
-    volume: u64,
-    rg: f64,
-    acceptance: f64,
+/// The counters at the previous row, as the checkpoint keeps them.
+fn since((steps, accepted): (u64, u64)) -> Counters {
+    Counters {
+        steps,
+        accepted,
+        ..Counters::default()
+    }
 }
 
 /// The series is kept in memory (it is rewritten at each checkpoint and plotted).
@@ -173,21 +175,21 @@ fn write_file(path: &Path, body: impl FnOnce(&mut dyn Write) -> std::io::Result<
     tesseral::io::write_atomic(path, body).with_context(|| format!("writing {}", path.display()))
 }
 
-fn write_csv(path: &Path, rows: &[Row]) -> Result<()> {
+fn write_csv(path: &Path, rows: &[Sample]) -> Result<()> {
     write_file(path, |w| {
         writeln!(w, "step,area,volume,radius_of_gyration,acceptance_rate")?;
         for r in rows {
             writeln!(
                 w,
                 "{},{},{},{:.6},{:.6}",
-                r.step, r.area, r.volume, r.rg, r.acceptance
+                r.step, r.area, r.volume, r.radius_of_gyration, r.acceptance
             )?;
         }
         Ok(())
     })
 }
 
-fn read_csv(path: &Path) -> Result<Vec<Row>> {
+fn read_csv(path: &Path) -> Result<Vec<Sample>> {
     let text = fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
     let mut rows = Vec::new();
     for (n, line) in text.lines().enumerate().skip(1) {
@@ -200,11 +202,11 @@ fn read_csv(path: &Path) -> Result<Vec<Row>> {
             )
         };
         ensure!(f.len() == 5, bad());
-        rows.push(Row {
+        rows.push(Sample {
             step: f[0].parse().with_context(bad)?,
             area: f[1].parse().with_context(bad)?,
             volume: f[2].parse().with_context(bad)?,
-            rg: f[3].parse().with_context(bad)?,
+            radius_of_gyration: f[3].parse().with_context(bad)?,
             acceptance: f[4].parse().with_context(bad)?,
         });
     }
@@ -325,23 +327,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             args.checkpoint_every,
         )
     };
-    let row = |c: &Chain<L>, base: (u64, u64)| {
-        let k = c.counters();
-        let dn = k.steps - base.0;
-        Row {
-            step: k.steps,
-            area: c.area(),
-            volume: c.volume(),
-            rg: c.radius_of_gyration(),
-            acceptance: if dn == 0 {
-                0.0
-            } else {
-                (k.accepted - base.1) as f64 / dn as f64
-            },
-        }
-    };
     if chain.steps() == 0 {
-        rows.push(row(&chain, base));
+        rows.push(chain.sample(since(base)));
     }
     let start_steps = chain.steps();
     let bar = ProgressBar::with_draw_target(
@@ -363,7 +350,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             },
         ),
     );
-    let save = |chain: &mut Chain<L>, rows: &[Row], base: (u64, u64)| -> Result<()> {
+    let save = |chain: &mut Chain<L>, rows: &[Sample], base: (u64, u64)| -> Result<()> {
         let cp = CliCheckpoint {
             chain: chain.checkpoint(),
             sample_every,
@@ -410,7 +397,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
         bar.set_position(target - start_steps);
         let s = chain.steps();
         if s % sample_every == 0 {
-            rows.push(row(&chain, base));
+            rows.push(chain.sample(since(base)));
             base = (s, chain.counters().accepted);
             bar.set_message(format!("area {}", chain.area()));
             if let Some(a) = anim.as_mut().filter(|_| s < args.steps) {
@@ -428,7 +415,7 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
     let seconds = t0.elapsed().as_secs_f64();
     bar.finish_and_clear();
     if rows.last().map(|r| r.step) != Some(chain.steps()) {
-        rows.push(row(&chain, base));
+        rows.push(chain.sample(since(base)));
     }
     let report = topology::check_sphere(&chain.voxels())
         .context("global topology check of the final surface")?;

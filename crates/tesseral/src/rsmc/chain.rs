@@ -84,6 +84,22 @@ pub struct Counters {
     pub refused: u64,
 }
 
+/// One row of a chain's trajectory: its state after `step` attempted steps, as the
+/// CLI's `series.csv` and Python's `rsmc` report it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Attempted steps so far.
+    pub step: u64,
+    /// Area A (plaquettes).
+    pub area: u64,
+    /// Volume V (voxels).
+    pub volume: u64,
+    /// Radius of gyration of the voxel centres.
+    pub radius_of_gyration: f64,
+    /// Accepted over attempted steps since the counters `since` (0 when none).
+    pub acceptance: f64,
+}
+
 /// Everything needed to continue a chain exactly: parameters, counters, the random
 /// generator's state and the voxels. The lattice is rebuilt from the voxels in
 /// sorted order, which fixes the face-list order (see [`Chain::canonicalize`]).
@@ -308,6 +324,26 @@ impl<L: Lattice> Chain<L> {
     #[must_use]
     pub fn seed(&self) -> u64 {
         self.seed
+    }
+
+    /// The chain's state now, with the acceptance rate since the counters `since`
+    /// (taken at the previous sample; `Counters::default()` for the start).
+    #[must_use]
+    pub fn sample(&self, since: Counters) -> Sample {
+        let k = self.counters;
+        let steps = k.steps.saturating_sub(since.steps);
+        let accepted = k.accepted.saturating_sub(since.accepted);
+        Sample {
+            step: k.steps,
+            area: self.area(),
+            volume: self.volume(),
+            radius_of_gyration: self.radius_of_gyration(),
+            acceptance: if steps == 0 {
+                0.0
+            } else {
+                accepted as f64 / steps as f64
+            },
+        }
     }
 
     /// The area A (plaquettes). O(1).

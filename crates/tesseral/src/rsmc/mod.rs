@@ -38,7 +38,7 @@ pub mod stats;
 mod tests;
 pub mod topology;
 
-pub use chain::{Chain, Checkpoint, Counters, Params, CHECKPOINT_FORMAT};
+pub use chain::{Chain, Checkpoint, Counters, Params, Sample, CHECKPOINT_FORMAT};
 pub use checkpoint::MAX_CHECKPOINT_COORDINATE;
 pub use dense::{DenseLattice, MAX_CELLS};
 pub use start::{parse_start, MAX_BOX_SIDE, MAX_START_VOXELS};

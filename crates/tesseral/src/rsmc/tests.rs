@@ -487,3 +487,24 @@ fn libes_worked_examples_on_the_octree() {
         "rule (i) on deletion"
     );
 }
+
+#[test]
+fn samples_report_the_acceptance_since_the_previous_one() {
+    let mut c = Chain::new(DenseLattice::new(), params(0.2), 11, &[[0, 0, 0]]).unwrap();
+    let start = c.sample(Counters::default());
+    assert_eq!((start.step, start.area, start.volume), (0, 6, 1));
+    assert_eq!((start.radius_of_gyration, start.acceptance), (0.0, 0.0));
+    c.run(500);
+    let first = c.counters();
+    c.run(700);
+    let s = c.sample(first);
+    let k = c.counters();
+    assert_eq!(s.step, 1200);
+    assert_eq!((s.area, s.volume), (c.area(), c.volume()));
+    assert_eq!(s.radius_of_gyration, c.radius_of_gyration());
+    let expected = (k.accepted - first.accepted) as f64 / 700.0;
+    assert!(expected > 0.0 && (s.acceptance - expected).abs() < 1e-15);
+    // A sample taken where the previous one was has no steps to rate.
+    assert_eq!(c.sample(k).acceptance, 0.0);
+    c.assert_valid();
+}
