@@ -8,6 +8,7 @@ use tesseral::dynamic::DynamicOctree as Tree;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use crate::arrays::{rows, to_array};
+use crate::occupancy::{check_work, DEFAULT_MAX_CELLS};
 
 /// An unbounded dynamic octree of voxels (i64 coordinates), with the surface-face
 /// list of the random-surface simulations.
@@ -57,33 +58,36 @@ impl DynamicOctree {
     /// `OccupancyMap.insert_scan`). Coordinates are in voxels: voxel i spans [i, i+1).
     /// A point beyond `max_range` clears its ray up to `max_range` and sets nothing.
     /// Returns the scan's counts plus `inserted` and `removed` (voxels that changed).
-    #[pyo3(signature = (origin, points, max_range = None))]
+    /// A scan whose rays may cross more than `max_cells` voxels in all is refused
+    /// (ValueError) before any is cast.
+    #[pyo3(signature = (origin, points, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
     fn insert_scan<'py>(
         &mut self,
         py: Python<'py>,
         origin: [f64; 3],
         points: PyReadonlyArray2<'_, f64>,
         max_range: Option<f64>,
+        max_cells: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pts = rows(&points)?;
-        let t = &mut self.tree;
-        let (s, inserted, removed) = py
-            .allow_threads(|| {
-                // One scan in a fresh map at unit resolution: hit cells end with a
-                // positive log-odds and crossed ones with a negative one.
-                let mut map = OccupancyMap::new(1.0, SensorModel::octomap())?;
-                let s = map.insert_scan(origin, &pts, max_range);
-                let (mut inserted, mut removed) = (0u64, 0u64);
-                for (cell, l) in map.cells() {
-                    if l > 0.0 {
-                        inserted += u64::from(t.insert(cell));
-                    } else {
-                        removed += u64::from(t.remove(cell));
-                    }
-                }
-                Ok::<_, tesseral::occupancy::OccupancyError>((s, inserted, removed))
-            })
+        // One scan in a fresh map at unit resolution: hit cells end with a positive
+        // log-odds and crossed ones with a negative one.
+        let mut map = OccupancyMap::new(1.0, SensorModel::octomap())
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
+        check_work(&map, origin, &pts, max_range, max_cells)?;
+        let t = &mut self.tree;
+        let (s, inserted, removed) = py.allow_threads(|| {
+            let s = map.insert_scan(origin, &pts, max_range);
+            let (mut inserted, mut removed) = (0u64, 0u64);
+            for (cell, l) in map.cells() {
+                if l > 0.0 {
+                    inserted += u64::from(t.insert(cell));
+                } else {
+                    removed += u64::from(t.remove(cell));
+                }
+            }
+            (s, inserted, removed)
+        });
         let d = PyDict::new(py);
         d.set_item("points", s.points)?;
         d.set_item("rays", s.rays)?;

@@ -19,6 +19,29 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// The default of `max_cells`: as the CLI's `--max-cells`.
+pub(crate) const DEFAULT_MAX_CELLS: u64 = 10_000_000_000;
+
+/// Refuses a scan whose rays may cross more than `max_cells` cells, before any is
+/// cast (a far point with no `max_range` would be walked for hours).
+pub(crate) fn check_work(
+    map: &Map,
+    origin: [f64; 3],
+    points: &[[f64; 3]],
+    max_range: Option<f64>,
+    max_cells: u64,
+) -> PyResult<()> {
+    let w = map.scan_work(origin, points, max_range);
+    if w.cells > max_cells {
+        return Err(PyValueError::new_err(format!(
+            "the scan's {} rays may cross {} cells (the longest is {:.6e} units), past \
+             max_cells={max_cells}: cut long rays with max_range, or raise max_cells",
+            w.rays, w.cells, w.longest
+        )));
+    }
+    Ok(())
+}
+
 #[pymethods]
 impl OccupancyMap {
     #[new]
@@ -39,15 +62,19 @@ impl OccupancyMap {
 
     /// Inserts one scan: `points` is N×3 (world units), `origin` the sensor position.
     /// Returns the scan's counts: points, rays, skipped (NaN/inf), hits, misses.
-    #[pyo3(signature = (origin, points, max_range = None))]
+    /// A scan whose rays may cross more than `max_cells` cells in all is refused
+    /// (ValueError) before any is cast.
+    #[pyo3(signature = (origin, points, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
     fn insert_scan<'py>(
         &mut self,
         py: Python<'py>,
         origin: [f64; 3],
         points: PyReadonlyArray2<'_, f64>,
         max_range: Option<f64>,
+        max_cells: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
         let pts = rows(&points)?;
+        check_work(&self.map, origin, &pts, max_range, max_cells)?;
         let m = &mut self.map;
         let s = py.allow_threads(|| m.insert_scan(origin, &pts, max_range));
         let d = PyDict::new(py);

@@ -53,3 +53,19 @@ def test_repeated_scans_match_a_counting_model():
         t.OccupancyMap(0.0)
     with pytest.raises(ValueError):
         t.OccupancyMap(0.1, prob_hit=0.3)
+
+
+def test_a_far_point_is_refused_before_it_is_cast():
+    m = t.OccupancyMap(0.05)
+    far = np.array([[1.0, 0.0, 0.0], [1e9, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="past max_cells=10000000000"):
+        m.insert_scan((0.0, 0.0, 0.0), far)
+    assert m.stats()["free"] == 0  # nothing was cast
+    s = m.insert_scan((0.0, 0.0, 0.0), far, max_range=10.0)
+    assert s["rays"] == 2 and s["hits"] == 1
+    with pytest.raises(ValueError, match="max_cells=5"):
+        m.insert_scan((0.0, 0.0, 0.0), far[:1], max_cells=5)
+    d = t.DynamicOctree()
+    with pytest.raises(ValueError, match="past max_cells"):
+        d.insert_scan((0.5, 0.5, 0.5), np.array([[1e12, 0.5, 0.5]]))
+    assert len(d) == 0

@@ -565,3 +565,48 @@ fn the_map_is_a_model_with_its_frame() {
         .starts_with(&fs::read(d.join("map.tess")).unwrap()[..4]));
     assert!(String::from_utf8_lossy(&out.stderr).contains("wrote -"));
 }
+
+#[test]
+fn a_far_point_is_refused_before_it_is_cast_unless_cut_or_budgeted() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // A corrupt return a million kilometres away: 2·10^10 cells at 5 cm.
+    fs::write(
+        d.join("far.log"),
+        "NODE 0 0 0 0 0 0\n1 0 0\nNODE 0 0 0 0 0 0\n1 1 0\n1e9 0 0\n",
+    )
+    .unwrap();
+    let args = ["map", "far.log", "-o", "far.tess", "--resolution", "0.05"];
+    fails(d, &args, "far.log: scan 2 of 2: its 2 rays may cross");
+    fails(
+        d,
+        &args,
+        "past --max-cells 10000000000: cut long rays with --max-range",
+    );
+    assert!(!d.join("far.tess").exists());
+    // The same point, posed in the sensor frame by --pose: lengths do not change.
+    fs::write(d.join("far.xyz"), "1 0 0\n0 0 1e9\n").unwrap();
+    fails(
+        d,
+        &[
+            "map",
+            "far.xyz",
+            "-o",
+            "far.tess",
+            "--resolution",
+            "0.05",
+            "--pose",
+            "5,5,5,0.1,0.2,0.3",
+        ],
+        "the longest is 1.000000e9 m",
+    );
+    // Cut by --max-range, it is a free ray of 200 cells.
+    let mut cut = args.to_vec();
+    cut.extend(["--max-range", "10", "--json"]);
+    let v = json(d, &cut);
+    assert_eq!(v["rays"], 3);
+    // A smaller budget refuses an ordinary scan, naming the flag.
+    let mut small = args.to_vec();
+    small.extend(["--max-range", "10", "--max-cells", "30"]);
+    fails(d, &small, "scan 1 of 2: its ray may cross");
+}

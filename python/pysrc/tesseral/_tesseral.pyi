@@ -95,6 +95,7 @@ class DynamicOctree:
         origin: Tuple[float, float, float],
         points: npt.NDArray[np.float64],
         max_range: Optional[float] = ...,
+        max_cells: int = ...,
     ) -> dict[str, int]: ...
 
 class OccupancyMap:
@@ -111,6 +112,7 @@ class OccupancyMap:
         origin: Tuple[float, float, float],
         points: npt.NDArray[np.float64],
         max_range: Optional[float] = ...,
+        max_cells: int = ...,
     ) -> dict[str, int]: ...
     def state(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.uint8]: ...
     def log_odds(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.float32]: ...

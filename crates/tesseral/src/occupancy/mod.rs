@@ -39,8 +39,10 @@ mod tests;
 mod tests_ray;
 #[cfg(test)]
 mod tests_store;
+mod work;
 
 pub use sensor::{log_odds, probability, Pose, SensorModel};
+pub use work::ScanWork;
 
 use sensor::{Fixed, UNKNOWN};
 use store::Store;
