@@ -20,6 +20,11 @@
 #   issue's sizes; the outdoor map of that size does not fit in memory for Bonxai or
 #   OctoMap here, so pass smaller ones), OCTOMAP_SCANS (the first N scans only, as
 #   OctoMap is slow; default all), WORKLOADS="indoor outdoor", TOOLS="tesseral bonxai octomap".
+#   REAL_SCAN=FILE adds the workload `real`: a real laser scan as text lines `x y z`
+#   in the sensor frame (sensor at the origin), or that file bzip2-compressed, e.g.
+#   OctoMap's own octomap/share/data/scan.dat.bz2 (88,206 points, ranges 0.47-29 m),
+#   inserted REAL_COPIES times (default 10) from the same pose, max range 30 m (so no
+#   ray is cut).
 set -euo pipefail
 here="$(cd "$(dirname "$0")" && pwd)"
 root="$(cd "$here/../.." && pwd)"
@@ -61,17 +66,34 @@ timed() {
   echo "$out" | awk '/^RESULT/ { r = $0 } /^peak_rss_kb/ { p = $0 } END { print r, p }'
 }
 
-for w in ${WORKLOADS:-indoor outdoor}; do
-  if [ "$w" = indoor ]; then
+workloads=${WORKLOADS:-indoor outdoor}
+[ -n "${REAL_SCAN:-}" ] && [[ " $workloads " != *" real "* ]] && workloads="$workloads real"
+for w in $workloads; do
+  if [ "$w" = real ]; then
+    [ -f "${REAL_SCAN:-}" ] || { echo "REAL_SCAN: no such file: ${REAL_SCAN:-(unset)}" >&2; exit 1; }
+    copies=${REAL_COPIES:-10} range=30
+    dir="$build/real-$(basename "$REAL_SCAN" .bz2)-$copies"
+    mkdir -p "$dir"
+    if [ ! -f "$dir/real.scans" ]; then
+      case $REAL_SCAN in
+        *.bz2) bzip2 -dc "$REAL_SCAN" >"$dir/cloud.xyz" ;;
+        *) cp "$REAL_SCAN" "$dir/cloud.xyz" ;;
+      esac
+      "$peer" xyz "$dir/cloud.xyz" "$dir/real.scans" "$copies"
+    fi
+    echo "== real: $(basename "$REAL_SCAN") x $copies, 5 cm, max range $range" >&2
+  elif [ "$w" = indoor ]; then
     scans=${INDOOR_SCANS:-100} rays=${INDOOR_RAYS:-100000} range=10
   else
     scans=${OUTDOOR_SCANS:-100} rays=${OUTDOOR_RAYS:-100000} range=50
   fi
-  dir="$build/$w-$scans-$rays"
-  mkdir -p "$dir"
-  # `gen` writes both workloads; keep the one asked for.
-  [ -f "$dir/$w.scans" ] || "$peer" gen "$dir" "$scans" "$rays"
-  echo "== $w: $scans scans x $rays rays, 5 cm, max range $range" >&2
+  if [ "$w" != real ]; then
+    dir="$build/$w-$scans-$rays"
+    mkdir -p "$dir"
+    # `gen` writes both workloads; keep the one asked for.
+    [ -f "$dir/$w.scans" ] || "$peer" gen "$dir" "$scans" "$rays"
+    echo "== $w: $scans scans x $rays rays, 5 cm, max range $range" >&2
+  fi
   for tool in ${TOOLS:-tesseral bonxai octomap}; do
     case $tool in
       tesseral)

@@ -5,6 +5,9 @@
 //! - `occupancy_peer gen DIR SCANS RAYS`: writes `DIR/indoor.scans` and
 //!   `DIR/outdoor.scans` (per scan: origin as 3 × `f64`, point count as `u64`, points
 //!   as 3 × `f64` each, little-endian).
+//! - `occupancy_peer xyz CLOUD OUT COPIES`: writes a real scan given as text lines
+//!   `x y z` (sensor at the origin, e.g. OctoMap's `share/data/scan.dat`) as `OUT`,
+//!   `COPIES` scans of it from the same pose (a sensor standing still).
 //! - `occupancy_peer run FILE MAX_RANGE`: builds the map at 5 cm, OctoMap's sensor
 //!   model, then looks up 10⁶ cells drawn at random from the scans' end points (the
 //!   same splitmix64 draws as the C++ drivers) and prints one `RESULT` line: scans,
@@ -68,7 +71,11 @@ fn main() -> std::io::Result<()> {
     let args: Vec<String> = std::env::args().collect();
     let arg = |i: usize| -> &str {
         args.get(i).map_or_else(
-            || panic!("usage: occupancy_peer gen DIR SCANS RAYS | run FILE MAX_RANGE"),
+            || {
+                panic!(
+                    "usage: occupancy_peer gen DIR SCANS RAYS | xyz CLOUD OUT COPIES | run FILE MAX_RANGE"
+                )
+            },
             String::as_str,
         )
     };
@@ -84,6 +91,26 @@ fn main() -> std::io::Result<()> {
                     &scans(outdoor, count, rays),
                 )?;
             }
+        }
+        "xyz" => {
+            let text = std::fs::read_to_string(arg(2))?;
+            let points: Vec<[f64; 3]> = text
+                .lines()
+                .filter(|l| !l.trim().is_empty())
+                .map(|l| {
+                    let v: Vec<f64> = l
+                        .split_whitespace()
+                        .map(|w| w.parse().expect("a number"))
+                        .collect();
+                    [v[0], v[1], v[2]]
+                })
+                .collect();
+            let copies: usize = arg(4).parse().expect("COPIES");
+            let scan = Scan {
+                origin: [0.0; 3],
+                points,
+            };
+            write_scans(arg(3), &vec![scan; copies])?;
         }
         "run" => {
             let sc = read_scans(arg(2))?;
@@ -118,7 +145,7 @@ fn main() -> std::io::Result<()> {
                 lookup * 1e3,
             );
         }
-        other => panic!("unknown command {other}: gen or run"),
+        other => panic!("unknown command {other}: gen, xyz or run"),
     }
     Ok(())
 }

@@ -6,6 +6,7 @@
 
 use super::SplitMix64;
 
+#[derive(Clone)]
 pub struct Scan {
     pub origin: [f64; 3],
     pub points: Vec<[f64; 3]>,
