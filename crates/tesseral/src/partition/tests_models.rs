@@ -121,12 +121,7 @@ fn a_64_part_shuffle_sends_each_part_to_few_ranges() {
             .collect()
     };
     let (src, dst) = (even(64), even(64));
-    for by in [
-        [3, -5, 7],
-        [1001 % 1024, -7, 333],
-        [0, 0, 1],
-        [-511, 257, 129],
-    ] {
+    for by in [[3, -5, 7], [1001, -7, 333], [0, 0, 1], [-511, 257, 129]] {
         let got = reach((depth as u8, [0; 3]), &src, by, (depth as u8, [0; 3]), &dst).unwrap();
         let pieces: usize = got.iter().map(Vec::len).sum();
         // A full shuffle would make 64 × 64 = 4096 pieces.
