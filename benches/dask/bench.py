@@ -9,13 +9,17 @@ manifest) and must write the same dataset (the manifests, CRC-32s included, are
 compared). One process: Dask's synchronous scheduler in this process, each part
 built with all cores (rayon). Cluster: a LocalCluster of 1, then N, worker
 processes with one thread each and RAYON_NUM_THREADS=1, started before the clock.
-Prints the times, the speed-ups and the load average (the machine may be shared).
+Also times the CLI's `tesseral build --parts K` (the same dataset, streamed, one
+process) when target/release/tesseral is built. Prints the times, the speed-ups
+and the load average (the machine may be shared).
 """
 
 import argparse
+import json
 import os
 import pathlib
 import shutil
+import subprocess
 import tempfile
 import time
 
@@ -59,14 +63,14 @@ def shuffle(tmp, leaves, workers):
         try:
             src = tdask.read(tmp / "one")
             t0 = time.perf_counter()
-            m = tdask.write(tdask.translate(src, by), tmp / f"moved-{cluster}", **kw)
+            m = tdask.write(tdask.translate(src, by, **kw), tmp / f"moved-{cluster}", **kw)
             t1 = time.perf_counter()
             n = sum(p["leaves"] for p in m["parts"])
             print(f"{label}: translate {leaves:,} leaves by {by} -> {n:,}: {t1 - t0:.2f} s ({leaves / (t1 - t0) / 1e6:.2f} M leaves/s in)")
             moved = tdask.read(tmp / f"moved-{cluster}")
             src = tdask.read(tmp / "one")
             t0 = time.perf_counter()
-            m = tdask.write(tdask.op(src, moved, "union"), tmp / f"union-{cluster}", **kw)
+            m = tdask.write(tdask.op(src, moved, "union", **kw), tmp / f"union-{cluster}", **kw)
             t1 = time.perf_counter()
             u = sum(p["leaves"] for p in m["parts"])
             print(f"{label}: union of {leaves:,} and {n:,} leaves -> {u:,}: {t1 - t0:.2f} s ({(leaves + n) / (t1 - t0) / 1e6:.2f} M leaves/s in)")
@@ -98,6 +102,22 @@ def main():
         leaves = sum(p["leaves"] for p in m1["parts"])
         print(f"one process:  {one:8.2f} s  ({leaves:,} leaves, {leaves / one / 1e6:.2f} M leaves/s)")
         print(f"load average: {os.getloadavg()}")
+        exe = ROOT / "target" / "release" / "tesseral"
+        if exe.exists():
+            # The peer: the CLI's streamed `build --parts`, which writes the same
+            # dataset (colours included), in one process with all cores.
+            t0 = time.perf_counter()
+            subprocess.run(
+                [str(exe), "build", a.scene, "--depth", str(a.depth), "--parts", str(a.parts),
+                 "-o", str(tmp / "cli")],
+                check=True,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+            )
+            cli = time.perf_counter() - t0
+            same = json.loads((tmp / "cli" / "manifest.json").read_text())["parts"] == m1["parts"]
+            print(f"CLI build --parts {a.parts}: {cli:8.2f} s  (same dataset: {same})")
+            print(f"load average: {os.getloadavg()}")
         if a.shuffle:
             shuffle(tmp, leaves, a.workers)
         times = {}

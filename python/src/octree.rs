@@ -2,7 +2,7 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
@@ -16,6 +16,8 @@ use crate::errors;
 type Vec3 = (i64, i64, i64);
 /// `(vertices, faces)` of a mesh.
 type MeshArrays<'py> = (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>);
+/// `(voxels, rgba)` of the coloured voxels.
+type ColourArrays<'py> = (Bound<'py, PyArray2<i64>>, Bound<'py, PyArray2<u8>>);
 
 /// A solid as a linear octree with its frame (voxel size and placement in world
 /// units) and optional per-voxel colours and known-free space.
@@ -113,9 +115,17 @@ impl Octree {
         Ok(Octree::new(Model::new(tree)))
     }
 
-    /// Reads an octree file (every format the CLI reads, chosen by extension).
+    /// Reads an octree file (every format the CLI reads, chosen by extension), or a
+    /// partitioned dataset directory (`tesseral build --parts`, `tesseral.dask.write`)
+    /// as one model, its parts checked against the manifest.
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Octree> {
+        if tesseral::partition::is_dataset(&path) {
+            return py
+                .allow_threads(|| tesseral::partition::read_dataset_model(&path))
+                .map(Octree::new)
+                .map_err(crate::partition::partition_error);
+        }
         py.allow_threads(|| tesseral::io::read_model(&path))
             .map(Octree::new)
             .map_err(errors::format)
@@ -162,6 +172,21 @@ impl Octree {
             v
         });
         to_array(py, v)
+    }
+
+    /// The coloured voxels and their colours: (voxels N×3 int64, colours N×4 uint8
+    /// RGBA), sorted by voxel (x, then y, then z); empty arrays when there are no
+    /// colours.
+    fn colors<'py>(&self, py: Python<'py>) -> PyResult<ColourArrays<'py>> {
+        let l = &self.model.colors;
+        let (v, c): (Vec<[i64; 3]>, Vec<[u8; 4]>) = py.allow_threads(|| {
+            l.as_ref().map_or((Vec::new(), Vec::new()), |l| {
+                l.to_voxels().into_iter().map(|(v, _, c)| (v, c)).unzip()
+            })
+        });
+        let n = c.len();
+        let rgba: Vec<u8> = c.into_iter().flatten().collect();
+        Ok((to_array(py, v)?, rgba.into_pyarray(py).reshape([n, 4])?))
     }
 
     /// The voxel centres in world units, N×3 float64.

@@ -1,11 +1,11 @@
 //! The steps of a partitioned run, one call each, for `tesseral.dask`'s tasks:
-//! balanced ranges of a scene, building one code range, a set operation of two
-//! parts, splitting, joining, the two halves of a translation's shuffle, and the
-//! parts and manifest of a dataset on disk (the library's dataset code, so a dataset
-//! written here is the one `tesseral build --parts` writes).
+//! balanced ranges of a scene, building one code range (with the scene's colours),
+//! a set operation of two parts, cutting, joining, the reach and the two halves of a
+//! shuffle, and the parts and manifest of a dataset on disk (the library's dataset
+//! code, so a dataset written here is the one `tesseral build --parts` writes).
 //!
-//! Ranges cross as lists of `(lo, hi)` pairs; parts as `Octree`s, each in the whole
-//! space with its leaves inside its range.
+//! Ranges cross as lists of `(lo, hi)` pairs; parts as `Octree`s (models: tree,
+//! frame, colours), each in the whole space with its leaves inside its range.
 
 use std::path::PathBuf;
 
@@ -15,7 +15,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::linear::{LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
-use tesseral::partition::{self as part, ManifestPart, Partition, PartitionedOctree};
+use tesseral::partition::{self as part, Manifest, ManifestPart, Partition};
 
 use crate::errors;
 use crate::octree::Octree;
@@ -47,19 +47,24 @@ fn set_op(name: &str) -> PyResult<SetOp> {
     }
 }
 
-fn same_frame(a: Frame, b: Frame) -> PyResult<()> {
-    if a == b {
-        Ok(())
-    } else {
-        Err(errors::octree(format!(
-            "the parts have different frames (voxel size {} at {:?}, voxel size {} at {:?})",
-            a.voxel_size, a.translate, b.voxel_size, b.translate
-        )))
+fn frame_of(voxel_size: f64, translate: (f64, f64, f64)) -> PyResult<Frame> {
+    if !(voxel_size.is_finite() && voxel_size > 0.0) {
+        return Err(PyValueError::new_err(
+            "voxel_size must be positive and finite",
+        ));
     }
+    Ok(Frame::new(
+        voxel_size,
+        [translate.0, translate.1, translate.2],
+    ))
 }
 
-fn model(tree: LinearOctree, frame: Frame) -> Octree {
-    Octree::new(Model::new(tree).with_frame(frame))
+fn v3(v: Vec3) -> [i64; 3] {
+    [v.0, v.1, v.2]
+}
+
+fn octrees(models: Vec<Model>) -> Vec<Octree> {
+    models.into_iter().map(Octree::new).collect()
 }
 
 /// About `k` ranges of equal work for building `scene` at `depth` (those of
@@ -79,7 +84,7 @@ pub fn partition_scene_ranges(
 }
 
 /// The part of `scene` at `depth` in the codes `[lo, hi)`, with the scene's frame
-/// (no colours).
+/// and colours (those `tesseral build --parts` writes for the range).
 #[pyfunction]
 pub fn partition_build_range(
     py: Python<'_>,
@@ -89,62 +94,104 @@ pub fn partition_build_range(
     hi: u64,
 ) -> PyResult<Octree> {
     let s = scene.at_depth(depth)?;
-    let csg = s.csg().map_err(|e| errors::scene(py, e))?;
-    let tree = py
-        .allow_threads(|| csg.build_range(s.depth, [0, 0, 0], lo..hi))
-        .map_err(errors::octree)?;
-    Ok(model(tree, s.frame()))
+    let window = tesseral::csg::StreamPlan::default_window();
+    py.allow_threads(|| part::build_scene_range(&s, Partition { lo, hi }, window))
+        .map(Octree::new)
+        .map_err(errors::octree)
 }
 
-/// The set operation `op` of two parts cut to the same range.
+/// The set operation `op` of two parts cut to the same range (the first operand's
+/// colour wins).
 #[pyfunction]
 pub fn partition_set_op(py: Python<'_>, a: &Octree, b: &Octree, op: &str) -> PyResult<Octree> {
     let op = set_op(op)?;
-    same_frame(a.model.frame, b.model.frame)?;
-    let (ta, tb) = (&a.model.tree, &b.model.tree);
-    let tree = py
-        .allow_threads(|| part::set_op_part(ta, tb, op))
-        .map_err(errors::octree)?;
-    Ok(model(tree, a.model.frame))
+    let (ma, mb) = (&a.model, &b.model);
+    py.allow_threads(|| part::set_op_models(ma, mb, op))
+        .map(Octree::new)
+        .map_err(errors::octree)
 }
 
-/// The tree cut into `ranges` (which tile its space in order), one Octree per range.
+/// The part cut into `ranges` (sorted and disjoint; every leaf must lie in one),
+/// one Octree per range, colours cut with it.
 #[pyfunction]
 pub fn partition_split(
     py: Python<'_>,
     tree: &Octree,
     ranges: Vec<(u64, u64)>,
 ) -> PyResult<Vec<Octree>> {
-    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    let m = &tree.model;
     let ranges = ranges_in(&ranges);
-    let p = py
-        .allow_threads(|| PartitionedOctree::split(t, &ranges))
-        .map_err(errors::octree)?;
-    Ok(p.parts()
-        .iter()
-        .map(|(_, t)| model(t.clone(), frame))
-        .collect())
+    py.allow_threads(|| part::split_model(m, &ranges))
+        .map(octrees)
+        .map_err(errors::octree)
 }
 
-/// The union of pieces of one space and frame (at least one).
+/// The union of disjoint pieces (with their colours) in the space `(depth,
+/// origin)` with the frame `(voxel_size, translate)`; an empty part when there are
+/// none.
 #[pyfunction]
-pub fn partition_join(py: Python<'_>, pieces: Vec<Octree>) -> PyResult<Octree> {
-    let first = pieces
-        .first()
-        .ok_or_else(|| PyValueError::new_err("partition_join needs at least one piece"))?;
-    let (depth, origin, frame) = (
-        first.model.tree.depth(),
-        first.model.tree.origin(),
-        first.model.frame,
-    );
-    for p in &pieces {
-        same_frame(frame, p.model.frame)?;
-    }
-    let trees: Vec<LinearOctree> = pieces.into_iter().map(|p| p.model.tree).collect();
-    let tree = py
-        .allow_threads(|| part::join_pieces(depth, origin, trees))
-        .map_err(errors::octree)?;
-    Ok(model(tree, frame))
+pub fn partition_join(
+    py: Python<'_>,
+    depth: u8,
+    origin: Vec3,
+    voxel_size: f64,
+    translate: (f64, f64, f64),
+    pieces: Vec<Octree>,
+) -> PyResult<Octree> {
+    let frame = frame_of(voxel_size, translate)?;
+    let models: Vec<Model> = pieces.into_iter().map(|p| p.model).collect();
+    py.allow_threads(|| part::join_models(depth, v3(origin), frame, models))
+        .map(Octree::new)
+        .map_err(errors::octree)
+}
+
+/// For each source range (of the space `(src_depth, src_origin)`), the indices of
+/// the target ranges (of `(dst_depth, dst_origin)`) that its voxels moved by `by`
+/// can land in, from the ranges alone.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+pub fn partition_reach(
+    py: Python<'_>,
+    src_depth: u8,
+    src_origin: Vec3,
+    src_ranges: Vec<(u64, u64)>,
+    by: Vec3,
+    dst_depth: u8,
+    dst_origin: Vec3,
+    dst_ranges: Vec<(u64, u64)>,
+) -> PyResult<Vec<Vec<usize>>> {
+    let (src, dst) = (ranges_in(&src_ranges), ranges_in(&dst_ranges));
+    py.allow_threads(|| {
+        part::reach(
+            (src_depth, v3(src_origin)),
+            &src,
+            v3(by),
+            (dst_depth, v3(dst_origin)),
+            &dst,
+        )
+    })
+    .map_err(errors::octree)
+}
+
+/// The ranges of the space `(depth, origin)` re-expressed in a space grown from it
+/// (`(new_depth, new_origin)`), tiling it.
+#[pyfunction]
+pub fn partition_embedded_ranges(
+    depth: u8,
+    origin: Vec3,
+    ranges: Vec<(u64, u64)>,
+    new_depth: u8,
+    new_origin: Vec3,
+) -> PyResult<Vec<(u64, u64)>> {
+    let r = part::embedded_ranges(
+        depth,
+        v3(origin),
+        &ranges_in(&ranges),
+        new_depth,
+        v3(new_origin),
+    )
+    .map_err(errors::octree)?;
+    Ok(ranges_out(&r))
 }
 
 /// The space of the whole tree (of space `depth`, `origin`, whose parts have the
@@ -200,35 +247,24 @@ pub fn partition_balanced_ranges(
     Ok(ranges_out(&part::balanced_ranges_exact(depth, k, &c)))
 }
 
-/// `tree` moved by `by` into the space `(depth, origin)` and cut into `ranges`.
+/// `tree` moved by `by` into the space `(depth, origin)` and cut into `ranges` of
+/// it (sorted, disjoint: those `partition_reach` gives), colours with it; voxels
+/// landing outside the space are dropped when `drop_outside`, else an error.
 #[pyfunction]
-pub fn partition_translate_split(
+pub fn partition_move_split(
     py: Python<'_>,
     tree: &Octree,
     by: Vec3,
     depth: u8,
     origin: Vec3,
     ranges: Vec<(u64, u64)>,
+    drop_outside: bool,
 ) -> PyResult<Vec<Octree>> {
-    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    let m = &tree.model;
     let ranges = ranges_in(&ranges);
-    let p = py
-        .allow_threads(|| -> Result<_, String> {
-            let (moved, dropped) = t
-                .translate_into([by.0, by.1, by.2], depth, [origin.0, origin.1, origin.2])
-                .map_err(|e| e.to_string())?;
-            if dropped > 0 {
-                return Err(format!(
-                    "{dropped} voxels land outside the space of depth {depth} at {origin:?}"
-                ));
-            }
-            PartitionedOctree::split(&moved, &ranges).map_err(|e| e.to_string())
-        })
-        .map_err(errors::octree)?;
-    Ok(p.parts()
-        .iter()
-        .map(|(_, t)| model(t.clone(), frame))
-        .collect())
+    py.allow_threads(|| part::move_and_split(m, v3(by), depth, v3(origin), &ranges, drop_outside))
+        .map(octrees)
+        .map_err(errors::octree)
 }
 
 fn entry<'py>(py: Python<'py>, e: &ManifestPart) -> PyResult<Bound<'py, PyDict>> {
@@ -259,8 +295,8 @@ pub struct Entry {
     crc32: u32,
 }
 
-/// Writes part `i` (range `[lo, hi)`) of a dataset in `dir` (created if missing);
-/// returns its manifest entry as a dict.
+/// Writes part `i` (range `[lo, hi)`) of a dataset in `dir` (created if missing),
+/// with its frame and colours; returns its manifest entry as a dict.
 #[pyfunction]
 pub fn partition_write_part<'py>(
     py: Python<'py>,
@@ -270,11 +306,11 @@ pub fn partition_write_part<'py>(
     hi: u64,
     tree: &Octree,
 ) -> PyResult<Bound<'py, PyDict>> {
-    let (t, frame) = (&tree.model.tree, tree.model.frame);
+    let m = &tree.model;
     std::fs::create_dir_all(&dir)
         .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", dir.display())))?;
     let e = py
-        .allow_threads(|| part::write_part(&dir, i, Partition { lo, hi }, t, frame))
+        .allow_threads(|| part::write_model_part(&dir, i, Partition { lo, hi }, m))
         .map_err(partition_error)?;
     entry(py, &e)
 }
@@ -291,24 +327,9 @@ pub fn partition_write_manifest(
     translate: (f64, f64, f64),
     entries: Vec<Entry>,
 ) -> PyResult<()> {
-    let parts: Vec<ManifestPart> = entries
-        .into_iter()
-        .map(|e| ManifestPart {
-            file: e.file,
-            lo: e.lo,
-            hi: e.hi,
-            leaves: e.leaves,
-            voxels: e.voxels,
-            crc32: e.crc32,
-        })
-        .collect();
-    LinearOctree::empty(depth, [origin.0, origin.1, origin.2]).map_err(errors::octree)?;
-    if !(voxel_size.is_finite() && voxel_size > 0.0) {
-        return Err(PyValueError::new_err(
-            "voxel_size must be positive and finite",
-        ));
-    }
-    let frame = Frame::new(voxel_size, [translate.0, translate.1, translate.2]);
+    let parts: Vec<ManifestPart> = entries.into_iter().map(ManifestPart::from).collect();
+    LinearOctree::empty(depth, v3(origin)).map_err(errors::octree)?;
+    let frame = frame_of(voxel_size, translate)?;
     let origin = [origin.0, origin.1, origin.2];
     py.allow_threads(|| part::write_manifest(&dir, depth, origin, frame, &parts))
         .map_err(partition_error)
@@ -334,23 +355,47 @@ pub fn partition_read_manifest(py: Python<'_>, dir: PathBuf) -> PyResult<Bound<'
     Ok(d)
 }
 
-/// Part `i` of the dataset in `dir`, checked against its manifest.
+/// A part of the dataset in `dir` as the client's manifest describes it (space
+/// `(depth, origin)`, frame, and the part's entry): read and checked against that
+/// description (CRC-32, space, range, leaf and voxel counts) where it is loaded,
+/// so a part changed since the manifest was read is an error naming it.
 #[pyfunction]
-pub fn partition_read_part(py: Python<'_>, dir: PathBuf, i: usize) -> PyResult<Octree> {
-    py.allow_threads(|| {
-        let m = part::read_manifest(&dir)?;
-        part::read_part(&dir, &m, i)
-    })
-    .map(Octree::new)
-    .map_err(partition_error)
+#[allow(clippy::too_many_arguments)]
+pub fn partition_read_part(
+    py: Python<'_>,
+    dir: PathBuf,
+    depth: u8,
+    origin: Vec3,
+    voxel_size: f64,
+    translate: (f64, f64, f64),
+    entry: Entry,
+) -> PyResult<Octree> {
+    let frame = frame_of(voxel_size, translate)?;
+    let m = Manifest::new(depth, v3(origin), frame, vec![entry.into()]);
+    py.allow_threads(|| part::read_part(&dir, &m, 0))
+        .map(Octree::new)
+        .map_err(partition_error)
 }
 
 /// File errors as `FormatError`/`OSError`, the rest as `FormatError` too (they name
 /// the manifest or part at fault).
-fn partition_error(e: part::PartitionError) -> PyErr {
+pub fn partition_error(e: part::PartitionError) -> PyErr {
     match e {
         part::PartitionError::Format(f) => errors::format(f),
         other => errors::FormatError::new_err(other.to_string()),
+    }
+}
+
+impl From<Entry> for ManifestPart {
+    fn from(e: Entry) -> Self {
+        ManifestPart {
+            file: e.file,
+            lo: e.lo,
+            hi: e.hi,
+            leaves: e.leaves,
+            voxels: e.voxels,
+            crc32: e.crc32,
+        }
     }
 }
 
@@ -364,7 +409,9 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(partition_translated_space, m)?)?;
     m.add_function(wrap_pyfunction!(partition_translated_sample, m)?)?;
     m.add_function(wrap_pyfunction!(partition_balanced_ranges, m)?)?;
-    m.add_function(wrap_pyfunction!(partition_translate_split, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_reach, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_embedded_ranges, m)?)?;
+    m.add_function(wrap_pyfunction!(partition_move_split, m)?)?;
     m.add_function(wrap_pyfunction!(partition_write_part, m)?)?;
     m.add_function(wrap_pyfunction!(partition_write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(partition_read_manifest, m)?)?;

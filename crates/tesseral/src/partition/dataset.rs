@@ -72,6 +72,25 @@ pub struct ManifestPart {
     pub crc32: u32,
 }
 
+impl Manifest {
+    /// The manifest of a dataset of the space `(depth, origin)` with `frame` and
+    /// `parts` (unchecked: [`read_manifest`] checks what it reads).
+    #[must_use]
+    pub fn new(depth: u8, origin: Voxel, frame: Frame, parts: Vec<ManifestPart>) -> Self {
+        Self {
+            format: FORMAT.into(),
+            version: 1,
+            depth,
+            origin,
+            frame: ManifestFrame {
+                voxel_size: frame.voxel_size,
+                translate: frame.translate,
+            },
+            parts,
+        }
+    }
+}
+
 pub(crate) fn part_name(i: usize) -> String {
     format!("part-{i:05}.tess")
 }
@@ -128,17 +147,7 @@ pub fn write_manifest(
     frame: Frame,
     parts: &[ManifestPart],
 ) -> Result<(), PartitionError> {
-    let m = Manifest {
-        format: FORMAT.into(),
-        version: 1,
-        depth,
-        origin,
-        frame: ManifestFrame {
-            voxel_size: frame.voxel_size,
-            translate: frame.translate,
-        },
-        parts: parts.to_vec(),
-    };
+    let m = Manifest::new(depth, origin, frame, parts.to_vec());
     let text = serde_json::to_string_pretty(&m).expect("a manifest serializes");
     crate::io::write_atomic(&dir.join(MANIFEST), |w| {
         w.write_all(text.as_bytes())?;
@@ -178,6 +187,20 @@ pub fn write_part(
     tree: &LinearOctree,
     frame: Frame,
 ) -> Result<ManifestPart, PartitionError> {
+    write_model_part(dir, i, range, &Model::new(tree.clone()).with_frame(frame))
+}
+
+/// As [`write_part`], for a model: its frame and colours are written with it.
+///
+/// # Errors
+/// As [`write_part`].
+pub fn write_model_part(
+    dir: &Path,
+    i: usize,
+    range: Partition,
+    model: &Model,
+) -> Result<ManifestPart, PartitionError> {
+    let tree = &model.tree;
     if tree.leaves().first().is_some_and(|l| l.code() < range.lo)
         || tree.leaves().last().is_some_and(|l| l.end() > range.hi)
     {
@@ -187,10 +210,7 @@ pub fn write_part(
         )));
     }
     let name = part_name(i);
-    crate::io::write_model(
-        &dir.join(&name),
-        &Model::new(tree.clone()).with_frame(frame),
-    )?;
+    crate::io::write_model(&dir.join(&name), model)?;
     ManifestPart::of_file(
         dir,
         name,

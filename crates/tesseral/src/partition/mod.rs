@@ -22,17 +22,21 @@ use crate::Voxel;
 
 pub mod dataset;
 mod merge;
+mod models;
 mod shuffle;
 mod stream;
 mod translate;
 
 pub use dataset::{
     is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, read_part,
-    write_dataset, write_manifest, write_part, Manifest, ManifestPart, MANIFEST,
+    write_dataset, write_manifest, write_model_part, write_part, Manifest, ManifestPart, MANIFEST,
 };
 pub use merge::{stream_concat, stream_set_op, stream_set_op_in};
+pub use models::{
+    build_scene_range, embedded_ranges, join_models, move_and_split, set_op_models, split_model,
+};
 pub use shuffle::{
-    balanced_ranges_exact, join_pieces, set_op_part, translated_sample, translated_space,
+    balanced_ranges_exact, join_pieces, reach, set_op_part, translated_sample, translated_space,
     union_bbox, SAMPLE_PER_PART,
 };
 pub use stream::{
@@ -313,6 +317,8 @@ impl PartitionedOctree {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_models;
 #[cfg(test)]
 mod tests_shuffle;
 

@@ -269,3 +269,137 @@ impl PartitionedOctree {
         Self::from_parts(depth, origin, parts)
     }
 }
+
+/// Where the leaves of each source range can land: for each of `src_ranges` (code
+/// ranges of the space `src`), the indices, in order, of the `dst_ranges` (code
+/// ranges of the space `dst`, sorted and disjoint) that its voxels, moved by `by`,
+/// can fall in. Computed from the ranges alone, never from leaves: a superset of
+/// where any tree's leaves go, so a shuffle sends each source part only to these
+/// targets (its pieces for the others would be empty).
+///
+/// Each source range is cut into its maximal aligned cells (at most 14 per level);
+/// a cell of side `2^k`, moved, meets at most eight aligned cells of that side in
+/// `dst`, each one code interval; the targets are the ranges those intervals meet.
+///
+/// # Runtime
+/// O(n · depth · (1 + log m)) plus the output, for n source and m target ranges.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] for a bad space or a range outside its space.
+pub fn reach(
+    src: (u8, Voxel),
+    src_ranges: &[Partition],
+    by: [i64; 3],
+    dst: (u8, Voxel),
+    dst_ranges: &[Partition],
+) -> Result<Vec<Vec<usize>>, PartitionError> {
+    LinearOctree::empty(src.0, src.1)?;
+    LinearOctree::empty(dst.0, dst.1)?;
+    let (src_end, dst_end) = (space_end(src.0), space_end(dst.0));
+    let check = |ranges: &[Partition], end: u64, what: &str| {
+        let mut at = 0;
+        for (i, p) in ranges.iter().enumerate() {
+            if p.lo < at || p.hi < p.lo || p.hi > end {
+                return Err(PartitionError::Ranges(format!(
+                    "{what} range {i} [{}, {}) is out of order or outside its space (codes below {end})",
+                    p.lo, p.hi
+                )));
+            }
+            at = p.hi;
+        }
+        Ok(())
+    };
+    check(src_ranges, src_end, "source")?;
+    check(dst_ranges, dst_end, "target")?;
+    Ok(src_ranges
+        .iter()
+        .map(|p| {
+            let mut intervals = Vec::new();
+            for (code, k) in aligned_cells(p.lo, p.hi, src.0) {
+                moved_cell_intervals(src, code, k, by, dst, &mut intervals);
+            }
+            targets(&mut intervals, dst_ranges)
+        })
+        .collect())
+}
+
+fn space_end(depth: u8) -> u64 {
+    // 8^21 = 2^63 fits; deeper spaces are refused by `LinearOctree::empty` first.
+    1u64 << (3 * u32::from(depth))
+}
+
+/// The maximal aligned cells `(code, k)` (`8^k` codes from `code`, a multiple of
+/// `8^k`) whose union is `[lo, hi)`, in order.
+fn aligned_cells(lo: u64, hi: u64, depth: u8) -> Vec<(u64, u8)> {
+    let mut out = Vec::new();
+    let mut c = lo;
+    while c < hi {
+        let mut k = 0u8;
+        while k < depth {
+            let size = 1u64 << (3 * (u32::from(k) + 1));
+            if c % size != 0 || hi - c < size {
+                break;
+            }
+            k += 1;
+        }
+        out.push((c, k));
+        c += 1u64 << (3 * u32::from(k));
+    }
+    out
+}
+
+/// Pushes the code intervals of `dst` that the source cell `(code, k)` of `src`,
+/// moved by `by`, can meet: the aligned cells of side `2^min(k, dst depth)`
+/// covering its moved box, clipped to the space.
+fn moved_cell_intervals(
+    src: (u8, Voxel),
+    code: u64,
+    k: u8,
+    by: [i64; 3],
+    dst: (u8, Voxel),
+    out: &mut Vec<(u64, u64)>,
+) {
+    let rel = crate::code::decode(code);
+    let dst_side = 1i128 << dst.0;
+    let kk = k.min(dst.0);
+    let mut cells = [(0u32, 0u32); 3];
+    for a in 0..3 {
+        let lo =
+            i128::from(src.1[a]) + i128::from(rel[a]) + i128::from(by[a]) - i128::from(dst.1[a]);
+        let hi = (lo + (1i128 << k)).min(dst_side);
+        let lo = lo.max(0);
+        if lo >= hi {
+            return;
+        }
+        // Within the space: below 2^21, so the cell indices fit u32.
+        cells[a] = ((lo >> kk) as u32, ((hi - 1) >> kk) as u32);
+    }
+    let size = 1u64 << (3 * u32::from(kk));
+    for z in cells[2].0..=cells[2].1 {
+        for y in cells[1].0..=cells[1].1 {
+            for x in cells[0].0..=cells[0].1 {
+                let c = crate::code::encode(x << kk, y << kk, z << kk);
+                out.push((c, c + size));
+            }
+        }
+    }
+}
+
+/// The indices of the sorted, disjoint `ranges` that meet any of `intervals`.
+fn targets(intervals: &mut [(u64, u64)], ranges: &[Partition]) -> Vec<usize> {
+    intervals.sort_unstable();
+    let mut out: Vec<usize> = Vec::new();
+    let mut from = 0usize;
+    for &(lo, hi) in intervals.iter() {
+        // The first range ending past lo, no earlier than the last one taken.
+        let mut j = from + ranges[from..].partition_point(|p| p.hi <= lo);
+        while j < ranges.len() && ranges[j].lo < hi {
+            if ranges[j].hi > ranges[j].lo && out.last() != Some(&j) {
+                out.push(j);
+            }
+            j += 1;
+        }
+        from = j.saturating_sub(1).max(from);
+    }
+    out
+}
