@@ -10,6 +10,7 @@ use crate::model::Rgba;
 
 /// The leaves of one colour region, decoded lazily and checked as
 /// the whole-file reader checks them (packing, size, bounds, order).
+#[derive(Clone)]
 pub struct RegionLeaves<'a> {
     r: Reader<'a>,
     left: u64,
@@ -34,7 +35,43 @@ impl Iterator for RegionLeaves<'_> {
     }
 }
 
-impl RegionLeaves<'_> {
+impl<'a> RegionLeaves<'a> {
+    /// Cuts the region into stretches of at most `n` leaves (at least one), each
+    /// with its code range and count (the offset is 0) and a stream of its leaves
+    /// alone, so that a reader can decode the stretches that meet a code range
+    /// without reading the region from its start. Reads (and checks) the region
+    /// once; holds one small cursor per stretch.
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad leaf.
+    pub fn stretches(
+        mut self,
+        n: usize,
+    ) -> Result<Vec<(super::ChunkInfo, RegionLeaves<'a>)>, FormatError> {
+        let n = n.max(1) as u64;
+        let mut out = Vec::new();
+        while self.left > 0 && !self.failed {
+            let mut part = self.clone();
+            part.left = part.left.min(n);
+            let count = part.left;
+            let mut lo = None;
+            let mut hi = 0;
+            for _ in 0..count {
+                let l = self.next().expect("a leaf is left")?;
+                lo.get_or_insert(l.code());
+                hi = l.end();
+            }
+            let info = super::ChunkInfo {
+                offset: 0,
+                lo: lo.unwrap_or(0),
+                hi,
+                count,
+            };
+            out.push((info, part));
+        }
+        Ok(out)
+    }
+
     fn step(&mut self) -> Result<Leaf, String> {
         let delta = self.r.varint()?;
         if self.prev_end.is_some() && delta == 0 {

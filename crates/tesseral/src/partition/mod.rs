@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::linear::{push_merging, Leaf, LinearOctree, OctreeError, SetOp};
 use crate::Voxel;
 
+mod blocks;
 pub mod dataset;
 mod merge;
 mod shuffle;
@@ -38,7 +39,7 @@ pub use shuffle::{
 pub use stream::{
     build_scene_dataset, scene_ranges, write_plan_tess, write_plan_tess_coloured, StreamSummary,
 };
-pub use translate::{stream_translate, stream_translate_in, StreamTranslation, RUN_LEAVES};
+pub use translate::{stream_translate, stream_translate_in, StreamTranslation, CELL_LEAVES};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]
