@@ -37,7 +37,7 @@ impl Iterator for RegionLeaves<'_> {
 
 impl<'a> RegionLeaves<'a> {
     /// Cuts the region into stretches of at most `n` leaves (at least one), each
-    /// with its code range and count (the offset is 0) and a stream of its leaves
+    /// with its code range, count and byte offset in the file, and a stream of its leaves
     /// alone, so that a reader can decode the stretches that meet a code range
     /// without reading the region from its start. Reads (and checks) the region
     /// once; holds one small cursor per stretch.
@@ -62,7 +62,7 @@ impl<'a> RegionLeaves<'a> {
                 hi = l.end();
             }
             let info = super::ChunkInfo {
-                offset: 0,
+                offset: part.r.pos as u64,
                 lo: lo.unwrap_or(0),
                 hi,
                 count,

@@ -12,7 +12,7 @@ const CACHED: usize = 4;
 
 enum Source<'a> {
     File(&'a TessFile),
-    Region(Vec<RegionLeaves<'a>>),
+    Region(&'a TessFile, Vec<RegionLeaves<'a>>),
 }
 
 /// Leaves in sorted blocks of known code ranges and counts.
@@ -46,10 +46,19 @@ impl<'a> Blocks<'a> {
         Self::new(Source::File(f), f.chunks())
     }
 
-    /// A colour region cut into stretches of `n` leaves (read once to find them).
-    pub(super) fn of_region(r: RegionLeaves<'a>, n: usize) -> Result<Self, FormatError> {
-        let (info, parts) = r.stretches(n)?.into_iter().unzip();
-        Ok(Self::new(Source::Region(parts), info))
+    /// A colour region cut into stretches of `n` leaves (read once to find them)
+    /// (`f` is the file it lies in).
+    pub(super) fn of_region(
+        f: &'a TessFile,
+        r: RegionLeaves<'a>,
+        n: usize,
+    ) -> Result<Self, FormatError> {
+        let (info, parts): (Vec<ChunkInfo>, _) = r.stretches(n)?.into_iter().unzip();
+        // Finding the stretches read the whole region: let it go.
+        if let Some(first) = info.first() {
+            f.release(first.offset..u64::MAX);
+        }
+        Ok(Self::new(Source::Region(f, parts), info))
     }
 
     /// The blocks meeting the code range `[lo, hi)`, as an index range.
@@ -59,11 +68,12 @@ impl<'a> Blocks<'a> {
         first..last.max(first)
     }
 
-    /// At least the number of leaves meeting `[lo, hi)`: the counts of the blocks
-    /// that meet it (from the index; nothing is decoded).
-    pub(super) fn bound(&self, lo: u64, hi: u64) -> u64 {
+    /// At least the number of leaves meeting `[lo, hi)` (the counts of the blocks
+    /// that meet it), and the number of those blocks: from the index, nothing is
+    /// decoded.
+    pub(super) fn bound(&self, lo: u64, hi: u64) -> (u64, usize) {
         let r = self.meeting(lo, hi);
-        self.before[r.end] - self.before[r.start]
+        (self.before[r.end] - self.before[r.start], r.len())
     }
 
     /// Hands `take` the leaves meeting `[lo, hi)`, a block's share at a time, in
@@ -88,6 +98,21 @@ impl<'a> Blocks<'a> {
         Ok(())
     }
 
+    /// Lets the mapped bytes of block `i` leave resident memory (see
+    /// [`TessFile::release`]); it may be decoded again later.
+    pub(super) fn release(&self, i: usize) {
+        let f = match &self.source {
+            Source::File(f) | Source::Region(f, _) => f,
+        };
+        let end = self.info.get(i + 1).map_or(u64::MAX, |c| c.offset);
+        f.release(self.info[i].offset..end);
+    }
+
+    /// The number of blocks.
+    pub(super) fn len(&self) -> usize {
+        self.info.len()
+    }
+
     /// Block `i`, decoded (or from the cache).
     fn block(&mut self, i: usize) -> Result<&[Leaf], FormatError> {
         let at = match self.cache.iter().position(|(j, _)| *j == i) {
@@ -95,10 +120,11 @@ impl<'a> Blocks<'a> {
             None => {
                 let leaves = match &self.source {
                     Source::File(f) => f.chunk(i)?,
-                    Source::Region(parts) => parts[i].clone().collect::<Result<Vec<_>, _>>()?,
+                    Source::Region(_, parts) => parts[i].clone().collect::<Result<Vec<_>, _>>()?,
                 };
                 if self.cache.len() == CACHED {
-                    self.cache.remove(0);
+                    let (j, _) = self.cache.remove(0);
+                    self.release(j);
                 }
                 self.cache.push((i, leaves));
                 self.cache.len() - 1

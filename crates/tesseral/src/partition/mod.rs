@@ -31,7 +31,7 @@ pub use dataset::{
     is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, read_part,
     write_dataset, write_manifest, write_part, Manifest, ManifestPart, MANIFEST,
 };
-pub use merge::{stream_concat, stream_set_op, stream_set_op_in};
+pub use merge::{stream_concat, stream_set_op, stream_set_op_files, stream_set_op_in};
 pub use shuffle::{
     balanced_ranges_exact, join_pieces, set_op_part, translated_sample, translated_space,
     union_bbox, SAMPLE_PER_PART,
@@ -317,5 +317,7 @@ mod tests;
 #[cfg(test)]
 mod tests_shuffle;
 
+#[cfg(test)]
+mod tests_parts;
 #[cfg(test)]
 mod tests_translate;

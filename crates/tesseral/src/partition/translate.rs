@@ -9,7 +9,8 @@
 //! runs, no merge.
 //!
 //! The cells are chosen top-down from the chunk index alone: a cell is split while
-//! the chunks meeting its window hold more than `cell_leaves` leaves, and skipped
+//! the chunks meeting its window hold more than `cell_leaves` leaves (and are more
+//! than eight: splitting cannot do better than one per input cell), and skipped
 //! when its cube misses the input's bounding box or its window holds none. Each
 //! colour region is translated the same way (cut into stretches of leaves that
 //! play the chunks' part) into a [`LeafSpool`].
@@ -33,7 +34,7 @@ use crate::Voxel;
 
 /// The most leaves a cell's window may hold (by the chunk index) before the cell
 /// is split, unless [`stream_translate_in`] is told otherwise.
-pub const CELL_LEAVES: usize = 1 << 21;
+pub const CELL_LEAVES: usize = 1 << 22;
 
 /// What [`stream_translate_in`] wrote: the result's space and its counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -217,11 +218,18 @@ impl Mover {
         }
         if k <= self.depth {
             let size = 1u64 << (3 * u32::from(k));
-            let bound: u64 = window.iter().map(|&c| blocks.bound(c, c + size)).sum();
+            let (mut bound, mut met) = (0, 0);
+            for &c in &window {
+                let (n, m) = blocks.bound(c, c + size);
+                bound += n;
+                met += m;
+            }
             if bound == 0 {
                 return;
             }
-            if bound <= self.cap || k == 0 {
+            // Splitting cannot bring a window below one block per input cell: stop
+            // at eight blocks whatever the cap.
+            if bound <= self.cap || met <= 8 || k == 0 {
                 cells.push((code, k));
                 return;
             }
@@ -324,12 +332,15 @@ pub fn stream_translate_in(
 ) -> Result<StreamTranslation, PartitionError> {
     let cap = cell_leaves.max(1) as u64;
     let colours = super::merge::only_colours(f)?;
+    // Finding the colour regions read the colour section: let it go.
+    f.release(0..u64::MAX);
     let (depth, origin) = (f.depth(), f.origin());
     let mut blocks = Blocks::of_file(f);
     let mut bbox = None;
-    for i in 0..f.chunks().len() {
+    for i in 0..blocks.len() {
         let t = LinearOctree::from_parts(depth, origin, f.chunk(i)?);
         bbox = union_bbox([bbox, t.bbox()]);
+        blocks.release(i);
     }
     let to = translated_space(depth, origin, bbox, by)?;
     let mut tw = TessWriter::new(w, to.0, to.1).map_err(io_err)?;
@@ -345,7 +356,7 @@ pub fn stream_translate_in(
         // Stretches of a colour region play the chunks' part.
         let stretch = (cell_leaves / 32).clamp(1, DEFAULT_CHUNK_LEAVES);
         for (c, region) in colours {
-            let mut blocks = Blocks::of_region(region, stretch)?;
+            let mut blocks = Blocks::of_region(f, region, stretch)?;
             let mut spool = LeafSpool::new_in(spool_dir).map_err(io_err)?;
             mover.run(&mut blocks, &mut |l| spool.push(l))?;
             spools.push((c, spool));
