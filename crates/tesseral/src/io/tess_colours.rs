@@ -44,9 +44,13 @@ impl<'a> RegionLeaves<'a> {
     ///
     /// # Errors
     /// [`FormatError::Corrupt`] for a bad leaf.
+    ///
+    /// `done(pos)` is called after each stretch with the byte offset read up to,
+    /// so that a mapped reader can let the bytes before it go.
     pub fn stretches(
         mut self,
         n: usize,
+        done: &mut dyn FnMut(u64),
     ) -> Result<Vec<(super::ChunkInfo, RegionLeaves<'a>)>, FormatError> {
         let n = n.max(1) as u64;
         let mut out = Vec::new();
@@ -68,6 +72,7 @@ impl<'a> RegionLeaves<'a> {
                 count,
             };
             out.push((info, part));
+            done(self.r.pos as u64);
         }
         Ok(out)
     }
@@ -101,11 +106,15 @@ impl<'a> RegionLeaves<'a> {
 /// The colour regions of the sections `bytes[start..end]` of a version-2 file in a
 /// depth-`depth` space: `None` when the sections hold more than a frame and a
 /// colour layer (a legacy colour list, free space or log-odds).
-pub(crate) fn colour_regions(
-    bytes: &[u8],
+///
+/// `done(start, end)` is called after each stretch of bytes is scanned, so that a
+/// mapped reader can let it go.
+pub(crate) fn colour_regions<'a>(
+    bytes: &'a [u8],
     (start, end): (usize, usize),
     depth: u8,
-) -> Result<Option<Vec<(Rgba, RegionLeaves<'_>)>>, String> {
+    done: &dyn Fn(usize, usize),
+) -> Result<Option<Vec<(Rgba, RegionLeaves<'a>)>>, String> {
     let mut r = Reader {
         bytes: &bytes[..end],
         pos: start,
@@ -131,9 +140,15 @@ pub(crate) fn colour_regions(
         let leaves = r.u64()?;
         let at = r.pos;
         // Skip the region's varints to find the next region.
+        let mut last = at;
         for _ in 0..leaves {
             while r.u8()? & 0x80 != 0 {}
+            if r.pos - last >= super::chunked::RELEASE_STRETCH {
+                done(last, r.pos);
+                last = r.pos;
+            }
         }
+        done(last, r.pos);
         if out.iter().any(|(c, _): &(Rgba, _)| *c == rgba) {
             return Err(format!("colour region {i}: repeats a colour"));
         }

@@ -3,7 +3,7 @@
 
 use std::path::{Path, PathBuf};
 
-use super::chunked::{chunk_leaves, parse_layout, ChunkInfo, Layout, DEFAULT_CHUNK_LEAVES};
+use super::chunked::{chunk_leaves, ChunkInfo, Layout, DEFAULT_CHUNK_LEAVES};
 use super::sections::Extras;
 use super::FormatError;
 use crate::linear::{Leaf, LinearOctree};
@@ -108,7 +108,10 @@ impl TessFile {
                 layers,
             });
         }
-        let layout = parse_layout(&bytes).map_err(|m| err(FormatError::corrupt(m)))?;
+        // The checksum reads the sections (the colours: about half a big file):
+        // let their mapped pages go as it goes, so opening keeps memory flat.
+        let layout = super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b))
+            .map_err(|m| err(FormatError::corrupt(m)))?;
         let space =
             LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
         // The sections are under the index's checksum, checked above; the layers
@@ -249,10 +252,15 @@ impl TessFile {
         &self,
     ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
         match &self.body {
-            Body::Chunked(bytes, layout) => {
-                super::tess_colours::colour_regions(bytes, layout.sections, layout.depth)
-                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))
-            }
+            Body::Chunked(bytes, layout) => super::tess_colours::colour_regions(
+                bytes,
+                layout.sections,
+                layout.depth,
+                &|a, b| {
+                    release_map(bytes, a, b);
+                },
+            )
+            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
             Body::Decoded(_) => Ok(None),
         }
     }
@@ -302,23 +310,13 @@ impl TessFile {
     /// flat; nothing changes for files held in memory. Advice only: errors are
     /// ignored.
     pub fn release(&self, bytes: std::ops::Range<u64>) {
-        if let Body::Chunked(Bytes::Map(m), _) = &self.body {
-            let len = m.len() as u64;
-            let (start, end) = (bytes.start.min(len), bytes.end.min(len));
-            if start < end {
-                // SAFETY: the map is read-only and nothing writes through it, so
-                // MADV_DONTNEED only drops this process's page-table entries: the
-                // next access reads the same bytes from the page cache (or the file,
-                // with the caveat of `open` about a file rewritten under us). No
-                // slice of the map is invalidated.
-                let _ = unsafe {
-                    m.unchecked_advise_range(
-                        memmap2::UncheckedAdvice::DontNeed,
-                        start as usize,
-                        (end - start) as usize,
-                    )
-                };
-            }
+        if let Body::Chunked(b, _) = &self.body {
+            let len = b.len() as u64;
+            release_map(
+                b,
+                bytes.start.min(len) as usize,
+                bytes.end.min(len) as usize,
+            );
         }
     }
 
@@ -346,5 +344,22 @@ impl TessFile {
         super::sections::check_parts(&model)
             .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
         Ok(model)
+    }
+}
+
+/// Lets the mapped pages of `bytes[start..end]` leave resident memory (see
+/// [`TessFile::release`]); nothing for bytes held in memory.
+fn release_map(bytes: &Bytes, start: usize, end: usize) {
+    if let Bytes::Map(m) = bytes {
+        if start < end && end <= m.len() {
+            // SAFETY: the map is read-only and nothing writes through it, so
+            // MADV_DONTNEED only drops this process's page-table entries: the next
+            // access reads the same bytes from the page cache (or the file, with
+            // the caveat of `open` about a file rewritten under us). No slice of the
+            // map is invalidated.
+            let _ = unsafe {
+                m.unchecked_advise_range(memmap2::UncheckedAdvice::DontNeed, start, end - start)
+            };
+        }
     }
 }

@@ -9,6 +9,8 @@ use crate::linear::Leaf;
 /// Decoded blocks kept for the next windows (neighbouring output cells read
 /// neighbouring blocks).
 const CACHED: usize = 4;
+/// Decodes between two releases of the whole map.
+const SWEEP_EVERY: u64 = 64;
 
 enum Source<'a> {
     File(&'a TessFile),
@@ -22,6 +24,7 @@ pub(super) struct Blocks<'a> {
     /// `before[i]`: the leaves of blocks `0..i`.
     before: Vec<u64>,
     cache: Vec<(usize, Vec<Leaf>)>,
+    decodes: u64,
 }
 
 impl<'a> Blocks<'a> {
@@ -38,6 +41,7 @@ impl<'a> Blocks<'a> {
             info,
             before,
             cache: Vec::with_capacity(CACHED),
+            decodes: 0,
         }
     }
 
@@ -53,7 +57,16 @@ impl<'a> Blocks<'a> {
         r: RegionLeaves<'a>,
         n: usize,
     ) -> Result<Self, FormatError> {
-        let (info, parts): (Vec<ChunkInfo>, _) = r.stretches(n)?.into_iter().unzip();
+        let mut last = 0u64;
+        let (info, parts): (Vec<ChunkInfo>, _) = r
+            .stretches(n, &mut |pos| {
+                if pos - last.min(pos) >= 8 << 20 {
+                    f.release(last..pos);
+                    last = pos;
+                }
+            })?
+            .into_iter()
+            .unzip();
         // Finding the stretches read the whole region: let it go.
         if let Some(first) = info.first() {
             f.release(first.offset..u64::MAX);
@@ -101,11 +114,15 @@ impl<'a> Blocks<'a> {
     /// Lets the mapped bytes of block `i` leave resident memory (see
     /// [`TessFile::release`]); it may be decoded again later.
     pub(super) fn release(&self, i: usize) {
-        let f = match &self.source {
-            Source::File(f) | Source::Region(f, _) => f,
-        };
+        let f = self.file();
         let end = self.info.get(i + 1).map_or(u64::MAX, |c| c.offset);
         f.release(self.info[i].offset..end);
+    }
+
+    fn file(&self) -> &'a TessFile {
+        match &self.source {
+            Source::File(f) | Source::Region(f, _) => f,
+        }
     }
 
     /// The number of blocks.
@@ -125,6 +142,12 @@ impl<'a> Blocks<'a> {
                 if self.cache.len() == CACHED {
                     let (j, _) = self.cache.remove(0);
                     self.release(j);
+                }
+                // Page faults map neighbouring pages too (fault-around), which the
+                // releases above miss: now and then let the whole map go.
+                self.decodes += 1;
+                if self.decodes % SWEEP_EVERY == 0 {
+                    self.file().release(0..u64::MAX);
                 }
                 self.cache.push((i, leaves));
                 self.cache.len() - 1
