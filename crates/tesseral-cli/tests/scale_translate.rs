@@ -144,10 +144,10 @@ fn a_streamed_translation_too_far_is_refused() {
 }
 
 /// Bounded memory: the spheroid at depth 12 (14.5 M leaves, coloured) translated
-/// by an unaligned vector streams within a 384 MiB address space, and gives the
-/// leaf and voxel counts of the in-memory translation; the in-memory translation
-/// (written to standard output) cannot run in that space, so the cap does bound
-/// the work.
+/// by an unaligned vector streams (by itself: no flag) within a 320 MiB address
+/// space, and gives the leaf and voxel counts of the in-memory translation; the
+/// in-memory translation (written to standard output) cannot run in that space,
+/// so the cap does bound the work.
 #[test]
 fn a_streamed_translation_fits_in_a_small_address_space() {
     let dir = tempfile::tempdir().unwrap();
@@ -155,8 +155,6 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
     let scene = scenes().join("fig4c-spheroid.tss");
     let s = scene.to_str().unwrap();
     ok(d, &["build", s, "-o", "s.tess", "--depth", "12"]);
-    // No --stream: the in-memory estimate (48 B a leaf) passes --memory 300M, so the
-    // command chooses to stream by itself.
     let args = [
         "translate",
         "s.tess",
@@ -164,10 +162,8 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
         "t.tess",
         "--by=3,-5,7",
         "--json",
-        "--memory",
-        "300M",
     ];
-    let out = run_capped(d, &args, 384);
+    let out = run_capped(d, &args, 320);
     assert!(
         out.status.success(),
         "{}",
@@ -190,16 +186,17 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
             "tess",
             "--by=3,-5,7",
         ],
-        384,
+        320,
     );
     assert!(!out.status.success());
     assert!(out.stdout.is_empty());
 }
 
-/// A small file translates in memory unless --stream is given (it is several times
-/// faster); --stream with an input that cannot stream is an error naming the flag.
+/// A `.tess` into a `.tess` streams by itself and writes the in-memory path's
+/// bytes; --stream with an output that cannot stream is an error naming the flag;
+/// an in-memory translation over --memory is refused before the work, naming it.
 #[test]
-fn translation_streams_when_asked_or_over_the_memory_budget() {
+fn translation_streams_by_itself_and_in_memory_is_budgeted() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = scenes().join("tank.tss");
@@ -220,30 +217,26 @@ fn translation_streams_when_asked_or_over_the_memory_budget() {
             "translate",
             "a.tess",
             "-o",
-            "m.tess",
+            "s.tess",
             "--by=3,1,2",
             "--json",
         ],
     );
-    assert!(v.get("streamed").is_none() || v["streamed"] == false, "{v}");
-    let v = json(
+    assert_eq!(v["streamed"], true, "{v}");
+    let out = run(
         d,
         &[
             "translate",
             "a.tess",
             "-o",
-            "s.tess",
+            "-",
+            "--format",
+            "tess",
             "--by=3,1,2",
-            "--json",
-            "--memory",
-            "1K",
         ],
     );
-    assert_eq!(v["streamed"], true, "{v}");
-    assert_eq!(
-        fs::read(d.join("m.tess")).unwrap(),
-        fs::read(d.join("s.tess")).unwrap()
-    );
+    assert!(out.status.success());
+    assert_eq!(fs::read(d.join("s.tess")).unwrap(), out.stdout);
     ok(d, &["translate", "a.tess", "-o", "a.xyz", "--by=0,0,0"]);
     fails(
         d,
@@ -257,4 +250,98 @@ fn translation_streams_when_asked_or_over_the_memory_budget() {
         ],
         "--stream",
     );
+    fails(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "x.xyz",
+            "--by=1,0,0",
+            "--memory",
+            "1K",
+        ],
+        "--memory",
+    );
+    assert!(!d.join("x.xyz").exists());
+}
+
+/// The streamed `translate`, `op` and `convert` check `--max-output` before the
+/// work (estimated from the inputs' sizes): an error naming the flag, and no
+/// output or temporary file left.
+#[test]
+fn streamed_outputs_over_max_output_are_refused_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("showcase.tss");
+    let s = scene.to_str().unwrap();
+    ok(d, &["build", s, "-o", "a.tess", "--depth", "7"]);
+    ok(d, &["build", s, "--parts", "3", "-o", "ds", "--depth", "7"]);
+    for args in [
+        &["translate", "a.tess", "-o", "o.tess", "--by=3,-5,7"][..],
+        &["op", "union", "a.tess", "ds", "-o", "o.tess"][..],
+        &["op", "union", "ds", "a.tess", "-o", "o.tess"][..],
+        &["convert", "ds", "o.tess"][..],
+        &["convert", "a.tess", "o.tess"][..],
+    ] {
+        let mut args = args.to_vec();
+        args.extend(["--max-output", "2K"]);
+        fails(d, &args, "--max-output");
+        let mut names: Vec<String> = fs::read_dir(d)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        names.sort();
+        assert_eq!(names, ["a.tess", "ds"], "{args:?}");
+        // With room, the same command succeeds.
+        args.truncate(args.len() - 2);
+        ok(d, &args);
+        fs::remove_file(d.join("o.tess")).unwrap();
+    }
+}
+
+/// `op` with a dataset operand streams (its parts read in order as one stream)
+/// and writes the bytes the in-memory operation writes, colours included (an
+/// empty result: the same, empty, model).
+#[test]
+fn streamed_set_operations_take_datasets() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let a = scenes().join("showcase.tss");
+    let a = a.to_str().unwrap();
+    ok(d, &["build", a, "--parts", "3", "-o", "ds", "--depth", "7"]);
+    // A second operand in the same space and frame, other colours: the showcase
+    // moved (within its space).
+    ok(d, &["build", a, "-o", "a.tess", "--depth", "7"]);
+    ok(
+        d,
+        &[
+            "translate",
+            "a.tess",
+            "-o",
+            "b.tess",
+            "--by=-5,3,-2",
+            "--clip",
+        ],
+    );
+    for op in ["union", "intersection", "difference", "xor"] {
+        for (x, y) in [("ds", "b.tess"), ("b.tess", "ds"), ("ds", "ds")] {
+            let v = json(d, &["op", op, x, y, "-o", "s.tess", "--json"]);
+            assert_eq!(v["streamed"], true, "{op} {x} {y}");
+            let out = run(d, &["op", op, x, y, "-o", "-", "--format", "tess"]);
+            assert!(out.status.success(), "{op} {x} {y}");
+            if v["voxels"] == 0 {
+                // Empty: the in-memory file keeps an empty colour layer, the
+                // streamed one writes none; both mean no colours.
+                let m = json(d, &["op", op, x, y, "-o", "m.xyz", "--json"]);
+                assert_eq!(m["voxels"], 0);
+                continue;
+            }
+            assert_eq!(
+                fs::read(d.join("s.tess")).unwrap(),
+                out.stdout,
+                "{op} {x} {y}"
+            );
+        }
+    }
 }

@@ -158,18 +158,21 @@ fn streamed(args: &Args, out: &std::path::Path) -> Result<bool> {
         return Ok(false);
     }
     let input = &args.input;
-    let (files, frame) = if is_dataset(input) {
+    let size = |p: &std::path::Path| std::fs::metadata(p).map_or(0, |m| m.len());
+    let (files, frame, bytes) = if is_dataset(input) {
         let m = read_manifest(input)?;
         let mut files = Vec::with_capacity(m.parts.len());
-        for i in 0..m.parts.len() {
+        let mut bytes = 0u64;
+        for (i, p) in m.parts.iter().enumerate() {
+            bytes += size(&input.join(&p.file));
             files.push(open_part(input, &m, i)?);
         }
         let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
-        (files, frame)
+        (files, frame, bytes)
     } else if input.is_file() && io::extension(input) == "tess" {
         let f = TessFile::open(input)?;
         let frame = f.frame();
-        (vec![f], frame)
+        (vec![f], frame, size(input))
     } else {
         return Ok(false);
     };
@@ -178,10 +181,9 @@ fn streamed(args: &Args, out: &std::path::Path) -> Result<bool> {
             return Ok(false);
         }
     }
-    let spool_dir = match out.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
+    // The copy holds the same leaves and colours: about the inputs' size.
+    super::output::check_size(out, bytes, args.limits.limits.max_output)?;
+    let spool_dir = super::streamed::spool_dir(out);
     let mut summary = tesseral::partition::StreamSummary::default();
     io::write_atomic(out, |w| {
         summary = tesseral::partition::stream_concat(&files, frame, w, &spool_dir)

@@ -20,6 +20,7 @@ pub mod rsmc;
 pub mod shell;
 pub mod simulate;
 pub mod stdio;
+pub mod streamed;
 pub mod tables;
 pub mod transform;
 pub mod view;

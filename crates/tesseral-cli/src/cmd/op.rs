@@ -38,6 +38,11 @@ pub struct Args {
     json: bool,
     #[command(flatten)]
     limits: octree::OutArgs,
+    /// The working memory a version-1 `.tess` operand may take when it is decoded
+    /// whole (at most 24 bytes a byte of the file), checked before it is read:
+    /// bytes, or a number with K, M, G or T (powers of 1024).
+    #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = super::output::parse_bytes)]
+    memory: u64,
 }
 
 pub fn run(args: Args) -> Result<()> {
@@ -75,49 +80,55 @@ pub fn run(args: Args) -> Result<()> {
     octree::write(&args.output, &r, &args.limits, report)
 }
 
-/// Two version-2 `.tess` files of one space and frame, with no layers but colours,
-/// into a `.tess` file: a merge of the two sorted streams (colour regions
-/// included), one chunk of each held at a time. `None` when the inputs need the
-/// in-memory path.
+/// Two operands of one space and frame, each a `.tess` file or a dataset
+/// directory, with no layers but colours, into a `.tess` file: a merge of the two
+/// sorted streams (a dataset's parts read in order as one stream, colour regions
+/// included), one chunk of each held at a time. A version-1 file is one payload,
+/// decoded whole under the `--memory` check, then streamed from memory. The output
+/// size (estimated as the inputs' sizes together) is checked against
+/// `--max-output` before the work. `None` when the inputs need the in-memory
+/// path.
 fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
-    use tesseral::io::TessFile;
-    let tess = |p: &std::path::Path| {
-        !super::output::is_stdio(p) && p.is_file() && tesseral::io::extension(p) == "tess"
-    };
-    let out_tess =
-        !super::output::is_stdio(&args.output) && tesseral::io::extension(&args.output) == "tess";
-    if !(tess(&args.a) && tess(&args.b) && out_tess) {
+    use super::streamed::{is_tess_output, open_operand, spool_dir};
+    if !is_tess_output(&args.output) {
         return Ok(None);
     }
-    let a = TessFile::open(&args.a)?;
-    let b = TessFile::open(&args.b)?;
-    let colours_only =
-        |f: &TessFile| -> Result<bool> { Ok(!f.has_layers() || f.colour_streams()?.is_some()) };
-    let same_space = (a.depth(), a.origin(), a.frame()) == (b.depth(), b.origin(), b.frame());
-    let streamable =
-        a.is_streamed() && b.is_streamed() && same_space && colours_only(&a)? && colours_only(&b)?;
-    if !streamable {
+    let budget = super::budget::Budget {
+        max_leaves: None,
+        memory: args.memory,
+    };
+    let Some(a) = open_operand(&args.a, &budget)? else {
+        return Ok(None);
+    };
+    let Some(b) = open_operand(&args.b, &budget)? else {
+        return Ok(None);
+    };
+    let same_space = (a.space(), a.frame) == (b.space(), b.frame);
+    if !(same_space && a.colours_only()? && b.colours_only()?) {
         return Ok(None);
     }
-    // The colour spools' temporary files go next to the output.
-    let spool_dir = match args.output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => std::path::PathBuf::from("."),
-    };
+    super::output::check_size(
+        &args.output,
+        a.bytes.saturating_add(b.bytes),
+        args.limits.limits.max_output,
+    )?;
     let mut summary = tesseral::partition::StreamSummary::default();
+    let spool = spool_dir(&args.output);
     tesseral::io::write_atomic(&args.output, |w| {
-        summary = tesseral::partition::stream_set_op_in(&a, &b, op, a.frame(), w, &spool_dir)
-            .map_err(std::io::Error::other)?;
+        summary =
+            tesseral::partition::stream_set_op_files(&a.files, &b.files, op, a.frame, w, &spool)
+                .map_err(std::io::Error::other)?;
         Ok(())
     })
     .with_context(|| format!("writing {}", args.output.display()))?;
+    let (depth, origin) = a.space();
     if args.json {
         let out = serde_json::json!({
             "output": args.output,
             "voxels": summary.voxels,
             "leaves": summary.leaves,
-            "depth": a.depth(),
-            "origin": a.origin(),
+            "depth": depth,
+            "origin": origin,
             "op": match args.op {
                 OpArg::Union => "union",
                 OpArg::Intersection => "intersection",
@@ -128,6 +139,14 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
             "streamed": true,
         });
         crate::outln!("{out}")?;
+    } else {
+        crate::outln!(
+            "wrote {}: {} voxels, {} leaves, depth {depth}, origin {}",
+            args.output.display(),
+            summary.voxels,
+            summary.leaves,
+            octree::fmt_voxel(origin)
+        )?;
     }
     Ok(Some(Ok(())))
 }

@@ -48,22 +48,22 @@ pub struct TranslateArgs {
     /// of growing the space. Only with `--method linear`.
     #[arg(long)]
     clip: bool,
-    /// Translate a version-2 `.tess` file into a `.tess` file by an external merge
-    /// (bounded memory, temporary files beside the output) even when the translation
-    /// would fit in --memory. Without it, that path is taken only when the in-memory
-    /// translation is estimated above --memory.
+    /// Require the streamed translation (a version-2 `.tess` file whose only layer
+    /// is colours, into a `.tess` file, with `--method linear` and without
+    /// `--clip`): an error when the input or output cannot stream. Without it, such
+    /// a translation streams anyway (flat memory, about the in-memory time), and
+    /// anything else is translated in memory.
     #[arg(long)]
     stream: bool,
-    /// The working memory the translation may use in memory, estimated before the
-    /// work (about 48 bytes a leaf of the input, colours included): bytes, or a number
-    /// with K, M, G or T (powers of 1024). A version-2 `.tess` input larger than that
-    /// streams into a `.tess` output; other inputs are translated in memory.
+    /// The working memory of a translation that does not stream, estimated before
+    /// the work for a version-2 `.tess` input (about 48 bytes a leaf, colours
+    /// included): bytes, or a number with K, M, G or T (powers of 1024).
     #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = super::output::parse_bytes)]
     memory: u64,
 }
 
 /// Memory per input leaf of an in-memory translation: the input (leaves and
-/// colour regions), the moved copy and its pieces before merging (measured: 2.80 GB
+/// colour regions), the moved copy and the resampler's index (measured: 2.80 GB
 /// for the 58 M-leaf depth-13 spheroid with its colours).
 const TRANSLATE_BYTES_PER_LEAF: u64 = 48;
 
@@ -71,6 +71,20 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::guard(&args.output, &[&args.input], &args.limits)?;
     if streamed(&args)? {
         return Ok(());
+    }
+    if tesseral::io::extension(&args.input) == "tess" && args.input.is_file() {
+        let f = tesseral::io::TessFile::open(&args.input)?;
+        if f.is_streamed() {
+            super::budget::Budget {
+                max_leaves: None,
+                memory: args.memory,
+            }
+            .check_memory(
+                &format!("translating {} in memory", args.input.display()),
+                f.leaf_count().saturating_mul(TRANSLATE_BYTES_PER_LEAF),
+                " (or translate into a .tess file, which streams)",
+            )?;
+        }
     }
     let model = octree::read(&args.input)?;
     let by = match (args.by, args.by_world) {
@@ -155,8 +169,8 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
 }
 
 /// A version-2 `.tess` file with no layers but colours, translated into a `.tess`
-/// file by an external merge (`partition::stream_translate`): never the whole tree
-/// in memory. `false` (nothing done) for other inputs, outputs and methods.
+/// file output cell by output cell (`partition::stream_translate`): never the
+/// whole tree in memory. `false` (nothing done) for other inputs, outputs and methods.
 fn streamed(args: &TranslateArgs) -> Result<bool> {
     use tesseral::io::TessFile;
     let tess =
@@ -180,12 +194,6 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
             args.input.display()
         ));
     }
-    // In memory it is several times faster (no pieces to spool and merge): stream
-    // only when asked or when the in-memory translation would pass --memory.
-    let in_memory = f.leaf_count().saturating_mul(TRANSLATE_BYTES_PER_LEAF);
-    if !args.stream && in_memory <= args.memory {
-        return Ok(false);
-    }
     let by = match (args.by, args.by_world) {
         (Some(by), _) => by,
         (None, Some(w)) => f
@@ -194,11 +202,18 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
             .map_err(|e| anyhow::anyhow!("--by-world: {e}"))?,
         (None, None) => anyhow::bail!("give --by or --by-world"),
     };
-    // The runs' and colour spools' temporary files go next to the output.
-    let spool_dir = match args.output.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
-        _ => PathBuf::from("."),
-    };
+    // The output holds the same shape, moved: about the input's size (an
+    // unaligned move changes the leaf count by a fraction of a per cent on a
+    // built scene; a few big blocks moved off the lattice can shatter, hence the
+    // margin). Checked before the work.
+    let len = std::fs::metadata(&args.input).map_or(0, |m| m.len());
+    super::output::check_size(
+        &args.output,
+        len.saturating_add(len / 4),
+        args.limits.limits.max_output,
+    )?;
+    // The colour spools' temporary files go next to the output.
+    let spool_dir = super::streamed::spool_dir(&args.output);
     let mut done = None;
     tesseral::io::write_atomic(&args.output, |w| {
         done = Some(

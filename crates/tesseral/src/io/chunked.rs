@@ -266,6 +266,18 @@ fn u64_at(b: &[u8], at: usize) -> u64 {
 
 /// Parses and checks the header, trailer and index of version-2 bytes.
 pub(crate) fn parse_layout(bytes: &[u8]) -> Result<Layout, String> {
+    parse_layout_with(bytes, &|_, _| {})
+}
+
+/// Bytes checksummed between two calls of a reader's `done`.
+pub(crate) const RELEASE_STRETCH: usize = 8 << 20;
+
+/// As [`parse_layout`], calling `done(start, end)` after each stretch of the
+/// checksummed sections is read, so that a mapped reader can let it go.
+pub(crate) fn parse_layout_with(
+    bytes: &[u8],
+    done: &dyn Fn(usize, usize),
+) -> Result<Layout, String> {
     let len = bytes.len();
     if len < HEADER_LEN + TRAILER_LEN {
         return Err(format!(
@@ -304,7 +316,13 @@ pub(crate) fn parse_layout(bytes: &[u8]) -> Result<Layout, String> {
     let (sections_offset, index_offset) = (sections_offset as usize, index_offset as usize);
     let mut crc = crc32fast::Hasher::new();
     crc.update(&bytes[..HEADER_LEN]);
-    crc.update(&bytes[sections_offset..len - 12]);
+    let mut at = sections_offset;
+    while at < len - 12 {
+        let end = (at + RELEASE_STRETCH).min(len - 12);
+        crc.update(&bytes[at..end]);
+        done(at, end);
+        at = end;
+    }
     let actual = crc.finalize();
     if stored != actual {
         return Err(format!(

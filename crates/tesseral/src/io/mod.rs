@@ -48,7 +48,7 @@ pub use reframe::reframe;
 pub use sniff::sniff_format;
 pub use spool::LeafSpool;
 pub use tess_colours::RegionLeaves;
-pub use tess_file::TessFile;
+pub use tess_file::{LeafIter, TessFile};
 
 use std::fs;
 use std::path::Path;

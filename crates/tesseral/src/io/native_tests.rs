@@ -74,7 +74,7 @@ fn round_trips_random_trees_with_frame_and_colours() {
     }
 }
 
-fn encode_v1(model: &Model) -> Vec<u8> {
+pub(crate) fn encode_v1(model: &Model) -> Vec<u8> {
     let mut out = Vec::new();
     write_v1(&mut out, model).unwrap();
     out

@@ -10,6 +10,7 @@ use crate::model::Rgba;
 
 /// The leaves of one colour region, decoded lazily and checked as
 /// the whole-file reader checks them (packing, size, bounds, order).
+#[derive(Clone)]
 pub struct RegionLeaves<'a> {
     r: Reader<'a>,
     left: u64,
@@ -34,7 +35,48 @@ impl Iterator for RegionLeaves<'_> {
     }
 }
 
-impl RegionLeaves<'_> {
+impl<'a> RegionLeaves<'a> {
+    /// Cuts the region into stretches of at most `n` leaves (at least one), each
+    /// with its code range, count and byte offset in the file, and a stream of its leaves
+    /// alone, so that a reader can decode the stretches that meet a code range
+    /// without reading the region from its start. Reads (and checks) the region
+    /// once; holds one small cursor per stretch.
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad leaf.
+    ///
+    /// `done(pos)` is called after each stretch with the byte offset read up to,
+    /// so that a mapped reader can let the bytes before it go.
+    pub fn stretches(
+        mut self,
+        n: usize,
+        done: &mut dyn FnMut(u64),
+    ) -> Result<Vec<(super::ChunkInfo, RegionLeaves<'a>)>, FormatError> {
+        let n = n.max(1) as u64;
+        let mut out = Vec::new();
+        while self.left > 0 && !self.failed {
+            let mut part = self.clone();
+            part.left = part.left.min(n);
+            let count = part.left;
+            let mut lo = None;
+            let mut hi = 0;
+            for _ in 0..count {
+                let l = self.next().expect("a leaf is left")?;
+                lo.get_or_insert(l.code());
+                hi = l.end();
+            }
+            let info = super::ChunkInfo {
+                offset: part.r.pos as u64,
+                lo: lo.unwrap_or(0),
+                hi,
+                count,
+            };
+            out.push((info, part));
+            done(self.r.pos as u64);
+        }
+        Ok(out)
+    }
+
     fn step(&mut self) -> Result<Leaf, String> {
         let delta = self.r.varint()?;
         if self.prev_end.is_some() && delta == 0 {
@@ -64,11 +106,15 @@ impl RegionLeaves<'_> {
 /// The colour regions of the sections `bytes[start..end]` of a version-2 file in a
 /// depth-`depth` space: `None` when the sections hold more than a frame and a
 /// colour layer (a legacy colour list, free space or log-odds).
-pub(crate) fn colour_regions(
-    bytes: &[u8],
+///
+/// `done(start, end)` is called after each stretch of bytes is scanned, so that a
+/// mapped reader can let it go.
+pub(crate) fn colour_regions<'a>(
+    bytes: &'a [u8],
     (start, end): (usize, usize),
     depth: u8,
-) -> Result<Option<Vec<(Rgba, RegionLeaves<'_>)>>, String> {
+    done: &dyn Fn(usize, usize),
+) -> Result<Option<Vec<(Rgba, RegionLeaves<'a>)>>, String> {
     let mut r = Reader {
         bytes: &bytes[..end],
         pos: start,
@@ -94,9 +140,15 @@ pub(crate) fn colour_regions(
         let leaves = r.u64()?;
         let at = r.pos;
         // Skip the region's varints to find the next region.
+        let mut last = at;
         for _ in 0..leaves {
             while r.u8()? & 0x80 != 0 {}
+            if r.pos - last >= super::chunked::RELEASE_STRETCH {
+                done(last, r.pos);
+                last = r.pos;
+            }
         }
+        done(last, r.pos);
         if out.iter().any(|(c, _): &(Rgba, _)| *c == rgba) {
             return Err(format!("colour region {i}: repeats a colour"));
         }

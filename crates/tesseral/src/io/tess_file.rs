@@ -3,12 +3,15 @@
 
 use std::path::{Path, PathBuf};
 
-use super::chunked::{chunk_leaves, parse_layout, ChunkInfo, Layout, DEFAULT_CHUNK_LEAVES};
+use super::chunked::{chunk_leaves, ChunkInfo, Layout, DEFAULT_CHUNK_LEAVES};
 use super::sections::Extras;
 use super::FormatError;
 use crate::linear::{Leaf, LinearOctree};
 use crate::model::{Frame, Model};
 use crate::Voxel;
+
+/// Leaves of a file read one at a time, each checked.
+pub type LeafIter<'a> = Box<dyn Iterator<Item = Result<Leaf, FormatError>> + 'a>;
 
 enum Body {
     /// Version 2: the bytes and their parsed layout.
@@ -105,7 +108,10 @@ impl TessFile {
                 layers,
             });
         }
-        let layout = parse_layout(&bytes).map_err(|m| err(FormatError::corrupt(m)))?;
+        // The checksum reads the sections (the colours: about half a big file):
+        // let their mapped pages go as it goes, so opening keeps memory flat.
+        let layout = super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b))
+            .map_err(|m| err(FormatError::corrupt(m)))?;
         let space =
             LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
         // The sections are under the index's checksum, checked above; the layers
@@ -246,11 +252,71 @@ impl TessFile {
         &self,
     ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
         match &self.body {
-            Body::Chunked(bytes, layout) => {
-                super::tess_colours::colour_regions(bytes, layout.sections, layout.depth)
-                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))
-            }
+            Body::Chunked(bytes, layout) => super::tess_colours::colour_regions(
+                bytes,
+                layout.sections,
+                layout.depth,
+                &|a, b| {
+                    release_map(bytes, a, b);
+                },
+            )
+            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
             Body::Decoded(_) => Ok(None),
+        }
+    }
+
+    /// The colour regions as streams of leaves, for a file whose only layer is
+    /// colours, whatever its version: a version-2 file's regions are decoded as
+    /// they are read ([`TessFile::colour_streams`]); a version-1 file was decoded
+    /// whole at [`TessFile::open`] and its regions are walked in memory. `None`
+    /// when the file has free space or log-odds.
+    ///
+    /// # Errors
+    /// [`FormatError::Corrupt`] for a bad colour section.
+    pub fn colour_leaves(
+        &self,
+    ) -> Result<Option<Vec<(crate::model::Rgba, LeafIter<'_>)>>, FormatError> {
+        match &self.body {
+            Body::Chunked(..) => Ok(self.colour_streams()?.map(|v| {
+                v.into_iter()
+                    .map(|(c, r)| (c, Box::new(r) as LeafIter<'_>))
+                    .collect()
+            })),
+            Body::Decoded(_) => {
+                if self.extras.free.is_some() || self.extras.log_odds.is_some() {
+                    return Ok(None);
+                }
+                let regions = self.extras.colors.as_ref().map_or(&[][..], |l| l.regions());
+                Ok(Some(
+                    regions
+                        .iter()
+                        .map(|(c, t)| {
+                            (
+                                *c,
+                                Box::new(t.leaves().iter().copied().map(Ok)) as LeafIter<'_>,
+                            )
+                        })
+                        .collect(),
+                ))
+            }
+        }
+    }
+
+    /// Tells the system that the file's bytes in `bytes` (offsets, as
+    /// [`ChunkInfo::offset`] gives them) will not be read again soon: a mapped
+    /// file's pages there leave the process's resident memory. They stay in the
+    /// system's page cache, so reading them again costs a page fault, not a disk
+    /// read. A reader that walks a big file this way keeps its resident memory
+    /// flat; nothing changes for files held in memory. Advice only: errors are
+    /// ignored.
+    pub fn release(&self, bytes: std::ops::Range<u64>) {
+        if let Body::Chunked(b, _) = &self.body {
+            let len = b.len() as u64;
+            release_map(
+                b,
+                bytes.start.min(len) as usize,
+                bytes.end.min(len) as usize,
+            );
         }
     }
 
@@ -278,5 +344,22 @@ impl TessFile {
         super::sections::check_parts(&model)
             .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
         Ok(model)
+    }
+}
+
+/// Lets the mapped pages of `bytes[start..end]` leave resident memory (see
+/// [`TessFile::release`]); nothing for bytes held in memory.
+fn release_map(bytes: &Bytes, start: usize, end: usize) {
+    if let Bytes::Map(m) = bytes {
+        if start < end && end <= m.len() {
+            // SAFETY: the map is read-only and nothing writes through it, so
+            // MADV_DONTNEED only drops this process's page-table entries: the next
+            // access reads the same bytes from the page cache (or the file, with
+            // the caveat of `open` about a file rewritten under us). No slice of the
+            // map is invalidated.
+            let _ = unsafe {
+                m.unchecked_advise_range(memmap2::UncheckedAdvice::DontNeed, start, end - start)
+            };
+        }
     }
 }

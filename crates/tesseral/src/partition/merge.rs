@@ -137,18 +137,10 @@ pub fn stream_set_op(
 }
 
 /// The set operation `op` of two `.tess` files of one space, streamed into a new
-/// `.tess` written to `w` with `frame` (see the module docs). Colours follow the
-/// in-memory rule (`Model::set_op`): a voxel of the result keeps the first
-/// operand's colour where it has one, else the second's; each colour region is
-/// spooled to a temporary file in `spool_dir` and read from the inputs as a stream.
-///
-/// # Runtime
-/// O((leaves of both + colour leaves) × streams), reading each chunk once.
+/// `.tess` written to `w` with `frame`: [`stream_set_op_files`] of one file each.
 ///
 /// # Errors
-/// [`PartitionError::Ranges`] when the spaces differ, or an input has layers other
-/// than colours (free space, log-odds) or is version 1; [`PartitionError::Format`]
-/// for a bad chunk or a write error.
+/// As [`stream_set_op_files`].
 pub fn stream_set_op_in(
     a: &TessFile,
     b: &TessFile,
@@ -157,16 +149,105 @@ pub fn stream_set_op_in(
     w: &mut dyn Write,
     spool_dir: &Path,
 ) -> Result<StreamSummary, PartitionError> {
-    if (a.depth(), a.origin()) != (b.depth(), b.origin()) {
+    stream_set_op_files(
+        std::slice::from_ref(a),
+        std::slice::from_ref(b),
+        op,
+        frame,
+        w,
+        spool_dir,
+    )
+}
+
+/// An operand's colour regions: each colour's regions of all its files, chained
+/// in file order.
+fn operand_colours<'a>(
+    files: &'a [TessFile],
+) -> Result<Vec<(Rgba, crate::io::LeafIter<'a>)>, PartitionError> {
+    let mut out: Vec<(Rgba, crate::io::LeafIter<'a>)> = Vec::new();
+    for f in files {
+        let regions = if f.has_layers() {
+            f.colour_leaves()?.ok_or_else(|| {
+                PartitionError::Ranges(
+                    "an operand has free space or log-odds: no streamed operation".into(),
+                )
+            })?
+        } else {
+            Vec::new()
+        };
+        for (c, r) in regions {
+            match out.iter().position(|(x, _)| *x == c) {
+                Some(i) => {
+                    let (_, prev) = out.swap_remove(i);
+                    out.insert(i, (c, Box::new(prev.chain(r))));
+                }
+                None => out.push((c, r)),
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// The leaves of files that follow each other in code order, as one stream; an
+/// error when they overlap or are out of order.
+fn chained(files: &[TessFile]) -> crate::io::LeafIter<'_> {
+    let mut end = 0u64;
+    Box::new(files.iter().flat_map(TessFile::leaves).map(move |l| {
+        let l = l?;
+        if l.code() < end {
+            return Err(FormatError::corrupt(
+                "the parts overlap or are out of code order",
+            ));
+        }
+        end = l.end();
+        Ok(l)
+    }))
+}
+
+/// The set operation `op` of two operands of one space, each a list of `.tess`
+/// files whose leaves follow each other in code order (one file, or the parts of
+/// a dataset, read as one sorted stream), streamed into a new `.tess` written to
+/// `w` with `frame` (see the module docs). Colours follow the in-memory rule
+/// (`Model::set_op`): a voxel of the result keeps the first operand's colour where
+/// it has one, else the second's; each colour region is spooled to a temporary
+/// file in `spool_dir` and read from the inputs as a stream. A version-1 file
+/// (one payload) was decoded whole when it was opened; its leaves and colours are
+/// streamed from memory.
+///
+/// # Runtime
+/// O((leaves of both + colour leaves) × streams), reading each chunk once.
+///
+/// # Errors
+/// [`PartitionError::Ranges`] when the spaces differ, an operand has no files, or
+/// an input has layers other than colours (free space, log-odds);
+/// [`PartitionError::Format`] for a bad chunk, parts out of order or a write error.
+pub fn stream_set_op_files(
+    a: &[TessFile],
+    b: &[TessFile],
+    op: SetOp,
+    frame: Frame,
+    w: &mut dyn Write,
+    spool_dir: &Path,
+) -> Result<StreamSummary, PartitionError> {
+    let space = |fs: &[TessFile]| -> Result<(u8, crate::Voxel), PartitionError> {
+        let f = fs
+            .first()
+            .ok_or_else(|| PartitionError::Ranges("an operand has no files".into()))?;
+        let s = (f.depth(), f.origin());
+        if fs.iter().any(|g| (g.depth(), g.origin()) != s) {
+            return Err(PartitionError::Ranges(
+                "an operand's files are in different spaces".into(),
+            ));
+        }
+        Ok(s)
+    };
+    let ((da, oa), (db, ob)) = (space(a)?, space(b)?);
+    if (da, oa) != (db, ob) {
         return Err(PartitionError::Ranges(format!(
-            "the operands are in different spaces (depth {} origin {:?}, depth {} origin {:?})",
-            a.depth(),
-            a.origin(),
-            b.depth(),
-            b.origin()
+            "the operands are in different spaces (depth {da} origin {oa:?}, depth {db} origin {ob:?})"
         )));
     }
-    let (ca, cb) = (only_colours(a)?, only_colours(b)?);
+    let (ca, cb) = (operand_colours(a)?, operand_colours(b)?);
     let io = |e: std::io::Error| PartitionError::Format(FormatError::io(e));
     // One spool per distinct colour; stream i+2 is a's region i, then b's.
     let mut colours: Vec<Rgba> = Vec::new();
@@ -183,9 +264,9 @@ pub fn stream_set_op_in(
         spools.push((*c, LeafSpool::new_in(spool_dir).map_err(io)?));
     }
     let na = ca.len();
-    let mut streams = vec![intervals(a.leaves()), intervals(b.leaves())];
+    let mut streams = vec![intervals(chained(a)), intervals(chained(b))];
     streams.extend(ca.into_iter().chain(cb).map(|(_, r)| intervals(r)));
-    let mut tw = TessWriter::new(w, a.depth(), a.origin()).map_err(io)?;
+    let mut tw = TessWriter::new(w, da, oa).map_err(io)?;
     let mut voxels = 0u64;
     let keep = |in_a: bool, in_b: bool| match op {
         SetOp::Union => in_a || in_b,

@@ -20,6 +20,7 @@ use rayon::prelude::*;
 use crate::linear::{push_merging, Leaf, LinearOctree, OctreeError, SetOp};
 use crate::Voxel;
 
+mod blocks;
 pub mod dataset;
 mod merge;
 mod models;
@@ -31,7 +32,7 @@ pub use dataset::{
     is_dataset, open_part, read_dataset, read_dataset_model, read_manifest, read_part,
     write_dataset, write_manifest, write_model_part, write_part, Manifest, ManifestPart, MANIFEST,
 };
-pub use merge::{stream_concat, stream_set_op, stream_set_op_in};
+pub use merge::{stream_concat, stream_set_op, stream_set_op_files, stream_set_op_in};
 pub use models::{
     build_scene_range, embedded_ranges, join_models, move_and_split, set_op_models, split_model,
 };
@@ -42,7 +43,7 @@ pub use shuffle::{
 pub use stream::{
     build_scene_dataset, scene_ranges, write_plan_tess, write_plan_tess_coloured, StreamSummary,
 };
-pub use translate::{stream_translate, stream_translate_in, StreamTranslation, RUN_LEAVES};
+pub use translate::{stream_translate, stream_translate_in, StreamTranslation, CELL_LEAVES};
 
 /// Errors of partitioned octrees and datasets.
 #[derive(Debug, thiserror::Error)]
@@ -322,5 +323,7 @@ mod tests_models;
 #[cfg(test)]
 mod tests_shuffle;
 
+#[cfg(test)]
+mod tests_parts;
 #[cfg(test)]
 mod tests_translate;

@@ -26,8 +26,8 @@ fn offsets(rng: &mut rand_pcg::Pcg64, depth: u8) -> Vec<[i64; 3]> {
 }
 
 /// The streamed translation equals `Model::translate` (space, tree and colour
-/// layer) and moves exactly the voxels of a hash-set model, with runs of a few
-/// leaves so that many runs are merged.
+/// layer) and moves exactly the voxels of a hash-set model, with windows of a
+/// few leaves so that the output is cut into many cells, down to single voxels.
 #[test]
 fn streamed_translation_equals_the_in_memory_one() {
     let dir = tempfile::tempdir().unwrap();
@@ -54,7 +54,7 @@ fn streamed_translation_equals_the_in_memory_one() {
         std::fs::write(&path, native::tests::encode_chunked(&model, 1 + i % 5)).unwrap();
         let f = TessFile::open(&path).unwrap();
         for by in offsets(&mut rng, depth) {
-            for run in [1, 3, 64, RUN_LEAVES] {
+            for run in [1, 3, 64, CELL_LEAVES] {
                 let mut out = Vec::new();
                 let s = stream_translate_in(&f, by, &mut out, dir.path(), run).unwrap();
                 let got = native::decode(&out).unwrap();

@@ -1,35 +1,40 @@
-//! A `.tess` file translated into a `.tess` file with bounded memory: an external
-//! merge sort by code ranges. The leaves are read in batches; each batch is moved
-//! into the result's space (a leaf may split into several aligned blocks when the
-//! displacement is not a multiple of its size), and its pieces, sorted, are written
-//! as one run to a temporary file. The runs are then merged (a heap over one cursor
-//! per run) and the result is written through a [`TessWriter`], which joins the
-//! pieces back into maximal blocks. Each colour region is translated the same way,
-//! as its own set of runs, into a [`LeafSpool`].
+//! A `.tess` file translated into a `.tess` file with memory flat in its size,
+//! driven by the output: the result's space is cut into aligned cells, visited in
+//! tesseral order. An output cell of side `2^k` is the image of an unaligned cube
+//! of the input, which meets at most 2 × 2 × 2 input cells of side `2^k` (its
+//! *window*), each a code range of the input: their leaves that meet the cube are
+//! read through the chunk index ([`Blocks`]), moved into the output cell by
+//! [`LinearOctree::translate_into`], and the cell's final leaves are written at
+//! once through a [`TessWriter`], which joins blocks across cells. No pieces, no
+//! runs, no merge.
 //!
-//! Memory: one batch and its pieces while the runs are made; a cursor buffer per
-//! run, the writer's chunk and a spool buffer per colour while they are merged.
-//! The temporary files are unnamed: the system removes them however the process
-//! ends.
+//! The cells are chosen top-down from the chunk index alone: a cell is split while
+//! the chunks meeting its window hold more than `cell_leaves` leaves (and are more
+//! than eight: splitting cannot do better than one per input cell), and skipped
+//! when its cube misses the input's bounding box or its window holds none. Each
+//! colour region is translated the same way (cut into stretches of leaves that
+//! play the chunks' part) into a [`LeafSpool`].
+//!
+//! Memory: one cell's leaves (at most about `cell_leaves`), its moved copy and the
+//! resampler's index of it, a few decoded chunks, the writer's chunk, one spool
+//! buffer, and the cell list (16 bytes a cell). Time: each chunk is decoded once
+//! per output cell whose cube meets it (about once, more along the cells'
+//! boundaries), and the leaves are moved once.
 
-use std::cmp::Reverse;
-use std::collections::BinaryHeap;
-use std::fs::File;
-use std::io::{self, Read, Seek, SeekFrom, Write};
+use std::io::{self, Write};
 use std::path::Path;
 
+use super::blocks::Blocks;
 use super::shuffle::{translated_space, union_bbox};
 use super::{PartitionError, StreamSummary};
+use crate::code;
 use crate::io::{FormatError, LeafSpool, TessFile, TessWriter, DEFAULT_CHUNK_LEAVES};
-use crate::linear::{Leaf, LinearOctree};
-use crate::model::Rgba;
+use crate::linear::{Leaf, LinearOctree, OctreeError};
 use crate::Voxel;
 
-/// Leaves per run unless [`stream_translate_in`] is told otherwise: one chunk.
-pub const RUN_LEAVES: usize = DEFAULT_CHUNK_LEAVES;
-/// Leaves a run's cursor reads at a time.
-const CURSOR_LEAVES: usize = 4096;
-const LEAF_BYTES: usize = 8;
+/// The most leaves a cell's window may hold (by the chunk index) before the cell
+/// is split, unless [`stream_translate_in`] is told otherwise.
+pub const CELL_LEAVES: usize = 1 << 22;
 
 /// What [`stream_translate_in`] wrote: the result's space and its counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -44,153 +49,240 @@ pub struct StreamTranslation {
     pub summary: StreamSummary,
 }
 
-/// Sorted runs of leaves in one unnamed temporary file, each a stretch of packed
-/// leaves (8 bytes, little-endian).
-struct Runs {
-    file: File,
-    /// (byte offset, leaf count) of each run.
-    runs: Vec<(u64, u64)>,
-    end: u64,
-    bytes: Vec<u8>,
+/// A box of the input space, half-open, in voxels from the input's origin.
+#[derive(Debug, Clone, Copy)]
+struct Box3 {
+    lo: [i64; 3],
+    hi: [i64; 3],
 }
 
-impl Runs {
-    fn new_in(dir: &Path) -> io::Result<Self> {
-        Ok(Self {
-            file: tempfile::tempfile_in(dir)?,
-            runs: Vec::new(),
-            end: 0,
-            bytes: Vec::new(),
-        })
+impl Box3 {
+    /// The cube of the cell `(code, k)` (its code's low `3k` bits zero).
+    fn cube(code: u64, k: u8) -> Self {
+        let v = code::decode(code).map(i64::from);
+        Self {
+            lo: v,
+            hi: v.map(|x| x + (1i64 << k)),
+        }
     }
 
-    /// Adds one run (sorted, disjoint leaves).
-    fn add(&mut self, leaves: &[Leaf]) -> io::Result<()> {
-        if leaves.is_empty() {
-            return Ok(());
-        }
-        // A batch's pieces can be many: write them a slice at a time.
-        for part in leaves.chunks(CURSOR_LEAVES) {
-            self.bytes.clear();
-            for l in part {
-                self.bytes.extend_from_slice(&l.packed().to_le_bytes());
-            }
-            self.file.write_all(&self.bytes)?;
-        }
-        self.runs.push((self.end, leaves.len() as u64));
-        self.end += (leaves.len() * LEAF_BYTES) as u64;
-        Ok(())
+    fn meets(&self, o: &Self) -> bool {
+        (0..3).all(|a| self.lo[a] < o.hi[a] && o.lo[a] < self.hi[a])
     }
 
-    /// Merges the runs, handing every leaf to `push` in code order; an error when
-    /// two runs overlap.
-    fn merge(&self, push: &mut dyn FnMut(Leaf) -> io::Result<()>) -> io::Result<()> {
-        let mut cursors: Vec<Cursor> = self
-            .runs
-            .iter()
-            .map(|&(pos, left)| Cursor {
-                pos,
-                left,
-                buf: Vec::new(),
-                at: 0,
-            })
-            .collect();
-        let mut heap = BinaryHeap::with_capacity(cursors.len());
-        let mut raw = vec![0u8; CURSOR_LEAVES * LEAF_BYTES];
-        for (i, c) in cursors.iter_mut().enumerate() {
-            if let Some(l) = c.next(&self.file, &mut raw)? {
-                heap.push(Reverse((l.code(), l.packed(), i)));
-            }
-        }
-        let mut end = 0u64;
-        while let Some(Reverse((code, packed, i))) = heap.pop() {
-            if code < end {
-                return Err(io::Error::new(
-                    io::ErrorKind::InvalidData,
-                    "translated runs overlap",
-                ));
-            }
-            let leaf = Leaf::from_packed(packed);
-            end = leaf.end();
-            push(leaf)?;
-            if let Some(l) = cursors[i].next(&self.file, &mut raw)? {
-                heap.push(Reverse((l.code(), l.packed(), i)));
-            }
-        }
-        Ok(())
+    fn holds(&self, o: &Self) -> bool {
+        (0..3).all(|a| self.lo[a] <= o.lo[a] && o.hi[a] <= self.hi[a])
     }
 }
 
-/// A position in one run, with the leaves read ahead.
-struct Cursor {
-    pos: u64,
-    left: u64,
-    buf: Vec<Leaf>,
-    at: usize,
+/// Whether the code range `[lo, hi)` meets the box `b` (the range cut into
+/// maximal aligned blocks, each tested).
+fn range_meets(mut lo: u64, hi: u64, b: &Box3) -> bool {
+    while lo < hi {
+        let mut k = 0u8;
+        while k < 21 {
+            let size = 1u64 << (3 * u32::from(k + 1));
+            if lo % size != 0 || lo + size > hi {
+                break;
+            }
+            k += 1;
+        }
+        if Box3::cube(lo, k).meets(b) {
+            return true;
+        }
+        lo += 1u64 << (3 * u32::from(k));
+    }
+    false
 }
 
-impl Cursor {
-    fn next(&mut self, mut file: &File, raw: &mut [u8]) -> io::Result<Option<Leaf>> {
-        if self.at == self.buf.len() {
-            if self.left == 0 {
-                return Ok(None);
-            }
-            let n = (self.left as usize).min(CURSOR_LEAVES);
-            let bytes = &mut raw[..n * LEAF_BYTES];
-            file.seek(SeekFrom::Start(self.pos))?;
-            file.read_exact(bytes)?;
-            self.buf.clear();
-            self.buf.extend(bytes.chunks_exact(LEAF_BYTES).map(|b| {
-                let mut a = [0u8; LEAF_BYTES];
-                a.copy_from_slice(b);
-                Leaf::from_packed(u64::from_le_bytes(a))
-            }));
-            self.at = 0;
-            self.pos += (n * LEAF_BYTES) as u64;
-            self.left -= n as u64;
-        }
-        self.at += 1;
-        Ok(Some(self.buf[self.at - 1]))
+/// Appends `l` unless it is the last leaf already (a leaf bigger than a window
+/// cell is met in each window cell it covers).
+fn push_once(out: &mut Vec<Leaf>, l: Leaf) {
+    if out.last() != Some(&l) {
+        out.push(l);
     }
 }
 
-/// The translation of the leaves of one space into another.
-struct Move {
+/// Appends the leaves of `leaves` (sorted, all inside the cell `(code, k)` or one
+/// covering it) that meet the box `b`, whole.
+fn select(leaves: &[Leaf], code: u64, k: u8, b: &Box3, out: &mut Vec<Leaf>) {
+    let Some(&first) = leaves.first() else {
+        return;
+    };
+    let cell = Box3::cube(code, k);
+    if !cell.meets(b) {
+        return;
+    }
+    if b.holds(&cell) {
+        push_once(out, first);
+        out.extend_from_slice(&leaves[1..]);
+        return;
+    }
+    if first.size_log2() >= k {
+        push_once(out, first);
+        return;
+    }
+    let child = 1u64 << (3 * u32::from(k - 1));
+    let mut rest = leaves;
+    for d in 0..8 {
+        let lo = code + d * child;
+        let n = rest.partition_point(|l| l.code() < lo + child);
+        select(&rest[..n], lo, k - 1, b, out);
+        rest = &rest[n..];
+    }
+}
+
+/// The translation of one space's leaves into the result's space, cell by cell.
+struct Mover {
     depth: u8,
     origin: Voxel,
     by: [i64; 3],
     to: (u8, Voxel),
+    /// The output voxel `p` (from the output's origin) is the image of the input
+    /// voxel `p + shift` (from the input's origin).
+    shift: [i64; 3],
+    /// The input leaves' bounding box.
+    bbox: Box3,
+    cap: u64,
 }
 
-impl Move {
-    /// The pieces of `batch` (sorted leaves) moved into the result's space, sorted.
-    fn pieces(&self, batch: Vec<Leaf>) -> Result<Vec<Leaf>, PartitionError> {
-        let t = LinearOctree::from_sorted_leaves(self.depth, self.origin, batch)?;
-        let (moved, dropped) = t.translate_into(self.by, self.to.0, self.to.1)?;
-        if dropped != 0 {
-            return Err(PartitionError::Ranges(format!(
-                "{dropped} voxel(s) left the translated space"
-            )));
+impl Mover {
+    fn new(
+        (depth, origin): (u8, Voxel),
+        by: [i64; 3],
+        to: (u8, Voxel),
+        (lo, hi): (Voxel, Voxel),
+        cap: u64,
+    ) -> Result<Self, PartitionError> {
+        let mut shift = [0i64; 3];
+        let mut bbox = Box3 {
+            lo: [0; 3],
+            hi: [0; 3],
+        };
+        for a in 0..3 {
+            let s = i128::from(to.1[a]) - i128::from(by[a]) - i128::from(origin[a]);
+            shift[a] = i64::try_from(s).map_err(|_| OctreeError::Overflow)?;
+            bbox.lo[a] = lo[a] - origin[a];
+            bbox.hi[a] = hi[a] - origin[a] + 1;
         }
-        Ok(moved.leaves().to_vec())
+        Ok(Self {
+            depth,
+            origin,
+            by,
+            to,
+            shift,
+            bbox,
+            cap,
+        })
     }
 
-    /// Reads `leaves` in batches of `n`, moves each and adds its pieces as a run.
-    fn runs(
-        &self,
-        leaves: impl Iterator<Item = Result<Leaf, FormatError>>,
-        n: usize,
-        runs: &mut Runs,
-    ) -> Result<(), PartitionError> {
-        let mut batch = Vec::with_capacity(n);
-        let mut leaves = leaves.peekable();
-        while leaves.peek().is_some() {
-            batch.clear();
-            for l in leaves.by_ref().take(n) {
-                batch.push(l?);
+    /// The input cube under the output cell `(code, k)`, and (for `k` at most the
+    /// input's depth) the first codes of its window's input cells, sorted.
+    fn window(&self, code: u64, k: u8) -> (Box3, Vec<u64>) {
+        let p = code::decode(code);
+        let side = 1i64 << k;
+        let lo: [i64; 3] = std::array::from_fn(|a| i64::from(p[a]) + self.shift[a]);
+        let b = Box3 {
+            lo,
+            hi: lo.map(|v| v + side),
+        };
+        let mut cells = Vec::with_capacity(8);
+        if k > self.depth {
+            return (b, cells);
+        }
+        let n = 1i64 << (self.depth - k);
+        'e: for e in 0..8 {
+            let mut w = [0u32; 3];
+            for a in 0..3 {
+                let bit = (e >> a) & 1;
+                if bit == 1 && lo[a].rem_euclid(side) == 0 {
+                    continue 'e;
+                }
+                let q = lo[a].div_euclid(side) + bit;
+                if q < 0 || q >= n {
+                    continue 'e;
+                }
+                w[a] = q as u32;
             }
-            let pieces = self.pieces(std::mem::take(&mut batch))?;
-            runs.add(&pieces).map_err(io_err)?;
+            cells.push(code::encode(w[0], w[1], w[2]) << (3 * u32::from(k)));
+        }
+        cells.sort_unstable();
+        (b, cells)
+    }
+
+    /// The output cells to translate, in tesseral order, under `(code, k)`.
+    fn plan(&self, blocks: &Blocks<'_>, code: u64, k: u8, cells: &mut Vec<(u64, u8)>) {
+        let (b, window) = self.window(code, k);
+        if !b.meets(&self.bbox) {
+            return;
+        }
+        if k <= self.depth {
+            let size = 1u64 << (3 * u32::from(k));
+            let (mut bound, mut met) = (0, 0);
+            for &c in &window {
+                let (n, m) = blocks.bound(c, c + size);
+                bound += n;
+                met += m;
+            }
+            if bound == 0 {
+                return;
+            }
+            // Splitting cannot bring a window below one block per input cell: stop
+            // at eight blocks whatever the cap.
+            if bound <= self.cap || met <= 8 || k == 0 {
+                cells.push((code, k));
+                return;
+            }
+        }
+        let child = 1u64 << (3 * u32::from(k - 1));
+        for d in 0..8 {
+            self.plan(blocks, code + d * child, k - 1, cells);
+        }
+    }
+
+    /// Translates the leaves of `blocks` into `push`, in tesseral order.
+    fn run(
+        &self,
+        blocks: &mut Blocks<'_>,
+        push: &mut dyn FnMut(Leaf) -> io::Result<()>,
+    ) -> Result<(), PartitionError> {
+        let mut cells = Vec::new();
+        self.plan(blocks, 0, self.to.0, &mut cells);
+        for (code, k) in cells {
+            self.cell(blocks, code, k, push)?;
+        }
+        Ok(())
+    }
+
+    /// Translates the output cell `(code, k)`.
+    fn cell(
+        &self,
+        blocks: &mut Blocks<'_>,
+        code: u64,
+        k: u8,
+        push: &mut dyn FnMut(Leaf) -> io::Result<()>,
+    ) -> Result<(), PartitionError> {
+        let (b, window) = self.window(code, k);
+        let size = 1u64 << (3 * u32::from(k));
+        let mut sel = Vec::new();
+        for &c in &window {
+            blocks.read(
+                c,
+                c + size,
+                &|lo, hi| range_meets(lo, hi, &b),
+                &mut |leaves| select(leaves, c, k, &b, &mut sel),
+            )?;
+        }
+        if sel.is_empty() {
+            return Ok(());
+        }
+        let tree = LinearOctree::from_parts(self.depth, self.origin, sel);
+        let p = code::decode(code);
+        let at: Voxel = std::array::from_fn(|a| self.to.1[a] + i64::from(p[a]));
+        let (moved, _outside) = tree.translate_into(self.by, k, at)?;
+        drop(tree);
+        for &l in moved.leaves() {
+            push(Leaf::new(code | l.code(), l.size_log2())).map_err(io_err)?;
         }
         Ok(())
     }
@@ -200,7 +292,7 @@ fn io_err(e: io::Error) -> PartitionError {
     PartitionError::Format(FormatError::io(e))
 }
 
-/// [`stream_translate_in`] with runs of [`RUN_LEAVES`] leaves.
+/// [`stream_translate_in`] with windows of at most [`CELL_LEAVES`] leaves.
 ///
 /// # Errors
 /// As [`stream_translate_in`].
@@ -210,19 +302,21 @@ pub fn stream_translate(
     w: &mut dyn Write,
     spool_dir: &Path,
 ) -> Result<StreamTranslation, PartitionError> {
-    stream_translate_in(f, by, w, spool_dir, RUN_LEAVES)
+    stream_translate_in(f, by, w, spool_dir, CELL_LEAVES)
 }
 
 /// The model of `f` moved by `by` voxels, streamed into a new `.tess` written to
 /// `w` with the same frame (see the module docs): the result equals
 /// [`crate::model::Model::translate`] of the file's model, in the same space (the
-/// input's space when the moved leaves fit, else grown by root expansion). The
-/// leaves are read in batches of `run_leaves` (at least one); the runs and the
-/// colour spools are temporary files in `spool_dir`.
+/// input's space when the moved leaves fit, else grown by root expansion), byte for
+/// byte as the in-memory path writes it. An output cell is split while its window
+/// holds more than `cell_leaves` leaves (at least one); the colour spools are
+/// temporary files in `spool_dir`.
 ///
 /// # Runtime
-/// Two reads of the leaves (the first finds their bounding box), and
-/// O(p log r) for p pieces in r runs.
+/// One pass over the chunks for the bounding box, then O(n) in the leaves (each
+/// chunk decoded about once per output cell whose cube meets it), plus one pass
+/// over each colour region to cut it into stretches.
 ///
 /// # Errors
 /// [`PartitionError::Octree`] when the grown space would be too deep or a
@@ -234,40 +328,39 @@ pub fn stream_translate_in(
     by: [i64; 3],
     w: &mut dyn Write,
     spool_dir: &Path,
-    run_leaves: usize,
+    cell_leaves: usize,
 ) -> Result<StreamTranslation, PartitionError> {
-    let n = run_leaves.max(1);
+    let cap = cell_leaves.max(1) as u64;
     let colours = super::merge::only_colours(f)?;
+    // Finding the colour regions read the colour section: let it go.
+    f.release(0..u64::MAX);
     let (depth, origin) = (f.depth(), f.origin());
+    let mut blocks = Blocks::of_file(f);
     let mut bbox = None;
-    for i in 0..f.chunks().len() {
-        let t = LinearOctree::from_sorted_leaves(depth, origin, f.chunk(i)?)?;
+    for i in 0..blocks.len() {
+        let t = LinearOctree::from_parts(depth, origin, f.chunk(i)?);
         bbox = union_bbox([bbox, t.bbox()]);
+        blocks.release(i);
     }
     let to = translated_space(depth, origin, bbox, by)?;
-    let mv = Move {
-        depth,
-        origin,
-        by,
-        to,
-    };
-    let mut runs = Runs::new_in(spool_dir).map_err(io_err)?;
-    mv.runs(f.leaves(), n, &mut runs)?;
     let mut tw = TessWriter::new(w, to.0, to.1).map_err(io_err)?;
     let mut voxels = 0u64;
-    runs.merge(&mut |l| {
-        voxels += l.voxel_count();
-        tw.push(l)
-    })
-    .map_err(io_err)?;
-    drop(runs);
-    let mut spools: Vec<(Rgba, LeafSpool)> = Vec::with_capacity(colours.len());
-    for (c, region) in colours {
-        let mut runs = Runs::new_in(spool_dir).map_err(io_err)?;
-        mv.runs(region, n, &mut runs)?;
-        let mut spool = LeafSpool::new_in(spool_dir).map_err(io_err)?;
-        runs.merge(&mut |l| spool.push(l)).map_err(io_err)?;
-        spools.push((c, spool));
+    let mut spools = Vec::with_capacity(colours.len());
+    if let Some(bb) = bbox {
+        let mover = Mover::new((depth, origin), by, to, bb, cap)?;
+        mover.run(&mut blocks, &mut |l| {
+            voxels += l.voxel_count();
+            tw.push(l)
+        })?;
+        drop(blocks);
+        // Stretches of a colour region play the chunks' part.
+        let stretch = (cell_leaves / 32).clamp(1, DEFAULT_CHUNK_LEAVES);
+        for (c, region) in colours {
+            let mut blocks = Blocks::of_region(f, region, stretch)?;
+            let mut spool = LeafSpool::new_in(spool_dir).map_err(io_err)?;
+            mover.run(&mut blocks, &mut |l| spool.push(l))?;
+            spools.push((c, spool));
+        }
     }
     let leaves = tw.leaf_count();
     let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;

@@ -1,0 +1,125 @@
+//! What the streamed paths of `op`, `translate` and `convert` share: opening an
+//! operand (a `.tess` file or a dataset directory) as a list of `.tess` files read
+//! in code order, the output-size estimate checked against `--max-output` before
+//! the work, and where the temporary spools go.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use tesseral::io::TessFile;
+use tesseral::model::Frame;
+
+use super::budget::Budget;
+
+/// Memory per byte of a version-1 `.tess` file decoded whole: a leaf takes at
+/// least one byte there and about 24 bytes in memory (the leaf, its colour
+/// region's copy, and the decoder's buffers).
+const V1_BYTES_PER_FILE_BYTE: u64 = 24;
+
+/// An operand opened for streaming: its files in code order (one file, or a
+/// dataset's parts), its frame, and their size in bytes on disk.
+pub struct Operand {
+    /// The files whose leaves follow each other in code order.
+    pub files: Vec<TessFile>,
+    /// The frame (a dataset's from its manifest).
+    pub frame: Frame,
+    /// The files' bytes on disk.
+    pub bytes: u64,
+}
+
+impl Operand {
+    /// Whether every file's only layer (if any) is colours, so that it streams.
+    pub fn colours_only(&self) -> Result<bool> {
+        for f in &self.files {
+            if f.has_layers() && f.colour_leaves()?.is_none() {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+
+    /// The space of the first file.
+    pub fn space(&self) -> (u8, [i64; 3]) {
+        self.files
+            .first()
+            .map_or((0, [0; 3]), |f| (f.depth(), f.origin()))
+    }
+}
+
+fn file_len(path: &Path) -> Result<u64> {
+    Ok(std::fs::metadata(path)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?
+        .len())
+}
+
+/// Whether `path` is a `.tess` file of version 1 (one payload, decoded whole).
+fn is_version_1(path: &Path) -> Result<bool> {
+    use std::io::Read;
+    let mut head = [0u8; 10];
+    let mut f =
+        std::fs::File::open(path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    if f.read_exact(&mut head).is_err() {
+        return Ok(false);
+    }
+    Ok(u16::from_le_bytes([head[8], head[9]]) == 1)
+}
+
+/// Opens `path` for streaming: a dataset directory (its parts, checked against
+/// the manifest) or a `.tess` file. A version-1 file is one payload, decoded whole
+/// when it is opened: its memory (at most 24 bytes a byte of the file) is checked
+/// against `--memory` first. `None` for anything else (read it in memory).
+pub fn open_operand(path: &Path, budget: &Budget) -> Result<Option<Operand>> {
+    use tesseral::partition::{is_dataset, open_part, read_manifest};
+    if super::output::is_stdio(path) {
+        return Ok(None);
+    }
+    if is_dataset(path) {
+        let m = read_manifest(path)?;
+        let mut files = Vec::with_capacity(m.parts.len());
+        let mut bytes = 0u64;
+        for (i, p) in m.parts.iter().enumerate() {
+            bytes += file_len(&path.join(&p.file))?;
+            files.push(open_part(path, &m, i)?);
+        }
+        let frame = Frame::new(m.frame.voxel_size, m.frame.translate);
+        return Ok(Some(Operand {
+            files,
+            frame,
+            bytes,
+        }));
+    }
+    if !(path.is_file() && tesseral::io::extension(path) == "tess") {
+        return Ok(None);
+    }
+    let bytes = file_len(path)?;
+    if is_version_1(path)? {
+        budget.check_memory(
+            &format!(
+                "{} (a version-1 .tess file, read whole; `convert` it to .tess to stream it)",
+                path.display()
+            ),
+            bytes.saturating_mul(V1_BYTES_PER_FILE_BYTE),
+            "",
+        )?;
+    }
+    let f = TessFile::open(path)?;
+    let frame = f.frame();
+    Ok(Some(Operand {
+        files: vec![f],
+        frame,
+        bytes,
+    }))
+}
+
+/// The folder for temporary files beside `out`.
+pub fn spool_dir(out: &Path) -> PathBuf {
+    match out.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p.to_owned(),
+        _ => PathBuf::from("."),
+    }
+}
+
+/// Whether `out` is a `.tess` file (not standard output).
+pub fn is_tess_output(out: &Path) -> bool {
+    !super::output::is_stdio(out) && tesseral::io::extension(out) == "tess"
+}
