@@ -175,6 +175,10 @@ pub(crate) fn exit_block(
     (a, n, out)
 }
 
+/// Blocks crossed by [`exit_block`] so far (tests check that the jump is taken).
+#[cfg(test)]
+pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
 /// Hit and miss bits of one block: bit `x + 8y` of word `z`. The miss bits fill one
 /// cache line, which is all that a ray crossing the block touches.
 #[derive(Debug, Clone, Copy)]
@@ -271,6 +275,8 @@ impl Scratch {
             m[z as usize] |= 1 << (x | y << 3);
             if m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX {
                 // Every cell of the block is missed: only the exit matters.
+                #[cfg(test)]
+                JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
                 let (axis, n, t) = exit_block([tx, ty, tz], [dx, dy, dz], w.step, [x, y, z]);
                 let steps = n[0] + n[1] + n[2];
                 if n[0] > lx || n[1] > ly || n[2] > lz || steps >= left {
@@ -325,6 +331,13 @@ impl Scratch {
             }
             s = self.slot(block);
         }
+    }
+
+    /// Marks every cell of block `b` missed.
+    #[cfg(test)]
+    pub fn fill(&mut self, b: BlockKey) {
+        let s = self.slot(b);
+        self.blocks[s].miss = [u64::MAX; 8];
     }
 
     /// Marks a cell hit.
