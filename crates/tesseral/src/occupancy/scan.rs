@@ -34,12 +34,12 @@ fn spread(x: u32) -> u32 {
     (x | x << 1) & 0x5555
 }
 
-/// The finite points' indices ordered by the direction of their ray (a cube map of
+/// The finite points, copied in the order of the direction of their ray (a cube map of
 /// 6 × 32 × 32 cells, each face in Morton order), and the number of points that are
 /// not finite. Rays in one direction cell cross the same blocks, so their masks stay
 /// in cache, and a thread's share of the rays is a few cones, not the whole scene.
 /// The order changes no result: each ray only sets bits.
-fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<usize>, u64) {
+fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<[f64; 3]>, u64) {
     const CELLS: usize = 6 * (FACE_SIDE * FACE_SIDE) as usize;
     const SKIP: u16 = CELLS as u16;
     let cell: Vec<u16> = points
@@ -77,11 +77,11 @@ fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<usize>, u64) {
     for i in 2..start.len() {
         start[i] += start[i - 1];
     }
-    let mut order = vec![0usize; points.len() - skipped];
+    let mut order = vec![[0.0; 3]; points.len() - skipped];
     for (i, &c) in cell.iter().enumerate() {
         if c != SKIP {
             let at = &mut start[c as usize + 1];
-            order[*at] = i;
+            order[*at] = points[i];
             *at += 1;
         }
     }
@@ -151,8 +151,8 @@ impl OccupancyMap {
             .fold(
                 || Scratch::new(block_of_origin),
                 |mut s, chunk| {
-                    for &i in chunk {
-                        cast(&mut s, &points[i]);
+                    for p in chunk {
+                        cast(&mut s, p);
                     }
                     s
                 },
