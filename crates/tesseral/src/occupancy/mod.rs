@@ -36,6 +36,8 @@ mod store;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_dense;
+#[cfg(test)]
 mod tests_ray;
 #[cfg(test)]
 mod tests_store;

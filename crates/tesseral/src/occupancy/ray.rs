@@ -119,12 +119,74 @@ pub(crate) fn walk(
     }
 }
 
-/// Hit and miss bits of one block: bit `x + 8y` of word `z`.
+/// Where a walk leaves its block: the axis it leaves along, the steps it takes along
+/// each axis up to and including the step out, and the ray parameters then, exactly
+/// as [`walk`]'s steps would leave them.
+///
+/// The walk is a merge of three sequences of border parameters, one per axis, each
+/// summed step by step as the walk sums them (`t`, `t + d`, `t + d + d`, ...), in the
+/// order (parameter, then z before y before x on ties). The step out of the block
+/// along axis `i` comes `w_i` borders on (8 − x or x + 1); the first of these in the
+/// merge order is the exit, and the steps along another axis are its borders that
+/// precede the exit. At most 8 sums per axis, whatever the path inside.
+#[inline]
+pub(crate) fn exit_block(
+    t: [f64; 3],
+    d: [f64; 3],
+    step: [i64; 3],
+    c: [i64; 3],
+) -> (usize, [i64; 3], [f64; 3]) {
+    let mut w = [0i64; 3];
+    let mut e = [f64::MAX; 3];
+    for i in 0..3 {
+        if step[i] != 0 {
+            w[i] = if step[i] > 0 { 8 - c[i] } else { c[i] + 1 };
+            let mut v = t[i];
+            for _ in 1..w[i] {
+                v += d[i];
+            }
+            e[i] = v;
+        }
+    }
+    let a = if e[0] < e[1] {
+        if e[0] < e[2] {
+            0
+        } else {
+            2
+        }
+    } else if e[1] < e[2] {
+        1
+    } else {
+        2
+    };
+    let mut n = [0i64; 3];
+    let mut out = t;
+    for j in 0..3 {
+        if j == a {
+            n[j] = w[j];
+            out[j] = e[j] + d[j];
+        } else if step[j] != 0 {
+            while n[j] + 1 < w[j] && (out[j] < e[a] || (out[j] == e[a] && j > a)) {
+                out[j] += d[j];
+                n[j] += 1;
+            }
+        }
+    }
+    (a, n, out)
+}
+
+/// Blocks crossed by [`exit_block`] so far (tests check that the jump is taken).
+#[cfg(test)]
+pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Hit and miss bits of one block: bit `x + 8y` of word `z`. The miss bits fill one
+/// cache line, which is all that a ray crossing the block touches.
 #[derive(Debug, Clone, Copy)]
+#[repr(C, align(64))]
 pub(crate) struct Masks {
-    pub key: BlockKey,
     pub miss: [u64; 8],
     pub hit: [u64; 8],
+    pub key: BlockKey,
 }
 
 /// Blocks per side of the dense index around the origin (a power of two).
@@ -183,7 +245,9 @@ impl Scratch {
 
     /// Marks missed the cells of a ray, as [`walk`] visits them: the walk is kept in
     /// registers, in the cell's block-local coordinates, with one probe per block
-    /// crossed.
+    /// crossed. A block whose 512 cells are all missed already is crossed in one
+    /// jump to its exit ([`exit_block`]): near the origin most blocks fill after a
+    /// few hundred rays.
     #[inline]
     pub fn miss_ray(
         &mut self,
@@ -205,43 +269,75 @@ impl Scratch {
         let [mut lx, mut ly, mut lz] = w.left_axis;
         let mut left = w.left;
         let mut s = self.slot(block);
-        self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
-        // One step along an axis: stop before passing the end cell's plane or on
-        // reaching the end cell; a new block when the local coordinate wraps.
-        macro_rules! step {
-            ($l:ident, $t:ident, $d:ident, $c:ident, $s:ident, $axis:expr) => {{
-                if $l == 0 {
-                    return;
-                }
-                $l -= 1;
-                left -= 1;
-                if left == 0 {
-                    return;
-                }
-                $t += $d;
-                $c += $s;
-                if $c & !mask != 0 {
-                    $c &= mask;
-                    block[$axis] += $s;
-                    s = self.slot(block);
-                }
-            }};
-        }
         loop {
-            // Ties: x before z, y before z, y before x only when strictly smaller.
-            if tx < ty {
-                if tx < tz {
-                    step!(lx, tx, dx, x, sx, 0);
+            // (x, y, z) is the walk's cell, in block `s`, not marked yet.
+            let m = &mut self.blocks[s].miss;
+            m[z as usize] |= 1 << (x | y << 3);
+            if m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX {
+                // Every cell of the block is missed: only the exit matters.
+                #[cfg(test)]
+                JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                let (axis, n, t) = exit_block([tx, ty, tz], [dx, dy, dz], w.step, [x, y, z]);
+                let steps = n[0] + n[1] + n[2];
+                if n[0] > lx || n[1] > ly || n[2] > lz || steps >= left {
+                    // The walk ends in the block or on its exit step.
+                    return;
+                }
+                (lx, ly, lz) = (lx - n[0], ly - n[1], lz - n[2]);
+                left -= steps;
+                [tx, ty, tz] = t;
+                x = (x + sx * n[0]) & mask;
+                y = (y + sy * n[1]) & mask;
+                z = (z + sz * n[2]) & mask;
+                block[axis] += w.step[axis];
+                s = self.slot(block);
+                continue;
+            }
+            // One step along an axis: stop before passing the end cell's plane or on
+            // reaching the end cell; leave the loop when the local coordinate wraps.
+            macro_rules! step {
+                ($l:ident, $t:ident, $d:ident, $c:ident, $s:ident, $axis:expr) => {{
+                    if $l == 0 {
+                        return;
+                    }
+                    $l -= 1;
+                    left -= 1;
+                    if left == 0 {
+                        return;
+                    }
+                    $t += $d;
+                    $c += $s;
+                    if $c & !mask != 0 {
+                        $c &= mask;
+                        block[$axis] += $s;
+                        break;
+                    }
+                }};
+            }
+            loop {
+                // Ties: as `walk` (z first, then y, then x).
+                if tx < ty {
+                    if tx < tz {
+                        step!(lx, tx, dx, x, sx, 0);
+                    } else {
+                        step!(lz, tz, dz, z, sz, 2);
+                    }
+                } else if ty < tz {
+                    step!(ly, ty, dy, y, sy, 1);
                 } else {
                     step!(lz, tz, dz, z, sz, 2);
                 }
-            } else if ty < tz {
-                step!(ly, ty, dy, y, sy, 1);
-            } else {
-                step!(lz, tz, dz, z, sz, 2);
+                m[z as usize] |= 1 << (x | y << 3);
             }
-            self.blocks[s].miss[z as usize] |= 1 << (x | y << 3);
+            s = self.slot(block);
         }
+    }
+
+    /// Marks every cell of block `b` missed.
+    #[cfg(test)]
+    pub fn fill(&mut self, b: BlockKey) {
+        let s = self.slot(b);
+        self.blocks[s].miss = [u64::MAX; 8];
     }
 
     /// Marks a cell hit.

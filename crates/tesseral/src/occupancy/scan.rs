@@ -12,6 +12,82 @@ use crate::code::encode_wide;
 /// Rays per rayon task.
 const CHUNK: usize = 2048;
 
+/// `floor(v)` as an integer, saturating as `v.floor() as i64` does (without a call
+/// to the C library's `floor`, which the baseline x86-64 target makes).
+#[inline]
+fn floor(v: f64) -> i64 {
+    let t = v as i64;
+    if (t as f64) > v {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
+/// Direction cells per face side of the cube round the origin (a power of two).
+const FACE_SIDE: u32 = 32;
+
+/// The bits of a 5-bit number spread to the even places.
+fn spread(x: u32) -> u32 {
+    let x = (x | x << 4) & 0x0F0F;
+    let x = (x | x << 2) & 0x3333;
+    (x | x << 1) & 0x5555
+}
+
+/// The finite points, copied in the order of the direction of their ray (a cube map of
+/// 6 × 32 × 32 cells, each face in Morton order), and the number of points that are
+/// not finite. Rays in one direction cell cross the same blocks, so their masks stay
+/// in cache, and a thread's share of the rays is a few cones, not the whole scene.
+/// The order changes no result: each ray only sets bits.
+fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<[f64; 3]>, u64) {
+    const CELLS: usize = 6 * (FACE_SIDE * FACE_SIDE) as usize;
+    const SKIP: u16 = CELLS as u16;
+    let cell: Vec<u16> = points
+        .par_iter()
+        .with_min_len(4096)
+        .map(|p| {
+            if !p.iter().all(|c| c.is_finite()) {
+                return SKIP;
+            }
+            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+            let m = d.map(f64::abs);
+            let a = if m[0] >= m[1] && m[0] >= m[2] {
+                0
+            } else if m[1] >= m[2] {
+                1
+            } else {
+                2
+            };
+            if m[a] == 0.0 {
+                return 0;
+            }
+            let inv = 1.0 / m[a];
+            let side = f64::from(FACE_SIDE);
+            let q = |c: f64| ((c * inv + 1.0) * 0.5 * side).clamp(0.0, side - 1.0) as u32;
+            let (u, v) = (q(d[(a + 1) % 3]), q(d[(a + 2) % 3]));
+            let face = 2 * a as u32 + u32::from(d[a] < 0.0);
+            (face * FACE_SIDE * FACE_SIDE + (spread(u) | spread(v) << 1)) as u16
+        })
+        .collect();
+    let mut start = vec![0usize; CELLS + 3];
+    for &c in &cell {
+        start[c as usize + 2] += 1;
+    }
+    let skipped = start[CELLS + 2];
+    for i in 2..start.len() {
+        start[i] += start[i - 1];
+    }
+    let mut order = vec![[0.0; 3]; points.len() - skipped];
+    for (i, &c) in cell.iter().enumerate() {
+        if c != SKIP {
+            let at = &mut start[c as usize + 1];
+            order[*at] = points[i];
+            *at += 1;
+        }
+    }
+    (order, skipped as u64)
+}
+
 /// The tesseral code of a block key (its low 42 bits per axis, offset so that
 /// negative keys sort below positive ones).
 fn block_code(b: [i64; 3]) -> u128 {
@@ -46,7 +122,7 @@ impl OccupancyMap {
         let max_range = max_range.filter(|r| *r >= 0.0);
         let res = self.resolution;
         let inv = 1.0 / res;
-        let key = move |p: [f64; 3]| p.map(|c| (c * inv).floor() as i64);
+        let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
         let key_origin = key(origin);
         let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
         let cast = |s: &mut Scratch, p: &[f64; 3]| {
@@ -63,31 +139,25 @@ impl OccupancyMap {
                 }
             }
         };
-        // Few chunks (one per thread alone, four per thread with more, for
-        // balance): each has its own scratch, merged at the end.
+        let (order, skipped) = by_direction(origin, points);
+        // Few chunks of the rays in direction order (one per thread alone, four per
+        // thread with more, for balance): each has its own scratch, merged at the end.
         let threads = rayon::current_num_threads();
         let pieces = if threads == 1 { 1 } else { 4 * threads };
-        let chunk = points.len().div_ceil(pieces).max(CHUNK);
-        let (scratch, skipped) = points
+        let chunk = order.len().div_ceil(pieces).max(CHUNK);
+        let scratch = order
             .par_chunks(chunk)
             .with_min_len(1)
             .fold(
-                || (Scratch::new(block_of_origin), 0u64),
-                |(mut s, mut skipped), chunk| {
+                || Scratch::new(block_of_origin),
+                |mut s, chunk| {
                     for p in chunk {
-                        if p.iter().all(|c| c.is_finite()) {
-                            cast(&mut s, p);
-                        } else {
-                            skipped += 1;
-                        }
+                        cast(&mut s, p);
                     }
-                    (s, skipped)
+                    s
                 },
             )
-            .reduce(
-                || (Scratch::new(block_of_origin), 0),
-                |(a, n), (b, m)| (a.merge(b), n + m),
-            );
+            .reduce(|| Scratch::new(block_of_origin), Scratch::merge);
         stats.skipped = skipped;
         stats.rays = stats.points - skipped;
         // The blocks in tesseral order: their codes sorted beside their places.

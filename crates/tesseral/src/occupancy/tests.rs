@@ -99,14 +99,19 @@ fn dda(o: [f64; 3], e: [f64; 3], res: f64) -> Vec<Cell> {
 
 /// The naive map: cell → fixed-point log-odds, updated with OctoMap's rules written
 /// out with plain integers.
-struct Naive {
-    cells: HashMap<Cell, i32>,
-    f: Fixed,
-    res: f64,
+pub(super) struct Naive {
+    pub(super) cells: HashMap<Cell, i32>,
+    pub(super) f: Fixed,
+    pub(super) res: f64,
 }
 
 impl Naive {
-    fn scan(&mut self, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<f64>) -> ScanStats {
+    pub(super) fn scan(
+        &mut self,
+        origin: [f64; 3],
+        points: &[[f64; 3]],
+        max_range: Option<f64>,
+    ) -> ScanStats {
         let mut hits = HashSet::new();
         let mut misses = HashSet::new();
         let mut skipped = 0;
@@ -149,7 +154,7 @@ impl Naive {
     }
 }
 
-fn check_same(map: &OccupancyMap, naive: &Naive) {
+pub(super) fn check_same(map: &OccupancyMap, naive: &Naive) {
     let got: HashMap<Cell, i32> = {
         let mut m = HashMap::new();
         map.store.for_each(|c, v| {

@@ -1,11 +1,12 @@
 //! The fast ray walk of a scan's scratch against the reference walk.
 
 use std::collections::HashSet;
+use std::sync::atomic::Ordering;
 
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::ray::{walk, Scratch};
+use super::ray::{exit_block, walk, Scratch, JUMPS};
 
 fn key(p: [f64; 3], res: f64) -> [i64; 3] {
     let inv = 1.0 / res;
@@ -79,4 +80,151 @@ fn fast_walk_marks_the_cells_of_the_reference_walk() {
         s.miss_ray(o, e, ko, ke, res);
         assert_eq!(missed(&s), want, "case {case}: {o:?} -> {e:?} at {res}");
     }
+}
+
+/// The walk's own steps from a cell of a block to the step out of it: the axis, the
+/// steps along each axis, the ray parameters after.
+fn steps_out(
+    mut t: [f64; 3],
+    d: [f64; 3],
+    step: [i64; 3],
+    mut c: [i64; 3],
+) -> (usize, [i64; 3], [f64; 3]) {
+    let mut n = [0i64; 3];
+    loop {
+        // The reference walk's choice, ties included.
+        let dim = if t[0] < t[1] {
+            if t[0] < t[2] {
+                0
+            } else {
+                2
+            }
+        } else if t[1] < t[2] {
+            1
+        } else {
+            2
+        };
+        n[dim] += 1;
+        t[dim] += d[dim];
+        c[dim] += step[dim];
+        if !(0..8).contains(&c[dim]) {
+            return (dim, n, t);
+        }
+    }
+}
+
+#[test]
+fn exit_block_takes_the_steps_of_the_walk() {
+    let mut rng = Pcg64::seed_from_u64(12);
+    let mut ties = 0;
+    for case in 0..200_000 {
+        let step = [0, 1, 2].map(|_| [-1i64, 1, 0][rng.random_range(0..3)]);
+        if step == [0; 3] {
+            continue;
+        }
+        // Deltas and starts on a coarse dyadic grid in a third of the cases, so that
+        // borders of different axes often fall on one parameter.
+        let coarse = case % 3 == 0;
+        let d = [0, 1, 2].map(|i| {
+            if step[i] == 0 {
+                f64::MAX
+            } else if coarse {
+                f64::from(rng.random_range(1..8u32)) / 4.0
+            } else {
+                rng.random_range(0.05..3.0)
+            }
+        });
+        let t = [0, 1, 2].map(|i| {
+            if step[i] == 0 {
+                f64::MAX
+            } else if coarse {
+                f64::from(rng.random_range(0..16u32)) / 8.0
+            } else {
+                rng.random_range(0.0..d[i])
+            }
+        });
+        let c = [0, 1, 2].map(|_| rng.random_range(0..8i64));
+        let want = steps_out(t, d, step, c);
+        let got = exit_block(t, d, step, c);
+        assert_eq!(got.0, want.0, "case {case}: axis");
+        assert_eq!(got.1, want.1, "case {case}: steps");
+        assert_eq!(
+            got.2.map(f64::to_bits),
+            want.2.map(f64::to_bits),
+            "case {case}: parameters"
+        );
+        let e = [0, 1, 2].map(|i| want.2[i] - d[i]);
+        if (0..3).any(|i| i != want.0 && step[i] != 0 && e[i] == e[want.0]) {
+            ties += 1;
+        }
+    }
+    assert!(ties > 1000, "ties at the exit were exercised ({ties})");
+}
+
+#[test]
+fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
+    let mut rng = Pcg64::seed_from_u64(13);
+    let before = JUMPS.load(Ordering::Relaxed);
+    for case in 0..4000 {
+        let res = [0.25, 0.05, 0.125, 1.0][case % 4];
+        let span = res * [4.0, 40.0, 400.0][case % 3];
+        let shift = [0.0, -1.0e4, 3.3e5][case % 3] * res;
+        let snap = |rng: &mut Pcg64, v: f64| {
+            if rng.random_range(0..3) == 0 {
+                (v / res * 4.0).round() * res / 4.0
+            } else {
+                v
+            }
+        };
+        let o = [0, 1, 2].map(|_| {
+            let v = rng.random_range(-res * 8.0..res * 8.0);
+            snap(&mut rng, v) + shift
+        });
+        let mut e = [0, 1, 2].map(|i| {
+            let v = rng.random_range(-span..span);
+            snap(&mut rng, v) + o[i]
+        });
+        match case % 7 {
+            // Along an axis.
+            0 => {
+                let a = rng.random_range(0..3);
+                for b in 0..3 {
+                    if b != a {
+                        e[b] = o[b];
+                    }
+                }
+            }
+            // Zero length.
+            1 if case % 5 == 0 => e = o,
+            _ => {}
+        }
+        let (ko, ke) = (key(o, res), key(e, res));
+        let mut path = Vec::new();
+        walk(o, e, ko, ke, res, |c| path.push(c));
+        // Fill some of the blocks the walk crosses (the first, the last, the one
+        // holding the end cell, others at random) before the ray is cast.
+        let mut blocks: Vec<[i64; 3]> = path.iter().map(|c| c.map(|k| k >> 3)).collect();
+        blocks.dedup();
+        blocks.push(ke.map(|k| k >> 3));
+        let mut s = Scratch::new(ko.map(|c| c >> 3));
+        let mut want: HashSet<[i64; 3]> = path.iter().copied().collect();
+        for (i, b) in blocks.iter().enumerate() {
+            if i == 0 || i + 1 == blocks.len() || rng.random_range(0..3) == 0 {
+                s.fill(*b);
+                for bit in 0..512 {
+                    want.insert([
+                        b[0] * 8 + (bit & 7),
+                        b[1] * 8 + (bit >> 3 & 7),
+                        b[2] * 8 + (bit >> 6),
+                    ]);
+                }
+            }
+        }
+        s.miss_ray(o, e, ko, ke, res);
+        assert_eq!(missed(&s), want, "case {case}: {o:?} -> {e:?} at {res}");
+    }
+    assert!(
+        JUMPS.load(Ordering::Relaxed) > before + 4000,
+        "the jumps were taken"
+    );
 }
