@@ -4,7 +4,8 @@
 //! not the staircase of its voxels. See `docs/shading.md` for the
 //! estimators compared and the measured errors.
 
-use super::trace::{rank, RayTree, Root};
+use super::index::{RayTree, Root};
+use super::trace::rank;
 
 #[cfg(test)]
 mod tests;
