@@ -1,7 +1,9 @@
 //! The camera's frame: where the eye is, the primary rays, the light, and the beams
 //! of 8 × 8 pixel tiles.
 
-use super::{Projection, Ray, RayTree, RenderOptions};
+use super::beam::beam_start;
+use super::nodes::Trace;
+use super::{Projection, Ray, RenderOptions};
 
 pub(super) struct Frame {
     pub(super) centre: [f64; 3],
@@ -38,12 +40,13 @@ pub(super) fn normalize(a: [f64; 3]) -> [f64; 3] {
 }
 
 impl Frame {
-    pub(super) fn new(rt: &RayTree, opts: &RenderOptions) -> Frame {
+    pub(super) fn new<T: Trace + ?Sized>(rt: &T, opts: &RenderOptions) -> Frame {
         let (lo, hi) = match rt.bbox() {
             Some((lo, hi)) => (lo.map(|v| v as f64), hi.map(|v| v as f64 + 1.0)),
             None => {
-                let o = rt.origin().map(|v| v as f64);
-                (o, o.map(|v| v + f64::from(1u32 << rt.depth())))
+                let (depth, origin) = rt.space();
+                let o = origin.map(|v| v as f64);
+                (o, o.map(|v| v + f64::from(1u32 << depth)))
             }
         };
         let centre = [
@@ -141,10 +144,10 @@ pub(super) const BEAM: usize = 8;
 
 impl Frame {
     /// A lower bound on the first hit of every primary ray of pixels
-    /// `[x0, x1) × [y0, y1)` (see [`RayTree::beam_start`]).
-    pub(super) fn beam(
+    /// `[x0, x1) × [y0, y1)` (see [`super::RayTree::beam_start`]).
+    pub(super) fn beam<T: Trace + ?Sized>(
         &self,
-        rt: &RayTree,
+        rt: &T,
         w: usize,
         h: usize,
         x: [usize; 2],
@@ -173,7 +176,7 @@ impl Frame {
                 }
                 Some(dot(c, f) - spread(f))
             };
-            return rt.beam_start(stop, &near);
+            return beam_start(rt, stop, &near);
         }
         // Rays from the eye: the tile is a cone around its centre ray.
         let axis = self.ray(0.5 * (sx0 + sx1), 0.5 * (sy0 + sy1)).dir;
@@ -196,6 +199,6 @@ impl Frame {
             }
             Some(dist - rn)
         };
-        rt.beam_start(stop, &near)
+        beam_start(rt, stop, &near)
     }
 }

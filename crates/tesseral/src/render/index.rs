@@ -99,19 +99,26 @@ fn close(stack: &mut Vec<Open>, nodes: &mut Vec<Node>) {
 
 impl RayTree {
     /// The index of `tree` with its root classified and no nodes yet. O(1).
+    #[cfg(test)]
     fn unindexed(tree: &LinearOctree) -> Self {
-        let depth = tree.depth();
+        let mut rt = Self::unindexed_leaves(tree.depth(), tree.origin(), tree.leaves());
+        rt.bbox = tree.bbox();
+        rt
+    }
+
+    /// As [`RayTree::unindexed`], for sorted leaves in a space; no bounding box.
+    fn unindexed_leaves(depth: u8, origin: [i64; 3], leaves: &[Leaf]) -> Self {
         RayTree {
             depth,
-            origin: tree.origin(),
-            root: match colour_of(tree.leaves(), 0, depth) {
+            origin,
+            root: match colour_of(leaves, 0, depth) {
                 Colour::White => Root::White,
                 Colour::Black => Root::Black,
                 Colour::Gray => Root::Gray,
             },
             nodes: Vec::new(),
             root_node: 0,
-            bbox: tree.bbox(),
+            bbox: None,
         }
     }
 
@@ -124,9 +131,15 @@ impl RayTree {
     /// node is opened once).
     #[must_use]
     pub fn new(tree: &LinearOctree) -> Self {
-        let depth = tree.depth();
-        let leaves = tree.leaves();
-        let mut rt = Self::unindexed(tree);
+        let mut rt = Self::from_leaves(tree.depth(), tree.origin(), tree.leaves());
+        rt.bbox = tree.bbox();
+        rt
+    }
+
+    /// The index of sorted, disjoint `leaves` of the space `(depth, origin)` (a chunk
+    /// of a file, say), without a bounding box.
+    pub(crate) fn from_leaves(depth: u8, origin: [i64; 3], leaves: &[Leaf]) -> Self {
+        let mut rt = Self::unindexed_leaves(depth, origin, leaves);
         if rt.root != Root::Gray {
             return rt;
         }

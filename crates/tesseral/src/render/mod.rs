@@ -17,9 +17,11 @@ mod cut;
 mod frame;
 mod image;
 mod index;
+mod nodes;
 mod normal;
 mod options;
 mod shade;
+mod stream;
 mod trace;
 
 #[cfg(test)]
@@ -32,10 +34,12 @@ pub use options::{
     Camera, Clip, NormalFn, Normals, Projection, RenderOptions, Shader, Surface, View,
     DEFAULT_COLOUR,
 };
+pub use stream::{render_streamed, StreamStats, StreamedTree};
 pub use trace::{Hit, Ray, TraversalStack};
 
 use cut::Cut;
 use frame::{add, cross, dot, normalize, scale, Frame, BEAM};
+use nodes::Trace;
 use normal::NormalCache;
 use shade::Shade;
 
@@ -85,8 +89,8 @@ pub fn render_with(rt: &RayTree, surface: Surface<'_>, opts: &RenderOptions) -> 
 }
 
 /// Draws `rt`, marking the faces `cut` made (hatched, darker).
-fn render_cut(
-    rt: &RayTree,
+fn render_cut<T: Trace + ?Sized>(
+    rt: &T,
     surface: Surface<'_>,
     opts: &RenderOptions,
     cut: Option<Cut<'_>>,
@@ -134,8 +138,8 @@ fn render_cut(
 /// 8 × 8 tile first finds a lower bound on its rays' first hits
 /// ([`RayTree::beam_start`]), so its rays skip the empty space in front, and a tile
 /// whose beam meets nothing casts no ray at all.
-fn trace_block(
-    rt: &RayTree,
+fn trace_block<T: Trace + ?Sized>(
+    rt: &T,
     frame: &Frame,
     opts: &RenderOptions,
     xr: [usize; 2],
@@ -154,13 +158,13 @@ fn trace_block(
                     let ray = pixel_ray(frame, w, h, x, y);
                     let from = (start - margin).max(0.0);
                     let mut hit = if start.is_finite() {
-                        rt.cast_with(&ray, from, f64::INFINITY, stack)
+                        trace::cast(rt, &ray, from, f64::INFINITY, stack)
                     } else {
                         None
                     };
                     if hit.is_some_and(|h| h.at_start) && from > 0.0 {
                         // Only rounding can put a hit at the beam's start: cast again.
-                        hit = rt.cast_with(&ray, 0.0, f64::INFINITY, stack);
+                        hit = trace::cast(rt, &ray, 0.0, f64::INFINITY, stack);
                     }
                     each(x, y, &ray, hit);
                 }

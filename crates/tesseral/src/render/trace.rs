@@ -3,6 +3,7 @@
 //! octant mirroring, over the gray nodes of the linear octree.
 
 use super::index::{RayTree, Root};
+use super::nodes::{Kid, NodeId, Nodes, Trace};
 
 /// A ray `origin + t · dir`, in the voxel coordinates of the tree.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,35 +57,7 @@ impl RayTree {
     /// O(depth).
     #[must_use]
     pub fn contains(&self, v: [i64; 3]) -> bool {
-        let side = 1i64 << self.depth;
-        let rel = [
-            v[0] - self.origin[0],
-            v[1] - self.origin[1],
-            v[2] - self.origin[2],
-        ];
-        if rel.iter().any(|&c| c < 0 || c >= side) {
-            return false;
-        }
-        match self.root {
-            Root::White => return false,
-            Root::Black => return true,
-            Root::Gray => {}
-        }
-        let mut node = self.nodes[self.root_node as usize];
-        let mut k = self.depth;
-        loop {
-            k -= 1;
-            let d = ((rel[0] >> k) & 1) | (((rel[1] >> k) & 1) << 1) | (((rel[2] >> k) & 1) << 2);
-            let bit = 1u8 << d;
-            if node.black & bit != 0 {
-                return true;
-            }
-            if node.gray & bit == 0 {
-                return false;
-            }
-            let j = rank(node.gray, bit);
-            node = self.nodes[(node.first + j) as usize];
-        }
+        contains(self, v)
     }
 
     /// The first black block along `ray` with parameter in `[tmin, tmax]`.
@@ -111,101 +84,171 @@ impl RayTree {
         tmax: f64,
         stack: &mut TraversalStack,
     ) -> Option<Hit> {
-        if self.root == Root::White {
-            return None;
-        }
-        let side = f64::from(1u32 << self.depth);
-        let lo = self.origin.map(|v| v as f64);
-        let mut o = ray.origin;
-        let mut d = ray.dir;
-        let mut a = 0u8;
-        for ax in 0..3 {
-            if d[ax] < 0.0 {
-                o[ax] = 2.0 * lo[ax] + side - o[ax];
-                d[ax] = -d[ax];
-                a |= 1 << ax;
-            }
-            if d[ax] < 1e-12 {
-                d[ax] = 1e-12;
-            }
-        }
-        let mut t0 = [0.0; 3];
-        let mut t1 = [0.0; 3];
-        for ax in 0..3 {
-            let inv = 1.0 / d[ax];
-            t0[ax] = (lo[ax] - o[ax]) * inv;
-            t1[ax] = (lo[ax] + side - o[ax]) * inv;
-        }
-        let enter = t0[0].max(t0[1]).max(t0[2]);
-        let exit = t1[0].min(t1[1]).min(t1[2]);
-        if enter >= exit || exit < tmin || enter > tmax {
-            return None;
-        }
-        if self.root == Root::Black {
-            let (axis, t) = argmax(t0);
-            let at_start = t < tmin;
-            return Some(Hit {
-                t: if at_start { tmin } else { t },
-                axis,
-                block_min: self.origin,
-                size_log2: self.depth,
-                at_start,
-            });
-        }
-        self.walk(t0, t1, a, tmin, tmax, &mut stack.levels)
+        cast(self, ray, tmin, tmax, stack)
     }
+}
 
+/// Whether the voxel `v` of `t` is black: a descent from the root.
+pub(crate) fn contains<T: Trace + ?Sized>(t: &T, v: [i64; 3]) -> bool {
+    let (depth, origin) = t.space();
+    let side = 1i64 << depth;
+    let rel = [v[0] - origin[0], v[1] - origin[1], v[2] - origin[2]];
+    if rel.iter().any(|&c| c < 0 || c >= side) {
+        return false;
+    }
+    let mut id = match t.root() {
+        (Root::White, _) => return false,
+        (Root::Black, _) => return true,
+        (Root::Gray, id) => id,
+    };
+    let mut cur = t.cursor();
+    let mut k = depth;
+    let mut path = 0u64;
+    loop {
+        k -= 1;
+        let d = ((rel[0] >> k) & 1) | (((rel[1] >> k) & 1) << 1) | (((rel[2] >> k) & 1) << 2);
+        let label = d as u8;
+        if !cur.maybe(id, label) {
+            return false;
+        }
+        path = (path << 3) | u64::from(label);
+        match cur.kid(id, label, path, k) {
+            Kid::White => return false,
+            Kid::Black => return true,
+            Kid::Gray(c) => id = c,
+        }
+    }
+}
+
+/// The first black block of `t` along `ray` in `[tmin, tmax]` (see
+/// [`RayTree::cast`]).
+pub(crate) fn cast<T: Trace + ?Sized>(
+    t: &T,
+    ray: &Ray,
+    tmin: f64,
+    tmax: f64,
+    stack: &mut TraversalStack,
+) -> Option<Hit> {
+    let (root, root_id) = t.root();
+    if root == Root::White {
+        return None;
+    }
+    let (depth, origin) = t.space();
+    let side = f64::from(1u32 << depth);
+    let lo = origin.map(|v| v as f64);
+    let mut o = ray.origin;
+    let mut d = ray.dir;
+    let mut a = 0u8;
+    for ax in 0..3 {
+        if d[ax] < 0.0 {
+            o[ax] = 2.0 * lo[ax] + side - o[ax];
+            d[ax] = -d[ax];
+            a |= 1 << ax;
+        }
+        if d[ax] < 1e-12 {
+            d[ax] = 1e-12;
+        }
+    }
+    let mut t0 = [0.0; 3];
+    let mut t1 = [0.0; 3];
+    for ax in 0..3 {
+        let inv = 1.0 / d[ax];
+        t0[ax] = (lo[ax] - o[ax]) * inv;
+        t1[ax] = (lo[ax] + side - o[ax]) * inv;
+    }
+    let enter = t0[0].max(t0[1]).max(t0[2]);
+    let exit = t1[0].min(t1[1]).min(t1[2]);
+    if enter >= exit || exit < tmin || enter > tmax {
+        return None;
+    }
+    if root == Root::Black {
+        let (axis, t) = argmax(t0);
+        let at_start = t < tmin;
+        return Some(Hit {
+            t: if at_start { tmin } else { t },
+            axis,
+            block_min: origin,
+            size_log2: depth,
+            at_start,
+        });
+    }
+    let walk = Walk {
+        root: root_id,
+        depth,
+        origin,
+        a,
+        tmin,
+        tmax,
+    };
+    walk.run(&mut t.cursor(), t0, t1, &mut stack.levels)
+}
+
+/// One ray's traversal below a gray root.
+struct Walk {
+    root: NodeId,
+    depth: u8,
+    origin: [i64; 3],
+    /// The mirrored axes.
+    a: u8,
+    tmin: f64,
+    tmax: f64,
+}
+
+impl Walk {
     /// The iterative traversal below a gray root: an explicit stack of nodes, each
     /// with its slab parameters (mirrored space) and the child being visited.
     #[inline]
-    fn walk(
+    fn run<N: Nodes>(
         &self,
+        n: &mut N,
         t0: [f64; 3],
         t1: [f64; 3],
-        a: u8,
-        tmin: f64,
-        tmax: f64,
         stack: &mut [Level; 22],
     ) -> Option<Hit> {
+        let (a, tmin, tmax) = (self.a, self.tmin, self.tmax);
         if lt(t1[0], tmin) || lt(t1[1], tmin) || lt(t1[2], tmin) {
             return None;
         }
         let mut sp = 0usize;
-        stack[0] = Level::new(self.root_node, t0, t1, 0, self.depth);
+        stack[0] = Level::new(self.root, t0, t1, 0, self.depth);
         loop {
             let lv = &mut stack[sp];
             let cur = lv.cur;
             let (c0, c1) = lv.child(cur);
             let entry = max3(c0);
             if entry <= tmax {
-                let node = self.nodes[lv.node as usize];
                 let label = cur ^ a;
-                let bit = 1u8 << label;
-                if (node.black | node.gray) & bit != 0 {
+                if n.maybe(lv.node, label) {
                     let exit = min3(c1);
                     if exit >= tmin {
                         let path = (lv.path << 3) | u64::from(label);
                         let k = lv.k - 1;
-                        if node.black & bit != 0 {
-                            let (axis, t) = argmax(c0);
-                            let at_start = t < tmin;
-                            let rel = crate::code::decode(path << (3 * u32::from(k)));
-                            return Some(Hit {
-                                t: if at_start { tmin } else { t },
-                                axis,
-                                block_min: [0, 1, 2].map(|i| self.origin[i] + i64::from(rel[i])),
-                                size_log2: k,
-                                at_start,
-                            });
+                        match n.kid(lv.node, label, path, k) {
+                            Kid::Black => {
+                                let (axis, t) = argmax(c0);
+                                let at_start = t < tmin;
+                                let rel = crate::code::decode(path << (3 * u32::from(k)));
+                                return Some(Hit {
+                                    t: if at_start { tmin } else { t },
+                                    axis,
+                                    block_min: [0, 1, 2]
+                                        .map(|i| self.origin[i] + i64::from(rel[i])),
+                                    size_log2: k,
+                                    at_start,
+                                });
+                            }
+                            Kid::Gray(child) => {
+                                sp += 1;
+                                stack[sp] = Level::new(child, c0, c1, path, k);
+                                continue;
+                            }
+                            Kid::White => {}
                         }
-                        let j = rank(node.gray, bit);
-                        sp += 1;
-                        stack[sp] = Level::new(node.first + j, c0, c1, path, k);
-                        continue;
                     }
                 }
                 // Not entered: cross the nearest exit plane of this child, reusing
                 // the slab parameters just computed.
+                let lv = &mut stack[sp];
                 let ax = argmin(c1).0;
                 if cur & (1 << ax) == 0 {
                     lv.cur = cur | (1 << ax);
@@ -245,14 +288,14 @@ struct Level {
     t1: [f64; 3],
     /// The node's path from the root, one octal digit per level.
     path: u64,
-    node: u32,
+    node: NodeId,
     k: u8,
     cur: u8,
 }
 
 impl Level {
     #[inline]
-    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
+    fn new(node: NodeId, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
         let tm = [
             0.5 * (t0[0] + t1[0]),
             0.5 * (t0[1] + t1[1]),
