@@ -67,9 +67,9 @@ impl Top {
         let n = chunks.len();
         let root = if n == 0 {
             Root::White
-        } else if n == 1 && chunks[0].count == 1 && chunks[0].lo == 0 && chunks[0].hi == end {
-            Root::Black
-        } else if b.may_be_full(0, depth, 0, n) && (b.full)(0, depth, 0, n)? {
+        } else if (n == 1 && chunks[0].count == 1 && chunks[0].lo == 0 && chunks[0].hi == end)
+            || (b.may_be_full(0, depth, 0, n) && (b.full)(0, depth, 0, n)?)
+        {
             Root::Black
         } else {
             Root::Gray
