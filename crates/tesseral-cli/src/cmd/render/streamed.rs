@@ -90,6 +90,8 @@ pub(super) fn draw(
     }
     if json {
         let s = tree.stats();
+        // Counting the voxels reads every chunk once, after the picture.
+        let voxels = tree.voxel_count().map_err(|e| anyhow::anyhow!("{e}"))?;
         let j = serde_json::json!({
             "input": input,
             "output": out,
@@ -97,7 +99,7 @@ pub(super) fn draw(
             "height": image.height,
             "depth": tree.depth(),
             "leaves": tree.leaf_count(),
-            "voxels": null,
+            "voxels": voxels,
             "rebuilt_from_scene": false,
             "streamed": true,
             "chunks": s.chunks,

@@ -188,6 +188,21 @@ impl StreamedTree {
         self.bbox
     }
 
+    /// The number of black voxels: every chunk read once, one at a time (not
+    /// cached; a render does not need it).
+    ///
+    /// # Errors
+    /// A damaged chunk, naming the file and the chunk.
+    pub fn voxel_count(&self) -> Result<u64, FormatError> {
+        let mut n = 0u64;
+        for c in &self.chunks {
+            for l in self.files[c.part as usize].chunk(c.chunk as usize)? {
+                n += l.end() - l.code();
+            }
+        }
+        Ok(n)
+    }
+
     /// Whether the files carry colours.
     #[must_use]
     pub fn has_colours(&self) -> bool {
