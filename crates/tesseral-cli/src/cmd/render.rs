@@ -13,6 +13,8 @@ use super::budget::Budget;
 use super::octree;
 use super::output::{self, Size, MAX_SIDE};
 
+mod streamed;
+
 /// Arguments of `tesseral render`.
 #[derive(clap::Args)]
 pub struct Args {
@@ -81,6 +83,11 @@ pub struct Args {
     /// Print sizes and timings as JSON on stdout.
     #[arg(long)]
     json: bool,
+    /// Load the whole model before drawing. By default a version-2 `.tess` file or a
+    /// dataset is drawn streamed (only the chunks the rays reach are read, within
+    /// --memory); a cut, a slice or a contact sheet always loads the model.
+    #[arg(long)]
+    in_memory: bool,
     #[command(flatten)]
     budget: Budget,
 }
@@ -172,9 +179,49 @@ pub fn run(args: Args) -> Result<()> {
     if cut.is_some_and(|c| c.1 == '=') {
         bail!("--cut: write AXIS<C or AXIS>C, e.g. z<40");
     }
+    let normals = match args.normals.as_str() {
+        "auto" => render::Normals::Auto,
+        "faces" => render::Normals::Faces,
+        "smooth" => render::Normals::Smooth,
+        other => bail!("--normals {other:?}: expected auto, faces or smooth"),
+    };
+    let (az, el) = view.angles();
+    let opts = RenderOptions {
+        width,
+        height,
+        camera: Camera {
+            azimuth_deg: args.azimuth.unwrap_or(az),
+            elevation_deg: args.elevation.unwrap_or(el),
+            zoom: args.zoom,
+            projection: if args.perspective {
+                Projection::Perspective { fov_deg: fov }
+            } else {
+                Projection::Orthographic
+            },
+        },
+        outline: args.outline,
+        shadows: !args.no_shadows,
+        ao_samples: args.ao,
+        clip: None,
+        background,
+        normals,
+    };
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
+    if !is_scene && cut.is_none() && slice.is_none() && !args.sheet && !args.in_memory {
+        if let Some(tree) = streamed::open(&args.input, &args.budget)? {
+            return streamed::draw(
+                &args.input,
+                &args.output,
+                args.json,
+                &tree,
+                &opts,
+                solid_colour,
+                start,
+            );
+        }
+    }
     let mut colors = None;
     // A scene's cut and slice positions are in scene units: (scale, lower corner).
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
@@ -229,36 +276,13 @@ pub fn run(args: Args) -> Result<()> {
             .as_ref()
             .map(|f| f as &(dyn Fn([f64; 3]) -> Option<[f64; 3]> + Sync)),
     };
-    let normals = match args.normals.as_str() {
-        "auto" => render::Normals::Auto,
-        "faces" => render::Normals::Faces,
-        "smooth" => render::Normals::Smooth,
-        other => bail!("--normals {other:?}: expected auto, faces or smooth"),
-    };
-    let (az, el) = view.angles();
     let opts = RenderOptions {
-        width,
-        height,
-        camera: Camera {
-            azimuth_deg: args.azimuth.unwrap_or(az),
-            elevation_deg: args.elevation.unwrap_or(el),
-            zoom: args.zoom,
-            projection: if args.perspective {
-                Projection::Perspective { fov_deg: fov }
-            } else {
-                Projection::Orthographic
-            },
-        },
-        outline: args.outline,
-        shadows: !args.no_shadows,
-        ao_samples: args.ao,
         clip: cut.map(|(axis, op, c)| Clip {
             axis,
             at: to_voxel(axis, c),
             keep_above: op == '>',
         }),
-        background,
-        normals,
+        ..opts
     };
     let start = Instant::now();
     let image = if let Some((axis, _, c)) = slice {
@@ -296,6 +320,7 @@ pub fn run(args: Args) -> Result<()> {
             "leaves": tree.leaf_count(),
             "voxels": tree.voxel_count(),
             "rebuilt_from_scene": is_scene,
+            "streamed": false,
             "load_ms": load_ms,
             "render_ms": render_ms,
         });

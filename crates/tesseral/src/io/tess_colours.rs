@@ -35,6 +35,48 @@ impl Iterator for RegionLeaves<'_> {
     }
 }
 
+/// Where the decoding of a colour region can resume (see [`RegionLeaves::point`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RegionPoint {
+    pos: usize,
+    end: usize,
+    packed: u64,
+    prev_end: Option<u64>,
+    /// The leaves left from here to the region's end.
+    pub(crate) left: u64,
+}
+
+impl<'a> RegionLeaves<'a> {
+    /// Where the next leaf starts: decoding resumes there with
+    /// [`RegionLeaves::resume`], with the same checks.
+    pub(crate) fn point(&self) -> RegionPoint {
+        RegionPoint {
+            pos: self.r.pos,
+            end: self.r.bytes.len(),
+            packed: self.packed,
+            prev_end: self.prev_end,
+            left: self.left,
+        }
+    }
+
+    /// The leaves from `p` (a point of a region of these same `bytes`, the whole
+    /// file) on, at most `most` of them.
+    pub(crate) fn resume(bytes: &'a [u8], p: RegionPoint, depth: u8, most: u64) -> Self {
+        RegionLeaves {
+            r: Reader {
+                bytes: &bytes[..p.end],
+                pos: p.pos,
+            },
+            left: p.left.min(most),
+            packed: p.packed,
+            prev_end: p.prev_end,
+            space_end: 1u64 << (3 * u32::from(depth)),
+            depth,
+            failed: false,
+        }
+    }
+}
+
 impl<'a> RegionLeaves<'a> {
     /// Cuts the region into stretches of at most `n` leaves (at least one), each
     /// with its code range, count and byte offset in the file, and a stream of its leaves

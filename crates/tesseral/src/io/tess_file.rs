@@ -193,6 +193,20 @@ impl TessFile {
         }
     }
 
+    /// The mapped bytes of a version-2 file (for resuming colour regions).
+    pub(crate) fn mapped(&self) -> Option<&[u8]> {
+        match &self.body {
+            Body::Chunked(b, _) => Some(b),
+            Body::Decoded(_) => None,
+        }
+    }
+
+    /// The file's path.
+    #[must_use]
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
     /// The leaves of chunk `i` (of [`TessFile::chunks`]), checked.
     ///
     /// # Errors

@@ -3,23 +3,24 @@
 //! faces) or the ground plane.
 
 use super::cut::Cut;
+use super::nodes::Trace;
 use super::normal::NormalCache;
 use super::{
-    add, cross, dot, normalize, scale, Frame, Hit, Normals, Ray, RayTree, RenderOptions, Surface,
+    add, cross, dot, normalize, scale, Frame, Hit, Normals, Ray, RenderOptions, Surface,
     DEFAULT_COLOUR,
 };
 
 /// What shading a pixel needs besides its ray: the tree, the camera, the surface's
 /// colours and normals, the options and the cut.
-pub(super) struct Shade<'a> {
-    pub(super) rt: &'a RayTree,
+pub(super) struct Shade<'a, T: ?Sized> {
+    pub(super) rt: &'a T,
     pub(super) frame: &'a Frame,
     pub(super) surface: Surface<'a>,
     pub(super) opts: &'a RenderOptions,
     pub(super) cut: Option<Cut<'a>>,
 }
 
-impl Shade<'_> {
+impl<T: Trace + ?Sized> Shade<'_, T> {
     pub(super) fn pixel(&self, cache: &mut NormalCache, ray: &Ray, hit: Option<Hit>) -> [u8; 3] {
         let (rt, frame, opts) = (self.rt, self.frame, self.opts);
         let ground_t = if opts.shadows && ray.dir[2] < -1e-9 {
@@ -112,8 +113,8 @@ impl Shade<'_> {
     }
 }
 
-fn ambient_occlusion(
-    rt: &RayTree,
+fn ambient_occlusion<T: Trace + ?Sized>(
+    rt: &T,
     frame: &Frame,
     p: [f64; 3],
     n: [f64; 3],
@@ -150,7 +151,13 @@ fn ambient_occlusion(
     0.35 + 0.65 * f64::from(open) / f64::from(samples)
 }
 
-fn shade_ground(rt: &RayTree, frame: &Frame, opts: &RenderOptions, ray: &Ray, t: f64) -> [u8; 3] {
+fn shade_ground<T: Trace + ?Sized>(
+    rt: &T,
+    frame: &Frame,
+    opts: &RenderOptions,
+    ray: &Ray,
+    t: f64,
+) -> [u8; 3] {
     let p = ray.at(t);
     let dx = p[0] - frame.centre[0];
     let dy = p[1] - frame.centre[1];

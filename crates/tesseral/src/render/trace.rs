@@ -2,101 +2,8 @@
 //! Lastra ("An efficient parametric algorithm for octree traversal", WSCG 2000), with
 //! octant mirroring, over the gray nodes of the linear octree.
 
-use crate::linear::{Leaf, LinearOctree};
-
-/// One gray node: which children are gray and which are black (the rest are white),
-/// and where the gray children's nodes start (they are stored together, in label
-/// order).
-#[derive(Debug, Clone, Copy)]
-pub(super) struct Node {
-    pub(super) first: u32,
-    pub(super) gray: u8,
-    pub(super) black: u8,
-}
-
-/// The colour of the root.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Root {
-    White,
-    Black,
-    Gray,
-}
-
-/// The gray nodes of a linear octree, in a form rays can descend quickly.
-///
-/// The linear octree keeps only its black leaves, sorted; a node of the implicit tree
-/// is a code range, white when no leaf falls in it, black when one leaf covers it,
-/// gray otherwise. This index records, for each gray node, the colours of its eight
-/// children: 8 bytes per gray node (about a seventh of the leaves' 8 bytes each). It
-/// is derived from the leaves in one pass, never from the solid: rendering an octree
-/// file never rebuilds the solid.
-///
-/// ```
-/// use tesseral::linear::LinearOctree;
-/// use tesseral::render::{Ray, RayTree};
-/// let tree = LinearOctree::from_voxels(2, [0, 0, 0], [[1, 1, 1]]).unwrap();
-/// let rt = RayTree::new(&tree);
-/// let hit = rt.cast(&Ray::new([-5.0, 1.5, 1.5], [1.0, 0.0, 0.0]), 0.0, f64::INFINITY).unwrap();
-/// assert!((hit.t - 6.0).abs() < 1e-9 && hit.axis == 0 && hit.block_min == [1, 1, 1]);
-/// ```
-#[derive(Debug, Clone)]
-pub struct RayTree {
-    depth: u8,
-    origin: [i64; 3],
-    pub(super) root: Root,
-    pub(super) nodes: Vec<Node>,
-    pub(super) root_node: u32,
-    bbox: Option<([i64; 3], [i64; 3])>,
-}
-
-/// A node still open in the one-pass index build: its children so far.
-struct Open {
-    code: u64,
-    k: u8,
-    gray: u8,
-    black: u8,
-    n: u8,
-    kids: [Node; 8],
-}
-
-impl Open {
-    fn new(code: u64, k: u8) -> Self {
-        Open {
-            code,
-            k,
-            gray: 0,
-            black: 0,
-            n: 0,
-            kids: [Node {
-                first: 0,
-                gray: 0,
-                black: 0,
-            }; 8],
-        }
-    }
-
-    /// Whether the node's code range holds `code`.
-    fn holds(&self, code: u64) -> bool {
-        let shift = 3 * u32::from(self.k);
-        shift >= 64 || code >> shift == self.code >> shift
-    }
-}
-
-/// Closes the node on top of the stack: stores its gray children together and
-/// records it as a gray child of its parent.
-fn close(stack: &mut Vec<Open>, nodes: &mut Vec<Node>) {
-    let o = stack.pop().expect("a node to close");
-    let first = nodes.len() as u32;
-    nodes.extend_from_slice(&o.kids[..usize::from(o.n)]);
-    let parent = stack.last_mut().expect("the root is never closed here");
-    parent.gray |= 1 << ((o.code >> (3 * u32::from(o.k))) & 7);
-    parent.kids[usize::from(parent.n)] = Node {
-        first,
-        gray: o.gray,
-        black: o.black,
-    };
-    parent.n += 1;
-}
+use super::index::{RayTree, Root};
+use super::nodes::{Kid, NodeId, Nodes, Trace};
 
 /// A ray `origin + t · dir`, in the voxel coordinates of the tree.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -144,200 +51,13 @@ pub struct Hit {
 }
 
 impl RayTree {
-    /// The index of `tree` with its root classified and no nodes yet. O(1).
-    fn unindexed(tree: &LinearOctree) -> Self {
-        let depth = tree.depth();
-        RayTree {
-            depth,
-            origin: tree.origin(),
-            root: match colour_of(tree.leaves(), 0, depth) {
-                Colour::White => Root::White,
-                Colour::Black => Root::Black,
-                Colour::Gray => Root::Gray,
-            },
-            nodes: Vec::new(),
-            root_node: 0,
-            bbox: tree.bbox(),
-        }
-    }
-
-    /// Indexes the gray nodes of `tree` in one pass over its sorted leaves: the open
-    /// ancestors of the current leaf are kept on a stack; a node is closed when the
-    /// leaves leave it, and its gray children's records are then stored together.
-    ///
-    /// # Runtime
-    /// O(n) for n leaves (each leaf opens and closes at most `depth` nodes, and every
-    /// node is opened once).
-    #[must_use]
-    pub fn new(tree: &LinearOctree) -> Self {
-        let depth = tree.depth();
-        let leaves = tree.leaves();
-        let mut rt = Self::unindexed(tree);
-        if rt.root != Root::Gray {
-            return rt;
-        }
-        let mut nodes = Vec::with_capacity(leaves.len() / 3 + 1);
-        let mut stack = vec![Open::new(0, depth)];
-        for leaf in leaves {
-            let (c, s) = (leaf.code(), leaf.size_log2());
-            while !stack[stack.len() - 1].holds(c) {
-                close(&mut stack, &mut nodes);
-            }
-            loop {
-                let top = &stack[stack.len() - 1];
-                if top.k == s + 1 {
-                    break;
-                }
-                let k = top.k - 1;
-                stack.push(Open::new(c >> (3 * u32::from(k)) << (3 * u32::from(k)), k));
-            }
-            let top = stack.last_mut().expect("the root stays open");
-            top.black |= 1 << ((c >> (3 * u32::from(s))) & 7);
-        }
-        while stack.len() > 1 {
-            close(&mut stack, &mut nodes);
-        }
-        let root = stack.pop().expect("the root");
-        let first = nodes.len() as u32;
-        nodes.extend_from_slice(&root.kids[..usize::from(root.n)]);
-        nodes.push(Node {
-            first,
-            gray: root.gray,
-            black: root.black,
-        });
-        rt.root_node = nodes.len() as u32 - 1;
-        rt.nodes = nodes;
-        rt
-    }
-
-    /// The same index built top-down by partitioning the leaf slice: the reference the
-    /// one-pass builder is tested against.
-    #[cfg(test)]
-    pub(crate) fn new_by_partition(tree: &LinearOctree) -> Self {
-        let mut rt = Self::unindexed(tree);
-        if rt.root == Root::Gray {
-            rt.nodes.push(Node {
-                first: 0,
-                gray: 0,
-                black: 0,
-            });
-            rt.index(0, 0, tree.depth(), tree.leaves());
-        }
-        rt
-    }
-
-    /// Whether two indexes describe the same tree (layouts may differ).
-    #[cfg(test)]
-    pub(crate) fn same_tree(&self, other: &RayTree) -> bool {
-        fn eq(a: &RayTree, i: u32, b: &RayTree, j: u32) -> bool {
-            let (x, y) = (a.nodes[i as usize], b.nodes[j as usize]);
-            x.gray == y.gray
-                && x.black == y.black
-                && (0..x.gray.count_ones()).all(|c| eq(a, x.first + c, b, y.first + c))
-        }
-        self.root == other.root
-            && (self.root != Root::Gray || eq(self, self.root_node, other, other.root_node))
-    }
-
-    #[cfg(test)]
-    fn index(&mut self, at: usize, code: u64, k: u8, leaves: &[Leaf]) {
-        let child_cells = 1u64 << (3 * u32::from(k - 1));
-        let mut ranges = [(0usize, 0usize); 8];
-        let (mut gray, mut black) = (0u8, 0u8);
-        let mut lo = 0;
-        for d in 0..8u64 {
-            let end_code = code + (d + 1) * child_cells;
-            let hi = lo + leaves[lo..].partition_point(|l| l.code() < end_code);
-            ranges[d as usize] = (lo, hi);
-            match colour_of(&leaves[lo..hi], code + d * child_cells, k - 1) {
-                Colour::White => {}
-                Colour::Black => black |= 1 << d,
-                Colour::Gray => gray |= 1 << d,
-            }
-            lo = hi;
-        }
-        let first = self.nodes.len();
-        self.nodes[at] = Node {
-            first: first as u32,
-            gray,
-            black,
-        };
-        for _ in 0..gray.count_ones() {
-            self.nodes.push(Node {
-                first: 0,
-                gray: 0,
-                black: 0,
-            });
-        }
-        let mut j = first;
-        for d in 0..8u64 {
-            if gray & (1 << d) != 0 {
-                let (a, b) = ranges[d as usize];
-                self.index(j, code + d * child_cells, k - 1, &leaves[a..b]);
-                j += 1;
-            }
-        }
-    }
-
-    /// The number of gray nodes indexed.
-    #[must_use]
-    pub fn gray_nodes(&self) -> usize {
-        self.nodes.len()
-    }
-
-    /// The inclusive bounding box of the black voxels (as [`LinearOctree::bbox`]).
-    #[must_use]
-    pub fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
-        self.bbox
-    }
-
-    /// The tree's depth.
-    #[must_use]
-    pub fn depth(&self) -> u8 {
-        self.depth
-    }
-
-    /// The lowest corner of the tree's space.
-    #[must_use]
-    pub fn origin(&self) -> [i64; 3] {
-        self.origin
-    }
-
     /// Whether the voxel `v` is black: a descent from the root.
     ///
     /// # Runtime
     /// O(depth).
     #[must_use]
     pub fn contains(&self, v: [i64; 3]) -> bool {
-        let side = 1i64 << self.depth;
-        let rel = [
-            v[0] - self.origin[0],
-            v[1] - self.origin[1],
-            v[2] - self.origin[2],
-        ];
-        if rel.iter().any(|&c| c < 0 || c >= side) {
-            return false;
-        }
-        match self.root {
-            Root::White => return false,
-            Root::Black => return true,
-            Root::Gray => {}
-        }
-        let mut node = self.nodes[self.root_node as usize];
-        let mut k = self.depth;
-        loop {
-            k -= 1;
-            let d = ((rel[0] >> k) & 1) | (((rel[1] >> k) & 1) << 1) | (((rel[2] >> k) & 1) << 2);
-            let bit = 1u8 << d;
-            if node.black & bit != 0 {
-                return true;
-            }
-            if node.gray & bit == 0 {
-                return false;
-            }
-            let j = rank(node.gray, bit);
-            node = self.nodes[(node.first + j) as usize];
-        }
+        contains(self, v)
     }
 
     /// The first black block along `ray` with parameter in `[tmin, tmax]`.
@@ -364,101 +84,171 @@ impl RayTree {
         tmax: f64,
         stack: &mut TraversalStack,
     ) -> Option<Hit> {
-        if self.root == Root::White {
-            return None;
-        }
-        let side = f64::from(1u32 << self.depth);
-        let lo = self.origin.map(|v| v as f64);
-        let mut o = ray.origin;
-        let mut d = ray.dir;
-        let mut a = 0u8;
-        for ax in 0..3 {
-            if d[ax] < 0.0 {
-                o[ax] = 2.0 * lo[ax] + side - o[ax];
-                d[ax] = -d[ax];
-                a |= 1 << ax;
-            }
-            if d[ax] < 1e-12 {
-                d[ax] = 1e-12;
-            }
-        }
-        let mut t0 = [0.0; 3];
-        let mut t1 = [0.0; 3];
-        for ax in 0..3 {
-            let inv = 1.0 / d[ax];
-            t0[ax] = (lo[ax] - o[ax]) * inv;
-            t1[ax] = (lo[ax] + side - o[ax]) * inv;
-        }
-        let enter = t0[0].max(t0[1]).max(t0[2]);
-        let exit = t1[0].min(t1[1]).min(t1[2]);
-        if enter >= exit || exit < tmin || enter > tmax {
-            return None;
-        }
-        if self.root == Root::Black {
-            let (axis, t) = argmax(t0);
-            let at_start = t < tmin;
-            return Some(Hit {
-                t: if at_start { tmin } else { t },
-                axis,
-                block_min: self.origin,
-                size_log2: self.depth,
-                at_start,
-            });
-        }
-        self.walk(t0, t1, a, tmin, tmax, &mut stack.levels)
+        cast(self, ray, tmin, tmax, stack)
     }
+}
 
+/// Whether the voxel `v` of `t` is black: a descent from the root.
+pub(crate) fn contains<T: Trace + ?Sized>(t: &T, v: [i64; 3]) -> bool {
+    let (depth, origin) = t.space();
+    let side = 1i64 << depth;
+    let rel = [v[0] - origin[0], v[1] - origin[1], v[2] - origin[2]];
+    if rel.iter().any(|&c| c < 0 || c >= side) {
+        return false;
+    }
+    let mut id = match t.root() {
+        (Root::White, _) => return false,
+        (Root::Black, _) => return true,
+        (Root::Gray, id) => id,
+    };
+    let mut cur = t.cursor();
+    let mut k = depth;
+    let mut path = 0u64;
+    loop {
+        k -= 1;
+        let d = ((rel[0] >> k) & 1) | (((rel[1] >> k) & 1) << 1) | (((rel[2] >> k) & 1) << 2);
+        let label = d as u8;
+        if !cur.maybe(id, label) {
+            return false;
+        }
+        path = (path << 3) | u64::from(label);
+        match cur.kid(id, label, path, k) {
+            Kid::White => return false,
+            Kid::Black => return true,
+            Kid::Gray(c) => id = c,
+        }
+    }
+}
+
+/// The first black block of `t` along `ray` in `[tmin, tmax]` (see
+/// [`RayTree::cast`]).
+pub(crate) fn cast<T: Trace + ?Sized>(
+    t: &T,
+    ray: &Ray,
+    tmin: f64,
+    tmax: f64,
+    stack: &mut TraversalStack,
+) -> Option<Hit> {
+    let (root, root_id) = t.root();
+    if root == Root::White {
+        return None;
+    }
+    let (depth, origin) = t.space();
+    let side = f64::from(1u32 << depth);
+    let lo = origin.map(|v| v as f64);
+    let mut o = ray.origin;
+    let mut d = ray.dir;
+    let mut a = 0u8;
+    for ax in 0..3 {
+        if d[ax] < 0.0 {
+            o[ax] = 2.0 * lo[ax] + side - o[ax];
+            d[ax] = -d[ax];
+            a |= 1 << ax;
+        }
+        if d[ax] < 1e-12 {
+            d[ax] = 1e-12;
+        }
+    }
+    let mut t0 = [0.0; 3];
+    let mut t1 = [0.0; 3];
+    for ax in 0..3 {
+        let inv = 1.0 / d[ax];
+        t0[ax] = (lo[ax] - o[ax]) * inv;
+        t1[ax] = (lo[ax] + side - o[ax]) * inv;
+    }
+    let enter = t0[0].max(t0[1]).max(t0[2]);
+    let exit = t1[0].min(t1[1]).min(t1[2]);
+    if enter >= exit || exit < tmin || enter > tmax {
+        return None;
+    }
+    if root == Root::Black {
+        let (axis, t) = argmax(t0);
+        let at_start = t < tmin;
+        return Some(Hit {
+            t: if at_start { tmin } else { t },
+            axis,
+            block_min: origin,
+            size_log2: depth,
+            at_start,
+        });
+    }
+    let walk = Walk {
+        root: root_id,
+        depth,
+        origin,
+        a,
+        tmin,
+        tmax,
+    };
+    walk.run(&mut t.cursor(), t0, t1, &mut stack.levels)
+}
+
+/// One ray's traversal below a gray root.
+struct Walk {
+    root: NodeId,
+    depth: u8,
+    origin: [i64; 3],
+    /// The mirrored axes.
+    a: u8,
+    tmin: f64,
+    tmax: f64,
+}
+
+impl Walk {
     /// The iterative traversal below a gray root: an explicit stack of nodes, each
     /// with its slab parameters (mirrored space) and the child being visited.
     #[inline]
-    fn walk(
+    fn run<N: Nodes>(
         &self,
+        n: &mut N,
         t0: [f64; 3],
         t1: [f64; 3],
-        a: u8,
-        tmin: f64,
-        tmax: f64,
         stack: &mut [Level; 22],
     ) -> Option<Hit> {
+        let (a, tmin, tmax) = (self.a, self.tmin, self.tmax);
         if lt(t1[0], tmin) || lt(t1[1], tmin) || lt(t1[2], tmin) {
             return None;
         }
         let mut sp = 0usize;
-        stack[0] = Level::new(self.root_node, t0, t1, 0, self.depth);
+        stack[0] = Level::new(self.root, t0, t1, 0, self.depth);
         loop {
             let lv = &mut stack[sp];
             let cur = lv.cur;
             let (c0, c1) = lv.child(cur);
             let entry = max3(c0);
             if entry <= tmax {
-                let node = self.nodes[lv.node as usize];
                 let label = cur ^ a;
-                let bit = 1u8 << label;
-                if (node.black | node.gray) & bit != 0 {
+                if n.maybe(lv.node, label) {
                     let exit = min3(c1);
                     if exit >= tmin {
                         let path = (lv.path << 3) | u64::from(label);
                         let k = lv.k - 1;
-                        if node.black & bit != 0 {
-                            let (axis, t) = argmax(c0);
-                            let at_start = t < tmin;
-                            let rel = crate::code::decode(path << (3 * u32::from(k)));
-                            return Some(Hit {
-                                t: if at_start { tmin } else { t },
-                                axis,
-                                block_min: [0, 1, 2].map(|i| self.origin[i] + i64::from(rel[i])),
-                                size_log2: k,
-                                at_start,
-                            });
+                        match n.kid(lv.node, label, path, k) {
+                            Kid::Black => {
+                                let (axis, t) = argmax(c0);
+                                let at_start = t < tmin;
+                                let rel = crate::code::decode(path << (3 * u32::from(k)));
+                                return Some(Hit {
+                                    t: if at_start { tmin } else { t },
+                                    axis,
+                                    block_min: [0, 1, 2]
+                                        .map(|i| self.origin[i] + i64::from(rel[i])),
+                                    size_log2: k,
+                                    at_start,
+                                });
+                            }
+                            Kid::Gray(child) => {
+                                sp += 1;
+                                stack[sp] = Level::new(child, c0, c1, path, k);
+                                continue;
+                            }
+                            Kid::White => {}
                         }
-                        let j = rank(node.gray, bit);
-                        sp += 1;
-                        stack[sp] = Level::new(node.first + j, c0, c1, path, k);
-                        continue;
                     }
                 }
                 // Not entered: cross the nearest exit plane of this child, reusing
                 // the slab parameters just computed.
+                let lv = &mut stack[sp];
                 let ax = argmin(c1).0;
                 if cur & (1 << ax) == 0 {
                     lv.cur = cur | (1 << ax);
@@ -484,96 +274,6 @@ impl RayTree {
     }
 }
 
-impl RayTree {
-    /// A lower bound on where a bundle of rays first meets the solid (ESVO-style beam
-    /// optimization, Laine & Karras 2010). `near(min, max)` returns, for a box, `None`
-    /// when no ray of the bundle can enter it, else a lower bound on the ray parameter
-    /// of its points. Nodes of side `2^stop_log2` or less count as solid, so the search
-    /// stays coarse. Returns infinity when no ray of the bundle meets a black block.
-    ///
-    /// # Runtime
-    /// O(nodes whose boxes the bundle meets, down to the stop size).
-    #[must_use]
-    pub fn beam_start(
-        &self,
-        stop_log2: u8,
-        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
-    ) -> f64 {
-        let side = f64::from(1u32 << self.depth);
-        let lo = self.origin.map(|v| v as f64);
-        let hi = lo.map(|v| v + side);
-        match self.root {
-            Root::White => f64::INFINITY,
-            Root::Black => near(lo, hi).unwrap_or(f64::INFINITY),
-            Root::Gray => {
-                if near(lo, hi).is_none() {
-                    return f64::INFINITY;
-                }
-                let mut best = f64::INFINITY;
-                self.beam_rec(
-                    self.root_node,
-                    self.origin,
-                    self.depth,
-                    stop_log2,
-                    near,
-                    &mut best,
-                );
-                best
-            }
-        }
-    }
-
-    fn beam_rec(
-        &self,
-        n: u32,
-        min: [i64; 3],
-        k: u8,
-        stop: u8,
-        near: &impl Fn([f64; 3], [f64; 3]) -> Option<f64>,
-        best: &mut f64,
-    ) {
-        let node = self.nodes[n as usize];
-        let half = 1i64 << (k - 1);
-        let mut kids: [(f64, u8, [i64; 3]); 8] = [(0.0, 0, [0; 3]); 8];
-        let mut count = 0;
-        for label in 0..8u8 {
-            let bit = 1u8 << label;
-            if (node.black | node.gray) & bit == 0 {
-                continue;
-            }
-            let cmin = [
-                min[0] + half * i64::from(label & 1),
-                min[1] + half * i64::from((label >> 1) & 1),
-                min[2] + half * i64::from((label >> 2) & 1),
-            ];
-            let lo = cmin.map(|v| v as f64);
-            let hi = lo.map(|v| v + half as f64);
-            if let Some(t) = near(lo, hi) {
-                // Insertion by t: nearer children first prune the rest sooner.
-                let mut i = count;
-                while i > 0 && kids[i - 1].0 > t {
-                    kids[i] = kids[i - 1];
-                    i -= 1;
-                }
-                kids[i] = (t, label, cmin);
-                count += 1;
-            }
-        }
-        for &(t, label, cmin) in &kids[..count] {
-            if t >= *best {
-                break;
-            }
-            let bit = 1u8 << label;
-            if node.black & bit != 0 || k - 1 <= stop {
-                *best = t;
-            } else {
-                let j = rank(node.gray, bit);
-                self.beam_rec(node.first + j, cmin, k - 1, stop, near, best);
-            }
-        }
-    }
-}
-
 /// Scratch space for [`RayTree::cast_with`]: one entry per tree depth.
 #[derive(Debug, Clone, Default)]
 pub struct TraversalStack {
@@ -588,14 +288,14 @@ struct Level {
     t1: [f64; 3],
     /// The node's path from the root, one octal digit per level.
     path: u64,
-    node: u32,
+    node: NodeId,
     k: u8,
     cur: u8,
 }
 
 impl Level {
     #[inline]
-    fn new(node: u32, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
+    fn new(node: NodeId, t0: [f64; 3], t1: [f64; 3], path: u64, k: u8) -> Self {
         let tm = [
             0.5 * (t0[0] + t1[0]),
             0.5 * (t0[1] + t1[1]),
@@ -706,20 +406,5 @@ fn argmin(t: [f64; 3]) -> (usize, f64) {
         (1, t[1])
     } else {
         (2, t[2])
-    }
-}
-
-enum Colour {
-    White,
-    Black,
-    Gray,
-}
-
-/// The colour of the node `(code, k)` whose leaves are `leaves` (all inside it).
-fn colour_of(leaves: &[Leaf], code: u64, k: u8) -> Colour {
-    match leaves {
-        [] => Colour::White,
-        [l] if l.code() == code && l.size_log2() == k => Colour::Black,
-        _ => Colour::Gray,
     }
 }

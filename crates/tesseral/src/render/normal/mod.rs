@@ -4,7 +4,8 @@
 //! not the staircase of its voxels. See `docs/shading.md` for the
 //! estimators compared and the measured errors.
 
-use super::trace::{rank, RayTree, Root};
+use super::index::Root;
+use super::nodes::{Kid, NodeId, Nodes, Trace};
 
 #[cfg(test)]
 mod tests;
@@ -30,21 +31,21 @@ impl Brick {
     /// O(nodes meeting the cube), about the surface voxels inside it times a small
     /// factor, plus the depth.
     #[cfg(test)]
-    pub(crate) fn around(rt: &RayTree, centre: [i64; 3], reach: usize) -> Brick {
+    pub(crate) fn around<T: Trace + ?Sized>(rt: &T, centre: [i64; 3], reach: usize) -> Brick {
         Self::gather(rt, centre, reach, i64::MAX)
     }
 
     /// As [`Brick::around`], but only the voxels within `reach + ½` of the centre are
     /// sure to be marked (the nodes that miss that ball are skipped): what
     /// [`Brick::ball_moment`] reads.
-    pub(crate) fn ball(rt: &RayTree, centre: [i64; 3], reach: usize) -> Brick {
+    pub(crate) fn ball<T: Trace + ?Sized>(rt: &T, centre: [i64; 3], reach: usize) -> Brick {
         let r = reach as i64;
         Self::gather(rt, centre, reach, r * r + r)
     }
 
     /// The voxels of the cube `centre ± reach` in the nodes with a voxel centre within
     /// `√room` of `centre` (`(r + ½)² = r² + r + ¼`: integers compare with `r² + r`).
-    fn gather(rt: &RayTree, centre: [i64; 3], reach: usize, room: i64) -> Brick {
+    fn gather<T: Trace + ?Sized>(rt: &T, centre: [i64; 3], reach: usize, room: i64) -> Brick {
         assert!(reach <= MAX_REACH, "brick reach {reach} over {MAX_REACH}");
         let mut b = Brick {
             reach,
@@ -53,24 +54,32 @@ impl Brick {
         let r = reach as i64;
         let lo = centre.map(|c| c - r);
         let hi = centre.map(|c| c + r);
-        match rt.root {
-            Root::White => {}
-            Root::Black => b.paint(lo, hi, rt.origin(), 1i64 << rt.depth()),
-            Root::Gray => {
+        let (depth, origin) = rt.space();
+        match rt.root() {
+            (Root::White, _) => {}
+            (Root::Black, _) => b.paint(lo, hi, origin, 1i64 << depth),
+            (Root::Gray, root) => {
                 let at = Around {
                     lo,
                     hi,
                     centre,
                     room,
                 };
-                b.descend(rt, rt.root_node, rt.origin(), rt.depth(), &at);
+                b.descend(&mut rt.cursor(), root, origin, depth, 0, &at);
             }
         }
         b
     }
 
-    fn descend(&mut self, rt: &RayTree, n: u32, min: [i64; 3], k: u8, at: &Around) {
-        let node = rt.nodes[n as usize];
+    fn descend<N: Nodes>(
+        &mut self,
+        rt: &mut N,
+        n: NodeId,
+        min: [i64; 3],
+        k: u8,
+        path: u64,
+        at: &Around,
+    ) {
         let half = 1i64 << (k - 1);
         // Which halves of the node the cube meets, per axis: bit 0 low, bit 1 high.
         let mut halves = [0u8; 3];
@@ -79,8 +88,7 @@ impl Brick {
             halves[a] = u8::from(at.lo[a] < mid) | (u8::from(at.hi[a] >= mid) << 1);
         }
         for label in 0..8u8 {
-            let bit = 1u8 << label;
-            if (node.black | node.gray) & bit == 0 {
+            if !rt.maybe(n, label) {
                 continue;
             }
             let side = [label & 1, (label >> 1) & 1, (label >> 2) & 1];
@@ -100,11 +108,11 @@ impl Brick {
             if far > at.room {
                 continue;
             }
-            if node.black & bit != 0 {
-                self.paint(at.lo, at.hi, cmin, half);
-            } else {
-                let j = rank(node.gray, bit);
-                self.descend(rt, node.first + j, cmin, k - 1, at);
+            let cpath = (path << 3) | u64::from(label);
+            match rt.kid(n, label, cpath, k - 1) {
+                Kid::White => {}
+                Kid::Black => self.paint(at.lo, at.hi, cmin, half),
+                Kid::Gray(c) => self.descend(rt, c, cmin, k - 1, cpath, at),
             }
         }
     }
@@ -229,7 +237,7 @@ pub(crate) const REACH: usize = 4;
 /// [`REACH`] + ½ of `v`. Where that moment vanishes (a lone voxel, a thin sheet) or
 /// points behind the face seen, the face's own normal.
 #[must_use]
-pub(crate) fn surface_normal(rt: &RayTree, v: [i64; 3], face: [f64; 3]) -> [f64; 3] {
+pub(crate) fn surface_normal<T: Trace + ?Sized>(rt: &T, v: [i64; 3], face: [f64; 3]) -> [f64; 3] {
     let g = Brick::ball(rt, v, REACH).ball_moment().map(|c| c as f64);
     let len = (g[0] * g[0] + g[1] * g[1] + g[2] * g[2]).sqrt();
     let facing = g[0] * face[0] + g[1] * face[1] + g[2] * face[2];
@@ -257,7 +265,12 @@ impl NormalCache {
     }
 
     /// [`surface_normal`], looked up first.
-    pub(crate) fn normal(&mut self, rt: &RayTree, v: [i64; 3], face: [f64; 3]) -> [f64; 3] {
+    pub(crate) fn normal<T: Trace + ?Sized>(
+        &mut self,
+        rt: &T,
+        v: [i64; 3],
+        face: [f64; 3],
+    ) -> [f64; 3] {
         let f = face
             .iter()
             .enumerate()

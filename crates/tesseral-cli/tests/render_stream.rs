@@ -1,0 +1,129 @@
+//! `tesseral render` of version-2 `.tess` files and datasets, streamed (only the
+//! chunks the rays reach are read) against the in-memory render (issue 15).
+
+mod common;
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use common::{json, ok, run, run_capped};
+
+fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+#[test]
+fn streamed_renders_equal_the_in_memory_ones() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("showcase.tss");
+    let s = scene.to_str().unwrap();
+    ok(d, &["build", s, "-o", "m.tess", "--depth", "7"]);
+    ok(d, &["build", s, "-o", "ds", "--depth", "7", "--parts", "3"]);
+    for input in ["m.tess", "ds"] {
+        for extra in [
+            &[][..],
+            &["--perspective", "--azimuth", "30", "--elevation", "20"][..],
+            &["--outline", "--view", "front", "--zoom", "2.5"][..],
+        ] {
+            let mut a = vec![
+                "render", input, "-o", "s.png", "--size", "160x120", "--json",
+            ];
+            a.extend_from_slice(extra);
+            let v = json(d, &a);
+            assert_eq!(v["streamed"], true, "{v}");
+            assert!(v["chunks_decoded"].as_u64().unwrap() >= 1);
+            let mut b = vec![
+                "render", input, "-o", "m.png", "--size", "160x120", "--json",
+            ];
+            b.extend_from_slice(extra);
+            b.push("--in-memory");
+            let w = json(d, &b);
+            assert_eq!(w["streamed"], false, "{w}");
+            assert_eq!(v["leaves"], w["leaves"]);
+            assert!(
+                fs::read(d.join("s.png")).unwrap() == fs::read(d.join("m.png")).unwrap(),
+                "{input} {extra:?}: the streamed PNG differs from the in-memory one"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_damaged_chunk_is_named_by_file_and_chunk() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("fig4c-spheroid.tss");
+    ok(
+        d,
+        &[
+            "build",
+            scene.to_str().unwrap(),
+            "-o",
+            "s.tess",
+            "--depth",
+            "9",
+        ],
+    );
+    let chunks = tesseral::io::TessFile::open(&d.join("s.tess"))
+        .unwrap()
+        .chunks();
+    let mut bytes = fs::read(d.join("s.tess")).unwrap();
+    // Every chunk's payload (past its 32-byte head): whichever a ray reads first.
+    for c in &chunks {
+        bytes[c.offset as usize + 32 + 1] ^= 0x55;
+    }
+    fs::write(d.join("s.tess"), bytes).unwrap();
+    let out = run(d, &["render", "s.tess", "-o", "s.png", "--view", "top"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("s.tess") && err.contains("chunk ") && err.contains("checksum"),
+        "{err}"
+    );
+    assert!(!d.join("s.png").exists());
+}
+
+/// A depth-12 spheroid (14.5 M leaves) renders in 256 MiB of address space when
+/// streamed; loaded whole it cannot.
+#[test]
+fn a_streamed_render_fits_in_a_small_address_space() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = scenes().join("fig4c-spheroid.tss");
+    let s = scene.to_str().unwrap();
+    let out = run_capped(d, &["build", s, "-o", "s.tess", "--depth", "12"], 256);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let args = [
+        "render", "s.tess", "-o", "s.png", "--memory", "64M", "--json",
+    ];
+    let out = run_capped(d, &args, 256);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(v["streamed"], true);
+    assert_eq!(v["leaves"], 14_520_164);
+    assert!(fs::metadata(d.join("s.png")).unwrap().len() > 1000);
+    let out = run_capped(
+        d,
+        &[
+            "render",
+            "s.tess",
+            "-o",
+            "m.png",
+            "--in-memory",
+            "--memory",
+            "64M",
+        ],
+        256,
+    );
+    assert!(!out.status.success());
+    assert!(!d.join("m.png").exists());
+}

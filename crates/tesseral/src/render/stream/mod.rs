@@ -1,0 +1,425 @@
+//! Rendering a `.tess` file or a partitioned dataset without loading it: the rays
+//! read only the chunks they reach.
+//!
+//! The top of the tree comes from the chunk index ([`top`]); a node that meets a
+//! single chunk is answered by that chunk's own ray index ([`RayTree`] of its
+//! leaves), built when a ray, a beam or a normal estimate first reaches into it and
+//! kept in a [`Cache`] under a byte budget. Every traversal is the in-memory one
+//! (written once over [`Nodes`]), so the image is the in-memory render's, byte for
+//! byte. See `docs/render-stream.md`.
+
+mod cache;
+mod colours;
+#[cfg(test)]
+mod tests;
+mod top;
+
+use std::path::Path;
+use std::sync::atomic::Ordering;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use cache::Cache;
+use colours::Colours;
+use top::{ChunkRef, Top, TopKid};
+
+use super::index::{RayTree, Root};
+use super::nodes::{bounding_box, Kid, NodeId, Nodes, Trace};
+use super::trace::rank;
+use super::{render_cut, Image, RenderOptions, Surface};
+use crate::io::{FormatError, TessFile};
+use crate::model::Rgba;
+use crate::Voxel;
+
+/// The `src` of the top nodes in a [`NodeId`].
+const TOP: u32 = u32::MAX;
+
+/// A tree read from version-2 `.tess` files (one file, or the parts of a dataset)
+/// chunk by chunk as rays reach the chunks, with at most a budget of decoded chunks
+/// and colour blocks kept.
+///
+/// ```
+/// use tesseral::io::{write_model, Model};
+/// use tesseral::linear::LinearOctree;
+/// use tesseral::render::{render, render_streamed, RenderOptions, StreamedTree};
+/// let dir = tempfile::tempdir().unwrap();
+/// let path = dir.path().join("a.tess");
+/// let tree = LinearOctree::from_voxels(4, [0, 0, 0], [[1, 2, 3], [9, 9, 9]]).unwrap();
+/// write_model(&path, &Model::new(tree.clone())).unwrap();
+/// let st = StreamedTree::open(&path, 1 << 20).unwrap();
+/// let opts = RenderOptions { width: 64, height: 48, ..Default::default() };
+/// let img = render_streamed(&st, Default::default(), &opts).unwrap();
+/// assert_eq!(img, render(&tree, Default::default(), &opts));
+/// ```
+pub struct StreamedTree {
+    files: Vec<TessFile>,
+    /// Each part's code range `[lo, hi)`.
+    ranges: Vec<(u64, u64)>,
+    chunks: Vec<ChunkRef>,
+    top: Top,
+    depth: u8,
+    origin: Voxel,
+    bbox: Option<([i64; 3], [i64; 3])>,
+    leaves: u64,
+    cache: Cache<RayTree>,
+    colours: Option<Colours>,
+    /// The first error met while rendering (a damaged chunk or colour block).
+    error: Mutex<Option<FormatError>>,
+}
+
+/// What a streamed render read.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StreamStats {
+    /// Chunks in the tree.
+    pub chunks: u64,
+    /// Chunks decoded (a chunk evicted and needed again counts again).
+    pub chunks_decoded: u64,
+    /// Colour blocks decoded.
+    pub colour_blocks_decoded: u64,
+    /// Bytes of decoded chunks and colour blocks kept now.
+    pub cached_bytes: u64,
+}
+
+impl StreamedTree {
+    /// Opens a version-2 `.tess` file, keeping at most about `cache_bytes` of decoded
+    /// chunks and colour blocks.
+    ///
+    /// # Errors
+    /// [`FormatError`] naming the file: unreadable, not version 2, layers other than
+    /// colours, a damaged index or colour section, or a damaged chunk on the way to
+    /// the solid's bounding box.
+    pub fn open(path: &Path, cache_bytes: u64) -> Result<Self, FormatError> {
+        let f = TessFile::open(path)?;
+        let end = 1u64 << (3 * u32::from(f.depth()));
+        Self::from_parts(vec![f], vec![(0, end)], cache_bytes)
+    }
+
+    /// The tree made of `files`, the parts of a dataset in order, part `i` holding
+    /// the codes `ranges[i]` (all in one space).
+    ///
+    /// # Errors
+    /// As [`StreamedTree::open`]; also parts in different spaces or out of order.
+    pub fn from_parts(
+        files: Vec<TessFile>,
+        ranges: Vec<(u64, u64)>,
+        cache_bytes: u64,
+    ) -> Result<Self, FormatError> {
+        let Some(first) = files.first() else {
+            return Err(FormatError::corrupt("no parts to render"));
+        };
+        let (depth, origin) = (first.depth(), first.origin());
+        let mut chunks = Vec::new();
+        let mut leaves = 0u64;
+        for (p, f) in files.iter().enumerate() {
+            if !f.is_streamed() {
+                return Err(FormatError::unsupported(
+                    "a version-1 .tess file has no chunks to stream (convert it to version 2)",
+                )
+                .with_path(f.path()));
+            }
+            if (f.depth(), f.origin()) != (depth, origin) {
+                return Err(FormatError::corrupt(
+                    "the part is in another space than the first part",
+                )
+                .with_path(f.path()));
+            }
+            let (lo, hi) = ranges[p];
+            for (i, c) in f.chunks().into_iter().enumerate() {
+                if chunks.last().is_some_and(|l: &ChunkRef| l.hi > c.lo) || c.lo < lo || c.hi > hi {
+                    return Err(FormatError::corrupt(format!(
+                        "chunk {i}: range [{}, {}) overlaps an earlier part or leaves the part's range",
+                        c.lo, c.hi
+                    ))
+                    .with_path(f.path()));
+                }
+                chunks.push(ChunkRef {
+                    part: p as u32,
+                    chunk: i as u32,
+                    lo: c.lo,
+                    hi: c.hi,
+                    count: c.count,
+                });
+            }
+            leaves += f.leaf_count();
+        }
+        let top = Top::build(depth, &chunks, |code, k, a, b| {
+            covered(&files, &chunks[a..b], code, k)
+        })?;
+        let colours = Colours::index(&files, depth, cache_bytes / 4)?;
+        let mut t = StreamedTree {
+            files,
+            ranges,
+            chunks,
+            top,
+            depth,
+            origin,
+            bbox: None,
+            leaves,
+            cache: Cache::new(cache_bytes - cache_bytes / 4),
+            colours,
+            error: Mutex::new(None),
+        };
+        t.bbox = bounding_box(&t);
+        t.take_error().map_or(Ok(t), Err)
+    }
+
+    /// The depth of the space.
+    #[must_use]
+    pub fn depth(&self) -> u8 {
+        self.depth
+    }
+
+    /// The lowest voxel of the space.
+    #[must_use]
+    pub fn origin(&self) -> Voxel {
+        self.origin
+    }
+
+    /// The number of leaves (from the index).
+    #[must_use]
+    pub fn leaf_count(&self) -> u64 {
+        self.leaves
+    }
+
+    /// The inclusive bounding box of the black voxels (as
+    /// [`crate::linear::LinearOctree::bbox`]), found at [`StreamedTree::open`] by
+    /// reading only the chunks at the solid's extreme faces.
+    #[must_use]
+    pub fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.bbox
+    }
+
+    /// The number of black voxels: every chunk read once, one at a time (not
+    /// cached; a render does not need it).
+    ///
+    /// # Errors
+    /// A damaged chunk, naming the file and the chunk.
+    pub fn voxel_count(&self) -> Result<u64, FormatError> {
+        let mut n = 0u64;
+        for c in &self.chunks {
+            for l in self.files[c.part as usize].chunk(c.chunk as usize)? {
+                n += l.end() - l.code();
+            }
+        }
+        Ok(n)
+    }
+
+    /// Whether the files carry colours.
+    #[must_use]
+    pub fn has_colours(&self) -> bool {
+        self.colours.is_some()
+    }
+
+    /// The stored colour of voxel `v`, if it has one (as
+    /// [`crate::model::Layer::get`] on the whole model). A damaged colour block is
+    /// recorded (see [`StreamedTree::take_error`]) and reads as no colour.
+    #[must_use]
+    pub fn colour(&self, v: Voxel) -> Option<Rgba> {
+        let c = self.colours.as_ref()?;
+        let side = 1i64 << self.depth;
+        let rel = [0, 1, 2].map(|i| v[i] - self.origin[i]);
+        if rel.iter().any(|&x| x < 0 || x >= side) {
+            return None;
+        }
+        let code = crate::code::encode(rel[0] as u32, rel[1] as u32, rel[2] as u32);
+        let part = self.ranges.partition_point(|r| r.1 <= code);
+        if part >= self.ranges.len() || self.ranges[part].0 > code {
+            return None;
+        }
+        match c.get(&self.files, part, code) {
+            Ok(found) => found,
+            Err(e) => {
+                self.record(e);
+                None
+            }
+        }
+    }
+
+    /// What was read so far.
+    #[must_use]
+    pub fn stats(&self) -> StreamStats {
+        let colour = self.colours.as_ref();
+        StreamStats {
+            chunks: self.chunks.len() as u64,
+            chunks_decoded: self.cache.loads.load(Ordering::Relaxed),
+            colour_blocks_decoded: colour.map_or(0, |c| c.cache.loads.load(Ordering::Relaxed)),
+            cached_bytes: self.cache.used() + colour.map_or(0, |c| c.cache.used()),
+        }
+    }
+
+    /// The first error met since the last call (a damaged chunk or colour block,
+    /// naming the file and the chunk), if any.
+    pub fn take_error(&self) -> Option<FormatError> {
+        self.error
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .take()
+    }
+
+    fn record(&self, e: FormatError) {
+        let mut g = self.error.lock().unwrap_or_else(PoisonError::into_inner);
+        if g.is_none() {
+            *g = Some(e);
+        }
+    }
+
+    /// The ray index of chunk `c`, decoded if it is not kept; `None` (recorded) for
+    /// a damaged chunk.
+    fn chunk_tree(&self, c: u32) -> Option<Arc<RayTree>> {
+        let r = self.chunks[c as usize];
+        let got = self.cache.get(u64::from(c), || {
+            let leaves = self.files[r.part as usize].chunk(r.chunk as usize)?;
+            let rt = RayTree::from_leaves(self.depth, self.origin, &leaves);
+            let bytes = std::mem::size_of_val(rt.nodes.as_slice()) as u64 + 256;
+            Ok::<_, FormatError>((rt, bytes))
+        });
+        match got {
+            Ok(rt) => Some(rt),
+            Err(e) => {
+                self.record(e);
+                None
+            }
+        }
+    }
+}
+
+/// Whether the leaves of `chunks` cover the node `(code, k)` (see [`Top::build`]).
+fn covered(files: &[TessFile], chunks: &[ChunkRef], code: u64, k: u8) -> Result<bool, FormatError> {
+    let size = 1u64 << (3 * u32::from(k));
+    let mut sum = 0u64;
+    for c in chunks {
+        for l in files[c.part as usize].chunk(c.chunk as usize)? {
+            if l.code() >= code && l.end() <= code + size {
+                sum += l.end() - l.code();
+            }
+        }
+    }
+    Ok(sum == size)
+}
+
+/// A reader of a [`StreamedTree`]'s nodes: it keeps the chunk it is in.
+pub(crate) struct Cursor<'a> {
+    t: &'a StreamedTree,
+    cur: Option<(u32, Arc<RayTree>)>,
+}
+
+impl Cursor<'_> {
+    fn chunk(&mut self, c: u32) -> Option<&RayTree> {
+        if self.cur.as_ref().is_none_or(|(id, _)| *id != c) {
+            self.cur = self.t.chunk_tree(c).map(|rt| (c, rt));
+        }
+        self.cur.as_ref().map(|(_, rt)| &**rt)
+    }
+
+    /// The node `(path, k)` in chunk `c`'s index: a descent from its root.
+    fn resolve(&mut self, c: u32, path: u64, k: u8) -> Kid {
+        let depth = self.t.depth;
+        let Some(rt) = self.chunk(c) else {
+            return Kid::White;
+        };
+        match rt.root {
+            Root::White => return Kid::White,
+            Root::Black => return Kid::Black,
+            Root::Gray => {}
+        }
+        let mut node = rt.nodes[rt.root_node as usize];
+        let mut s = depth;
+        loop {
+            s -= 1;
+            let bit = 1u8 << ((path >> (3 * u32::from(s - k))) & 7);
+            if node.black & bit != 0 {
+                return Kid::Black;
+            }
+            if node.gray & bit == 0 {
+                return Kid::White;
+            }
+            let at = node.first + rank(node.gray, bit);
+            if s == k {
+                return Kid::Gray(NodeId { src: c, node: at });
+            }
+            node = rt.nodes[at as usize];
+        }
+    }
+}
+
+impl Nodes for Cursor<'_> {
+    fn maybe(&mut self, id: NodeId, label: u8) -> bool {
+        if id.src == TOP {
+            return self.t.top.nodes[id.node as usize][usize::from(label)] != TopKid::White;
+        }
+        self.chunk(id.src).is_some_and(|rt| {
+            let n = rt.nodes[id.node as usize];
+            (n.black | n.gray) & (1 << label) != 0
+        })
+    }
+
+    fn kid(&mut self, id: NodeId, label: u8, path: u64, k: u8) -> Kid {
+        if id.src == TOP {
+            return match self.t.top.nodes[id.node as usize][usize::from(label)] {
+                TopKid::White => Kid::White,
+                TopKid::Black => Kid::Black,
+                TopKid::Top(i) => Kid::Gray(NodeId { src: TOP, node: i }),
+                TopKid::Chunk(c) => self.resolve(c, path, k),
+            };
+        }
+        let src = id.src;
+        let Some(rt) = self.chunk(src) else {
+            return Kid::White;
+        };
+        let n = rt.nodes[id.node as usize];
+        let bit = 1u8 << label;
+        if n.black & bit != 0 {
+            Kid::Black
+        } else if n.gray & bit != 0 {
+            Kid::Gray(NodeId {
+                src,
+                node: n.first + rank(n.gray, bit),
+            })
+        } else {
+            Kid::White
+        }
+    }
+}
+
+impl Trace for StreamedTree {
+    type Cursor<'a> = Cursor<'a>;
+
+    fn cursor(&self) -> Cursor<'_> {
+        Cursor { t: self, cur: None }
+    }
+
+    fn space(&self) -> (u8, [i64; 3]) {
+        (self.depth, self.origin)
+    }
+
+    fn root(&self) -> (Root, NodeId) {
+        (
+            self.top.root,
+            NodeId {
+                src: TOP,
+                node: self.top.root_node,
+            },
+        )
+    }
+
+    fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.bbox
+    }
+}
+
+/// Renders a [`StreamedTree`] as [`super::render_with`] renders the whole tree (no
+/// clipping plane: `opts.clip` is ignored), reading only the chunks the rays reach.
+/// The image equals the in-memory render's.
+///
+/// # Errors
+/// The first damaged chunk or colour block met, naming the file and the chunk.
+///
+/// # Runtime
+/// As [`super::render`], plus decoding the chunks reached (again when evicted).
+pub fn render_streamed(
+    tree: &StreamedTree,
+    surface: Surface<'_>,
+    opts: &RenderOptions,
+) -> Result<Image, FormatError> {
+    let img = render_cut(tree, surface, opts, None);
+    tree.take_error().map_or(Ok(img), Err)
+}
