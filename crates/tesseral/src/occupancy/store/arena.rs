@@ -1,5 +1,5 @@
 //! The arena that holds every non-uniform block: one `Vec<u16>` cut into units of 16
-//! bytes, with a free list per size and compaction once a quarter of it is free.
+//! bytes, with a free list per size (the store compacts it once a quarter is free).
 
 /// `u16` words per unit.
 pub(crate) const UNIT: usize = 8;
@@ -23,14 +23,6 @@ impl Arena {
         self.words.len() / UNIT
     }
 
-    /// Whether an allocation of `units` would grow the arena while a quarter of it
-    /// lies in free chunks (then the owner should compact first).
-    pub fn wants_compaction(&self, units: usize) -> bool {
-        self.free.get(units).is_none_or(Vec::is_empty)
-            && self.words.len() + units * UNIT > self.words.capacity()
-            && self.free_units * 4 >= self.len_units()
-    }
-
     /// A chunk of `units` units (contents unspecified), as its offset in units.
     ///
     /// # Panics
@@ -47,8 +39,8 @@ impl Arena {
         );
         let need = self.words.len() + units * UNIT;
         if need > self.words.capacity() {
-            // Grow by a quarter, not a doubling: the capacity is counted in `bytes`.
-            let extra = (self.words.len() / 4).max(units * UNIT).max(64 * UNIT);
+            // Grow by an eighth, not a doubling: the capacity is counted in `bytes`.
+            let extra = (self.words.len() / 8).max(units * UNIT).max(64 * UNIT);
             self.words.reserve_exact(extra);
         }
         self.words.resize(need, 0);

@@ -241,6 +241,10 @@ impl Store {
             self.blocks -= 1;
         }
         self.tables[s] = Entry::EMPTY;
+        // A quarter of the arena free (and more than a few KiB): compact.
+        if self.arena.free_units * 4 > self.arena.len_units() && self.arena.free_units > 256 {
+            self.compact();
+        }
     }
 
     /// Gives slot `s` (emptied first) a new block of `units` units with this tag;
@@ -251,9 +255,6 @@ impl Store {
             old.offset()
         } else {
             self.clear(s);
-            if self.arena.wants_compaction(units) {
-                self.compact();
-            }
             self.blocks += 1;
             self.arena.alloc(units)
         };
@@ -264,7 +265,7 @@ impl Store {
     /// Moves every arena block to a new arena, in table order, leaving no free chunk.
     fn compact(&mut self) {
         let used = self.arena.len_units() - self.arena.free_units;
-        let mut words = Vec::with_capacity((used + used / 4) * UNIT);
+        let mut words = Vec::with_capacity((used + used / 8) * UNIT);
         for e in &mut self.tables {
             if e.in_arena() {
                 let from = e.offset() as usize * UNIT;
