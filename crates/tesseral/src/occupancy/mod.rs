@@ -11,10 +11,13 @@
 //!
 //! # Layout
 //! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
-//! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]); a block
-//! is either *uniform* (all 512 cells clamped to the same value: one entry, as
-//! OctoMap prunes), *sparse* (up to 128 known cells, each its index and its
-//! log-odds in `i16` fixed point, sorted) or *dense* (512 log-odds, 1 KiB).
+//! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]), found
+//! through a two-level directory: a hash map of superblocks (8×8×8 blocks), each a
+//! flat table of 512 four-byte block entries. A block is *uniform* (all 512 cells
+//! clamped to the same value: the entry alone, as OctoMap prunes), *sparse* (its
+//! known cells, 2 bytes each, and up to six distinct values), a *palette* (1, 2, 4
+//! or 8 bits a cell and a list of the values) or *dense* (512 log-odds), whichever
+//! is smallest, in one arena; log-odds are `i16` fixed point.
 //! Unknown blocks are not stored. See `ARCHITECTURE.md` for why.
 //!
 //! ```
@@ -152,8 +155,8 @@ impl OccupancyMap {
     /// A cell's state.
     ///
     /// # Runtime
-    /// O(1): one hash probe and one load (a binary search over at most 128 cells in
-    /// a sparse block).
+    /// O(1): one hash probe for the superblock, one table load, one or two loads
+    /// in the block (a binary search over its cells in a sparse block).
     #[must_use]
     pub fn state(&self, cell: [i64; 3]) -> CellState {
         match self.store.get(cell) {
@@ -221,10 +224,11 @@ impl OccupancyMap {
         out
     }
 
-    /// Checks the invariants: every uniform block is clamped, no dense block is
-    /// uniformly clamped or small enough to be sparse, every sparse block holds 1 to
-    /// 128 cells in order, every value lies in the clamps, the pools and the index
-    /// agree.
+    /// Checks the invariants: the directory and its tables agree; every uniform
+    /// block is clamped; no block is all unknown or uniformly clamped; the arena's
+    /// blocks and free chunks tile it without overlap; sparse blocks list their cells
+    /// in order; palette numbers lie in their value lists; every known value lies in
+    /// the clamps.
     ///
     /// # Panics
     /// When an invariant is broken.

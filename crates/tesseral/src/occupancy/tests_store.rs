@@ -1,4 +1,5 @@
-//! The block store (uniform, sparse and dense blocks) against a `HashMap` of cells.
+//! The block store (uniform, sparse, palette and dense blocks, the directory, the
+//! arena's compaction) against a `HashMap` of cells.
 
 use std::collections::HashMap;
 
@@ -6,40 +7,77 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::sensor::{Fixed, UNKNOWN};
-use super::store::{Kind, Store, SPARSE_MAX};
+use super::store::{Kind, Store};
 use super::SensorModel;
+
+/// Blocks in four superblocks, negative keys among them.
+const BLOCKS: [[i64; 3]; 6] = [
+    [0, 0, 0],
+    [1, 0, 0],
+    [-1, -3, 2],
+    [7, 7, -7],
+    [8, 0, 0],
+    [-9, 100, 3],
+];
+
+fn cell_of(b: [i64; 3], i: usize) -> [i64; 3] {
+    [
+        b[0] * 8 + (i & 7) as i64,
+        b[1] * 8 + (i >> 3 & 7) as i64,
+        b[2] * 8 + (i >> 6) as i64,
+    ]
+}
+
+fn check(store: &Store, model: &HashMap<[i64; 3], i16>, what: &str) {
+    for (&c, &v) in model {
+        assert_eq!(store.get(c), v, "{what}: cell {c:?}");
+    }
+    let mut n = 0;
+    store.for_each(|c, v| {
+        n += 1;
+        assert_eq!(model.get(&c), Some(&v), "{what}: cell {c:?}");
+    });
+    assert_eq!(n, model.len(), "{what}: cells");
+}
 
 #[test]
 fn blocks_change_form_and_keep_their_cells() {
     let fixed = Fixed::new(&SensorModel::octomap());
-    let values = [fixed.min, fixed.max, fixed.miss, fixed.hit, 0, UNKNOWN];
-    for seed in 0..6u64 {
+    let few = [fixed.min, fixed.max, fixed.miss, fixed.hit, 0];
+    let mut compactions = 0;
+    // Forms seen: uniform, sparse, palettes of 1, 2, 4, 8 bits, dense.
+    let mut forms = [0usize; 7];
+    for seed in 0..8u64 {
         let mut rng = Pcg64::seed_from_u64(seed);
         let mut store = Store::default();
         let mut model: HashMap<[i64; 3], i16> = HashMap::new();
-        let mut forms = [0usize; 3];
-        // Four blocks (one with negative keys); set cells one by one, and now and then
-        // apply a whole scan's masks or fill a block with one clamp.
-        for op in 0..6000 {
-            let b = [[0i64, 0, 0], [1, 0, 0], [-1, -3, 2], [7, 7, -7]][rng.random_range(0..4)];
-            match rng.random_range(0..20) {
-                0 => {
+        for op in 0..8000 {
+            // Phases: few values; many, mostly in one block (to make dense blocks);
+            // forgetting (to shrink blocks); the two clamps only (1-bit palettes).
+            let phase = op / 700 % 4;
+            let b = if phase == 1 && rng.random_range(0..3) > 0 {
+                BLOCKS[0]
+            } else {
+                BLOCKS[rng.random_range(0..BLOCKS.len())]
+            };
+            // (No whole-block writes while values pile up in phase 1.)
+            match if phase == 1 {
+                19
+            } else {
+                rng.random_range(0..20)
+            } {
+                0 | 1 => {
+                    // A scan's masks, of random density.
+                    let dense = rng.random_range(1..4);
                     let mut miss = [0u64; 8];
                     let mut hit = [0u64; 8];
                     for w in 0..8 {
-                        miss[w] = rng.random::<u64>() & rng.random::<u64>();
-                        hit[w] = rng.random::<u64>()
-                            & rng.random::<u64>()
-                            & rng.random::<u64>()
-                            & !miss[w];
+                        miss[w] = (0..dense).fold(u64::MAX, |m, _| m & rng.random::<u64>());
+                        hit[w] = (0..dense + 1).fold(!miss[w], |m, _| m & rng.random::<u64>());
                     }
                     store.update(b, &miss, &hit, fixed);
                     for i in 0..512 {
-                        let c = [
-                            b[0] * 8 + (i & 7) as i64,
-                            b[1] * 8 + (i >> 3 & 7) as i64,
-                            b[2] * 8 + (i >> 6) as i64,
-                        ];
+                        let c = cell_of(b, i);
                         let old = model.get(&c).copied().unwrap_or(UNKNOWN);
                         if hit[i >> 6] >> (i & 63) & 1 == 1 {
                             model.insert(c, fixed.apply_hit(old));
@@ -48,27 +86,21 @@ fn blocks_change_form_and_keep_their_cells() {
                         }
                     }
                 }
-                1 => {
+                2 => {
                     let v = [fixed.min, fixed.max][rng.random_range(0..2)];
                     store.put(b, &[v; 512], fixed);
                     for i in 0..512 {
-                        model.insert(
-                            [
-                                b[0] * 8 + (i & 7),
-                                b[1] * 8 + (i >> 3 & 7),
-                                b[2] * 8 + (i >> 6),
-                            ],
-                            v,
-                        );
+                        model.insert(cell_of(b, i), v);
                     }
                 }
                 _ => {
-                    let c = [0, 1, 2].map(|a| b[a] * 8 + rng.random_range(0..8));
-                    // Mostly known values, so blocks grow past the sparse limit.
-                    let v = if op % 3000 < 2400 {
-                        values[rng.random_range(0..5)]
-                    } else {
-                        values[rng.random_range(0..6)]
+                    let c = cell_of(b, rng.random_range(0..512));
+                    let v = match phase {
+                        0 => few[rng.random_range(0..5)],
+                        1 => rng.random_range(fixed.min..=fixed.max),
+                        2 if rng.random_range(0..3) == 0 => few[rng.random_range(0..5)],
+                        2 => UNKNOWN,
+                        _ => [fixed.min, fixed.max][rng.random_range(0..2)],
                     };
                     store.set(c, v, fixed);
                     if v == UNKNOWN {
@@ -79,29 +111,93 @@ fn blocks_change_form_and_keep_their_cells() {
                 }
             }
             store.assert_valid(fixed);
-            if op % 97 == 0 {
-                for (&c, &v) in &model {
-                    assert_eq!(store.get(c), v, "seed {seed} op {op}: cell {c:?}");
-                }
-                let mut n = 0;
-                store.for_each(|c, v| {
-                    n += 1;
-                    assert_eq!(model.get(&c), Some(&v), "seed {seed} op {op}: cell {c:?}");
-                });
-                assert_eq!(n, model.len(), "seed {seed} op {op}: cells");
+            // The block just changed, every cell, and now and then the whole map.
+            for i in 0..512 {
+                let c = cell_of(b, i);
+                let want = model.get(&c).copied().unwrap_or(UNKNOWN);
+                assert_eq!(store.get(c), want, "seed {seed} op {op}: cell {c:?}");
             }
-            for b in [[0i64, 0, 0], [1, 0, 0], [-1, -3, 2], [7, 7, -7]] {
-                match store.entry(b).map(|e| e.kind()) {
-                    Some(Kind::Uniform(_)) => forms[0] += 1,
-                    Some(Kind::Sparse(_)) => forms[1] += 1,
-                    Some(Kind::Dense(_)) => forms[2] += 1,
-                    None => {}
-                }
+            if op % 97 == 0 {
+                check(&store, &model, &format!("seed {seed} op {op}"));
+            }
+            for b in BLOCKS {
+                let f = match store.entry(b).map(|e| e.kind()) {
+                    Some(Kind::Uniform(_)) => 0,
+                    Some(Kind::Sparse) => 1,
+                    Some(Kind::Palette(w)) => 2 + w.trailing_zeros() as usize,
+                    Some(Kind::Dense) => 6,
+                    None => continue,
+                };
+                forms[f] += 1;
             }
         }
-        assert!(
-            forms.iter().all(|&f| f > 0),
-            "seed {seed}: forms seen {forms:?} (sparse up to {SPARSE_MAX})"
-        );
+        check(&store, &model, &format!("seed {seed}"));
+        let blocks = BLOCKS.iter().filter(|&&b| store.entry(b).is_some()).count();
+        assert_eq!(store.block_count(), blocks, "seed {seed}: block count");
+        compactions += store.compactions();
     }
+    assert!(forms.iter().all(|&f| f > 0), "forms seen {forms:?}");
+    assert!(compactions > 0, "the arena was compacted");
+}
+
+#[test]
+fn blocks_take_the_smallest_form() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut store = Store::default();
+    let b = [3, -2, 5];
+    let kind = |s: &Store| s.entry(b).map(|e| e.kind());
+    // Ten known cells of one value: sparse (one header unit and two of cells).
+    let mut cells = [UNKNOWN; 512];
+    for c in cells.iter_mut().step_by(50) {
+        *c = fixed.miss;
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Sparse));
+    // Half the cells known, two values and unknown: 2-bit palette.
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = [UNKNOWN, fixed.min, fixed.max][i % 3];
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(2)));
+    // All known, two values: 1 bit.
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = [fixed.min, fixed.max][i % 2];
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(1)));
+    // Sixteen values: 4 bits; 256: 8 bits; 512: dense.
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = (i % 16) as i16;
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(4)));
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = (i % 255) as i16;
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(8)));
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = i as i16;
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Dense));
+    store.assert_valid(fixed);
+    // Clamped free everywhere: one entry; then a miss on a clamped-free block
+    // changes nothing, and a hit makes it a 1-bit palette.
+    store.put(b, &[fixed.min; 512], fixed);
+    assert_eq!(kind(&store), Some(Kind::Uniform(fixed.min)));
+    store.update(b, &[u64::MAX; 8], &[0; 8], fixed);
+    assert_eq!(kind(&store), Some(Kind::Uniform(fixed.min)));
+    let mut hit = [0u64; 8];
+    hit[3] = 1 << 9;
+    store.update(b, &[0; 8], &hit, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(1)));
+    assert_eq!(
+        store.get([3 * 8 + 1, -2 * 8 + 1, 5 * 8 + 3]),
+        fixed.min + fixed.hit
+    );
+    assert_eq!(store.get([3 * 8, -2 * 8 + 1, 5 * 8 + 3]), fixed.min);
+    assert_eq!(store.get([3 * 8, -2 * 8 + 1, 5 * 8 + 8]), UNKNOWN);
+    store.assert_valid(fixed);
+    assert_eq!(store.block_count(), 1);
 }

@@ -1,0 +1,79 @@
+//! The arena that holds every non-uniform block: one `Vec<u16>` cut into units of 16
+//! bytes, with a free list per size (the store compacts it once a quarter is free).
+
+/// `u16` words per unit.
+pub(crate) const UNIT: usize = 8;
+
+/// The most units the arena addresses (29 bits of a block entry): 8 GiB.
+pub(crate) const MAX_UNITS: usize = 1 << 29;
+
+#[derive(Debug, Clone, Default)]
+pub(crate) struct Arena {
+    /// The words, `UNIT` per unit; a block starts at a unit.
+    pub words: Vec<u16>,
+    /// Free chunks by size in units: `free[n]` lists the offsets of free `n`-unit chunks.
+    pub free: Vec<Vec<u32>>,
+    /// Units in free chunks.
+    pub free_units: usize,
+}
+
+impl Arena {
+    /// Units in use or free (the arena's length).
+    pub fn len_units(&self) -> usize {
+        self.words.len() / UNIT
+    }
+
+    /// A chunk of `units` units (contents unspecified), as its offset in units.
+    ///
+    /// # Panics
+    /// When the arena would pass [`MAX_UNITS`] (8 GiB of blocks).
+    pub fn alloc(&mut self, units: usize) -> u32 {
+        if let Some(at) = self.free.get_mut(units).and_then(Vec::pop) {
+            self.free_units -= units;
+            return at;
+        }
+        let at = self.len_units();
+        assert!(
+            at + units <= MAX_UNITS,
+            "occupancy map: more than 8 GiB of blocks"
+        );
+        let need = self.words.len() + units * UNIT;
+        if need > self.words.capacity() {
+            // Grow by an eighth, not a doubling: the capacity is counted in `bytes`.
+            let extra = (self.words.len() / 8).max(units * UNIT).max(64 * UNIT);
+            self.words.reserve_exact(extra);
+        }
+        self.words.resize(need, 0);
+        at as u32
+    }
+
+    /// Frees the chunk of `units` units at `at`.
+    pub fn release(&mut self, at: u32, units: usize) {
+        if self.free.len() <= units {
+            self.free.resize_with(units + 1, Vec::new);
+        }
+        self.free[units].push(at);
+        self.free_units += units;
+    }
+
+    /// The words of the chunk at `at` (in units), `len` words long.
+    #[inline]
+    pub fn get(&self, at: u32, len: usize) -> &[u16] {
+        let s = at as usize * UNIT;
+        &self.words[s..s + len]
+    }
+
+    /// The words of the chunk at `at`, mutably.
+    #[inline]
+    pub fn get_mut(&mut self, at: u32, len: usize) -> &mut [u16] {
+        let s = at as usize * UNIT;
+        &mut self.words[s..s + len]
+    }
+
+    /// Bytes held: the words' capacity and the free lists.
+    pub fn bytes(&self) -> usize {
+        self.words.capacity() * 2
+            + self.free.capacity() * std::mem::size_of::<Vec<u32>>()
+            + self.free.iter().map(|f| f.capacity() * 4).sum::<usize>()
+    }
+}

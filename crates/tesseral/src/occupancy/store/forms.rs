@@ -1,0 +1,365 @@
+//! The forms of a stored block and their layouts in the arena (`u16` words):
+//!
+//! - *uniform*: all 512 cells clamped to one value, held in the entry itself;
+//! - *sparse*: a header unit `[len, k, v0 … v5]` (its known cells and up to six
+//!   distinct values), then `len` cells `index << 3 | value number`, sorted;
+//! - *palette* of width `w` ∈ {1, 2, 4, 8}: 512 cells of `w` bits (cell `i` at bit
+//!   `i·w`, never across a word), then `[k, v0 … v(k−1)]` (room for 2^w values when
+//!   `w ≤ 4`, for `k` when `w = 8`); `UNKNOWN` may be one of the values;
+//! - *dense*: 512 `i16`.
+
+use super::arena::UNIT;
+use super::BLOCK_CELLS;
+use crate::occupancy::sensor::{Fixed, UNKNOWN};
+
+/// Entry tags (the low three bits of an entry).
+pub(crate) const EMPTY: u32 = 0;
+pub(crate) const UNIFORM: u32 = 1;
+pub(crate) const SPARSE: u32 = 2;
+/// Palette of width `1 << (tag − PALETTE)`: tags 3 to 6.
+pub(crate) const PALETTE: u32 = 3;
+pub(crate) const DENSE: u32 = 7;
+
+/// The most distinct values a sparse block holds.
+pub(crate) const SPARSE_VALUES: usize = 6;
+
+/// Units of a sparse block of `len` cells.
+#[inline]
+pub(crate) fn sparse_units(len: usize) -> usize {
+    1 + len.div_ceil(UNIT)
+}
+
+/// Words of a palette block's cells.
+#[inline]
+pub(crate) fn bits_words(w: u32) -> usize {
+    32 * w as usize
+}
+
+/// Words of a palette block's value list (its length first) holding `k` values.
+#[inline]
+fn list_words(w: u32, k: usize) -> usize {
+    1 + if w <= 4 { 1 << w } else { k }
+}
+
+/// Units of a palette block of width `w` holding `k` values.
+#[inline]
+pub(crate) fn palette_units(w: u32, k: usize) -> usize {
+    (bits_words(w) + list_words(w, k)).div_ceil(UNIT)
+}
+
+/// Units of a dense block.
+pub(crate) const DENSE_UNITS: usize = BLOCK_CELLS / UNIT;
+
+/// The narrowest palette width for `k` values.
+#[inline]
+pub(crate) fn width_for(k: usize) -> Option<u32> {
+    match k {
+        0..=2 => Some(1),
+        3..=4 => Some(2),
+        5..=16 => Some(4),
+        17..=256 => Some(8),
+        _ => None,
+    }
+}
+
+/// The palette number of cell `i` in a palette block's words.
+#[inline]
+pub(crate) fn palette_index(words: &[u16], w: u32, i: usize) -> usize {
+    let bit = i * w as usize;
+    ((words[bit >> 4] >> (bit & 15)) & ((1u16 << w) - 1)) as usize
+}
+
+/// Sets the palette number of cell `i`.
+#[inline]
+pub(crate) fn set_palette_index(words: &mut [u16], w: u32, i: usize, j: usize) {
+    let bit = i * w as usize;
+    let m = ((1u16 << w) - 1) << (bit & 15);
+    let x = &mut words[bit >> 4];
+    *x = (*x & !m) | ((j as u16) << (bit & 15) & m);
+}
+
+/// A sparse block's value for cell `i` (`UNKNOWN` when it is not listed).
+#[inline]
+pub(crate) fn sparse_get(words: &[u16], i: usize) -> i16 {
+    let len = words[0] as usize;
+    let cells = &words[UNIT..UNIT + len];
+    let key = (i as u16) << 3;
+    let p = cells.partition_point(|&c| c < key);
+    match cells.get(p) {
+        Some(&c) if c >> 3 == i as u16 => words[2 + (c & 7) as usize] as i16,
+        _ => UNKNOWN,
+    }
+}
+
+/// The units a block of this tag takes, from its words (which start at its offset).
+pub(crate) fn units_of(tag: u32, words: &[u16]) -> usize {
+    match tag {
+        SPARSE => sparse_units(words[0] as usize),
+        DENSE => DENSE_UNITS,
+        _ => {
+            let w = 1 << (tag - PALETTE);
+            palette_units(w, words[bits_words(w)] as usize)
+        }
+    }
+}
+
+/// The 512 values of a block in the arena (tag and words from its offset).
+pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
+    match tag {
+        SPARSE => {
+            out.fill(UNKNOWN);
+            let len = words[0] as usize;
+            for &c in &words[UNIT..UNIT + len] {
+                out[(c >> 3) as usize] = words[2 + (c & 7) as usize] as i16;
+            }
+        }
+        DENSE => {
+            for (o, &v) in out.iter_mut().zip(words) {
+                *o = v as i16;
+            }
+        }
+        _ => {
+            let w = 1 << (tag - PALETTE);
+            let list = &words[bits_words(w) + 1..];
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = list[palette_index(words, w, i)] as i16;
+            }
+        }
+    }
+}
+
+/// What a block's values are, and the form that stores them in the fewest units.
+pub(crate) struct Census {
+    /// Distinct values, in order of first appearance (`UNKNOWN` included).
+    pub values: Vec<i16>,
+    /// Each cell's number in `values`.
+    pub index: [u16; BLOCK_CELLS],
+    /// Known cells.
+    pub known: usize,
+}
+
+impl Census {
+    pub fn of(cells: &[i16; BLOCK_CELLS]) -> Self {
+        // A small open-addressed table from value to number.
+        let mut slots = [u16::MAX; 1024];
+        let mut values = Vec::new();
+        let mut index = [0u16; BLOCK_CELLS];
+        let mut known = 0;
+        for (i, &v) in cells.iter().enumerate() {
+            known += usize::from(v != UNKNOWN);
+            let mut h = (u32::from(v as u16).wrapping_mul(0x9E37_79B1) >> 22) as usize;
+            loop {
+                let s = slots[h];
+                if s == u16::MAX {
+                    slots[h] = values.len() as u16;
+                    index[i] = values.len() as u16;
+                    values.push(v);
+                    break;
+                }
+                if values[s as usize] == v {
+                    index[i] = s;
+                    break;
+                }
+                h = (h + 1) & 1023;
+            }
+        }
+        Self {
+            values,
+            index,
+            known,
+        }
+    }
+
+    /// Distinct known values.
+    pub fn known_values(&self) -> usize {
+        self.values.len() - usize::from(self.values.contains(&UNKNOWN))
+    }
+}
+
+/// The form a block takes: its tag and its units (0 for none and uniform).
+pub(crate) fn choose(known: usize, values: usize, known_values: usize) -> (u32, usize) {
+    let mut best = (DENSE, DENSE_UNITS);
+    if let Some(w) = width_for(values) {
+        let u = palette_units(w, values);
+        if u <= best.1 {
+            best = (PALETTE + w.trailing_zeros(), u);
+        }
+    }
+    if known_values <= SPARSE_VALUES {
+        let u = sparse_units(known);
+        if u < best.1 {
+            best = (SPARSE, u);
+        }
+    }
+    best
+}
+
+/// Writes a sparse block over `words` (its whole chunk): `cells` are
+/// `index << 16 | value as u16`, sorted by index, with at most [`SPARSE_VALUES`]
+/// distinct values.
+pub(crate) fn write_sparse(words: &mut [u16], cells: &[u32]) {
+    let (head, body) = words.split_at_mut(UNIT);
+    head.fill(0);
+    head[0] = cells.len() as u16;
+    let mut k = 0;
+    for (o, &c) in body.iter_mut().zip(cells) {
+        let v = c as u16;
+        let j = match head[2..2 + k].iter().position(|&x| x == v) {
+            Some(j) => j,
+            None => {
+                head[2 + k] = v;
+                k += 1;
+                k - 1
+            }
+        };
+        *o = ((c >> 16) as u16) << 3 | j as u16;
+    }
+    debug_assert!(k <= SPARSE_VALUES);
+    head[1] = k as u16;
+    body[cells.len()..].fill(0);
+}
+
+/// Writes a palette block of width `w` over `words` (its whole chunk).
+pub(crate) fn write_palette(words: &mut [u16], w: u32, census: &Census) {
+    words.fill(0);
+    for (i, &j) in census.index.iter().enumerate() {
+        let bit = i * w as usize;
+        words[bit >> 4] |= j << (bit & 15);
+    }
+    let at = bits_words(w);
+    words[at] = census.values.len() as u16;
+    for (o, &v) in words[at + 1..].iter_mut().zip(&census.values) {
+        *o = v as u16;
+    }
+}
+
+/// Writes a dense block.
+pub(crate) fn write_dense(words: &mut [u16], cells: &[i16; BLOCK_CELLS]) {
+    for (o, &v) in words.iter_mut().zip(cells) {
+        *o = v as u16;
+    }
+}
+
+/// Applies disjoint miss and hit masks to a block's 512 values.
+pub(crate) fn apply_masks(
+    cells: &mut [i16; BLOCK_CELLS],
+    miss: &[u64; 8],
+    hit: &[u64; 8],
+    fixed: Fixed,
+) {
+    for w in 0..8 {
+        let mut bits = miss[w];
+        while bits != 0 {
+            let i = w << 6 | bits.trailing_zeros() as usize;
+            cells[i] = fixed.apply_miss(cells[i]);
+            bits &= bits - 1;
+        }
+        let mut bits = hit[w];
+        while bits != 0 {
+            let i = w << 6 | bits.trailing_zeros() as usize;
+            cells[i] = fixed.apply_hit(cells[i]);
+            bits &= bits - 1;
+        }
+    }
+}
+
+/// Calls `f` on the index of every set bit of a block mask.
+#[inline]
+pub(crate) fn for_bits(mask: &[u64; 8], mut f: impl FnMut(usize)) {
+    for (w, &m) in mask.iter().enumerate() {
+        let mut bits = m;
+        while bits != 0 {
+            f(w << 6 | bits.trailing_zeros() as usize);
+            bits &= bits - 1;
+        }
+    }
+}
+
+/// Updates a palette block in place when its value list has room: each cell of
+/// `miss` gets a miss and each of `hit` a hit, through a per-value map from old to
+/// new value numbers. Returns `false`, leaving the block as it was, when the new
+/// values do not fit in the width (then the caller re-encodes the block).
+pub(crate) fn palette_update(
+    words: &mut [u16],
+    w: u32,
+    miss: &[u64; 8],
+    hit: &[u64; 8],
+    fixed: Fixed,
+) -> bool {
+    let at = bits_words(w);
+    let k = words[at] as usize;
+    let room = if w <= 4 {
+        1 << w
+    } else {
+        (palette_units(w, k) * UNIT - at - 1).min(256)
+    };
+    // Which value numbers are missed and hit.
+    let mut missed = [0u64; 4];
+    let mut hits = [0u64; 4];
+    for_bits(miss, |i| {
+        let j = palette_index(words, w, i);
+        missed[j >> 6] |= 1 << (j & 63);
+    });
+    for_bits(hit, |i| {
+        let j = palette_index(words, w, i);
+        hits[j >> 6] |= 1 << (j & 63);
+    });
+    let mut values = [0i16; 256];
+    for (v, &x) in values.iter_mut().zip(&words[at + 1..at + 1 + k]) {
+        *v = x as i16;
+    }
+    let mut n = k;
+    let mut to_miss = [0u8; 256];
+    let mut to_hit = [0u8; 256];
+    for (set, to, hit) in [(&missed, &mut to_miss, false), (&hits, &mut to_hit, true)] {
+        for (q, &m) in set.iter().enumerate() {
+            let mut bits = m;
+            while bits != 0 {
+                let j = q << 6 | bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let v = if hit {
+                    fixed.apply_hit(values[j])
+                } else {
+                    fixed.apply_miss(values[j])
+                };
+                to[j] = match values[..n].iter().position(|&x| x == v) {
+                    Some(t) => t as u8,
+                    None if n < room => {
+                        values[n] = v;
+                        n += 1;
+                        (n - 1) as u8
+                    }
+                    None => return false,
+                };
+            }
+        }
+    }
+    for_bits(miss, |i| {
+        let j = palette_index(words, w, i);
+        set_palette_index(words, w, i, to_miss[j] as usize);
+    });
+    for_bits(hit, |i| {
+        let j = palette_index(words, w, i);
+        set_palette_index(words, w, i, to_hit[j] as usize);
+    });
+    words[at] = n as u16;
+    for (o, &v) in words[at + 1 + k..at + 1 + n].iter_mut().zip(&values[k..n]) {
+        *o = v as u16;
+    }
+    true
+}
+
+/// The value of every cell of a palette block when all cells hold the same
+/// value number.
+pub(crate) fn palette_single(words: &[u16], w: u32) -> Option<i16> {
+    let first = palette_index(words, w, 0);
+    // The first word repeated holds that number in every cell.
+    let mut pattern = 0u16;
+    for c in 0..16 / w as usize {
+        pattern |= (first as u16) << (c * w as usize);
+    }
+    words[..bits_words(w)]
+        .iter()
+        .all(|&x| x == pattern)
+        .then(|| words[bits_words(w) + 1 + first] as i16)
+}

@@ -1,0 +1,159 @@
+//! The store's invariants.
+
+use super::arena::UNIT;
+use super::forms::{
+    bits_words, palette_index, sparse_units, units_of, DENSE, EMPTY, PALETTE, SPARSE,
+    SPARSE_VALUES, UNIFORM,
+};
+use super::{join, Store, BLOCK_CELLS, TABLE};
+use crate::occupancy::sensor::{Fixed, UNKNOWN};
+
+impl Store {
+    /// Checks the invariants: the directory and the tables agree; every uniform
+    /// block is clamped; every arena block lies inside the arena, overlapping no
+    /// other block and no free chunk, and every unit is a block's or free; a sparse
+    /// block lists 1 to 512 cells in order with at most six distinct values, a
+    /// palette block's numbers lie in its value list of distinct values; every
+    /// value is unknown (palette, dense) or within the clamps; no block is all
+    /// unknown or uniformly clamped.
+    ///
+    /// # Panics
+    /// When an invariant is broken.
+    pub fn assert_valid(&self, fixed: Fixed) {
+        assert_eq!(self.keys.len(), self.top.len(), "one key per table");
+        assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
+        for (t, k) in self.keys.iter().enumerate() {
+            assert_eq!(self.top.get(k), Some(&(t as u32)), "superblock {k:?}");
+        }
+        if let Some((k, t)) = self.last {
+            assert_eq!(self.top.get(&k), Some(&t), "the last superblock");
+        }
+        let n_units = self.arena.len_units();
+        assert_eq!(self.arena.words.len(), n_units * UNIT, "arena length");
+        let mut owner = vec![false; n_units];
+        let mut claim = |at: usize, units: usize, what: &str| {
+            assert!(at + units <= n_units, "{what}: past the arena's end");
+            for u in &mut owner[at..at + units] {
+                assert!(!*u, "{what}: overlaps another chunk");
+                *u = true;
+            }
+        };
+        let mut free_units = 0;
+        for (units, list) in self.arena.free.iter().enumerate() {
+            for &at in list {
+                claim(at as usize, units, "a free chunk");
+                free_units += units;
+            }
+        }
+        assert_eq!(free_units, self.arena.free_units, "free units");
+        let in_clamps = |b: [i64; 3], v: i16| {
+            assert!(
+                (fixed.min..=fixed.max).contains(&v),
+                "block {b:?}: value {v} outside the clamps"
+            );
+        };
+        let mut blocks = 0;
+        let mut cells = [UNKNOWN; BLOCK_CELLS];
+        for (s, &e) in self.tables.iter().enumerate() {
+            let b = join(self.keys[s / TABLE], s % TABLE);
+            match e.tag() {
+                EMPTY => {
+                    assert_eq!(e.0, 0, "block {b:?}: empty entry with bits");
+                    continue;
+                }
+                UNIFORM => {
+                    let v = (e.0 >> 16) as u16 as i16;
+                    assert!(
+                        v == fixed.min || v == fixed.max,
+                        "uniform block {b:?} holds {v}, not a clamp"
+                    );
+                    assert_eq!(e.0 & 0xFFF8, 0, "block {b:?}: uniform entry with bits");
+                    blocks += 1;
+                    continue;
+                }
+                _ => {}
+            }
+            blocks += 1;
+            let at = e.offset() as usize;
+            assert!(at < n_units, "block {b:?}: offset past the arena");
+            let words = self.words_of(e);
+            let units = units_of(e.tag(), words);
+            claim(at, units, &format!("block {b:?}"));
+            let words = &words[..units * UNIT];
+            match e.tag() {
+                SPARSE => {
+                    let (len, k) = (words[0] as usize, words[1] as usize);
+                    assert!(
+                        (1..=BLOCK_CELLS).contains(&len),
+                        "sparse block {b:?}: {len} cells"
+                    );
+                    assert!(
+                        (1..=SPARSE_VALUES).contains(&k),
+                        "sparse block {b:?}: {k} values"
+                    );
+                    assert_eq!(units, sparse_units(len));
+                    let values = &words[2..2 + k];
+                    for (j, &v) in values.iter().enumerate() {
+                        in_clamps(b, v as i16);
+                        assert!(!values[..j].contains(&v), "sparse block {b:?}: value twice");
+                    }
+                    let list = &words[UNIT..UNIT + len];
+                    assert!(
+                        list.windows(2).all(|w| w[0] >> 3 < w[1] >> 3),
+                        "sparse block {b:?} is not sorted"
+                    );
+                    assert!(
+                        list.iter().all(|&c| usize::from(c & 7) < k),
+                        "sparse block {b:?}: a value number past its list"
+                    );
+                    assert!(
+                        words[UNIT + len..].iter().all(|&x| x == 0),
+                        "sparse block {b:?}: bits past its cells"
+                    );
+                }
+                DENSE => {}
+                t => {
+                    let w = 1 << (t - PALETTE);
+                    let k = words[bits_words(w)] as usize;
+                    assert!(
+                        (1..=1usize << w).contains(&k),
+                        "palette block {b:?}: {k} values for width {w}"
+                    );
+                    let values = &words[bits_words(w) + 1..bits_words(w) + 1 + k];
+                    for (j, &v) in values.iter().enumerate() {
+                        assert!(
+                            !values[..j].contains(&v),
+                            "palette block {b:?}: value twice"
+                        );
+                        if v as i16 != UNKNOWN {
+                            in_clamps(b, v as i16);
+                        }
+                    }
+                    for i in 0..BLOCK_CELLS {
+                        assert!(
+                            palette_index(words, w, i) < k,
+                            "palette block {b:?}: cell {i} past the value list"
+                        );
+                    }
+                }
+            }
+            super::forms::decode(e.tag(), words, &mut cells);
+            let known: Vec<i16> = cells.iter().copied().filter(|&v| v != UNKNOWN).collect();
+            assert!(
+                !known.is_empty(),
+                "block {b:?} is all unknown: it should be dropped"
+            );
+            known.iter().for_each(|&v| in_clamps(b, v));
+            let first = cells[0];
+            assert!(
+                !(cells.iter().all(|&v| v == first) && (first == fixed.min || first == fixed.max)),
+                "block {b:?} is uniformly clamped: it should be one entry"
+            );
+        }
+        assert_eq!(blocks, self.blocks, "block count");
+        assert!(
+            owner.iter().all(|&u| u),
+            "an arena unit is neither a block's nor free"
+        );
+    }
+}
