@@ -376,8 +376,8 @@ fn fast_sibling_check_matches_the_reference() {
             run[0] = Leaf::new(parent + (1 << (3 * u32::from(k))), k);
         }
         assert_eq!(
-            super::completes_parent_fast(&run),
-            super::completes_parent(&run),
+            super::canonical::completes_parent_fast(&run),
+            super::canonical::completes_parent(&run),
             "{run:?}"
         );
     }
