@@ -4,13 +4,9 @@
 mod common;
 
 use std::fs;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use common::{expect_success, run};
-
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
+use common::{expect_success, run, scenes};
 
 fn refused(dir: &Path, args: &[&str], needles: &[&str]) -> String {
     let out = run(dir, args);

@@ -4,13 +4,8 @@
 mod common;
 
 use std::fs;
-use std::path::{Path, PathBuf};
 
-use common::{json, ok, run, run_capped};
-
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
+use common::{build_scene, json, ok, run, run_capped, scenes};
 
 #[test]
 fn streamed_renders_equal_the_in_memory_ones() {
@@ -53,18 +48,7 @@ fn streamed_renders_equal_the_in_memory_ones() {
 fn a_damaged_chunk_is_named_by_file_and_chunk() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("fig4c-spheroid.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "s.tess",
-            "--depth",
-            "9",
-        ],
-    );
+    build_scene(d, "fig4c-spheroid.tss", "s.tess", 9);
     let chunks = tesseral::io::TessFile::open(&d.join("s.tess"))
         .unwrap()
         .chunks();

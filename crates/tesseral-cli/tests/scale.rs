@@ -3,13 +3,8 @@
 mod common;
 
 use std::fs;
-use std::path::{Path, PathBuf};
 
-use common::{fails, json, ok, run_capped};
-
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
+use common::{fails, json, ok, run_capped, scenes};
 
 /// A streamed build writes the same voxels as the in-memory one (compared voxel for
 /// voxel through `.xyz`), and its JSON says it streamed; a build to `.tess` streams

@@ -5,13 +5,8 @@
 mod common;
 
 use std::fs;
-use std::path::{Path, PathBuf};
 
-use common::{fails, json, ok, run, run_capped};
-
-fn scenes() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
+use common::{build_scene, fails, json, ok, run, run_capped, scenes};
 
 /// The streamed translation writes the very file the in-memory one writes (the
 /// in-memory path is taken for `-o - --format tess`), colours included, for
@@ -115,18 +110,7 @@ fn streamed_translation_equals_the_in_memory_one() {
 fn a_streamed_translation_too_far_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("showcase.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "a.tess",
-            "--depth",
-            "6",
-        ],
-    );
+    build_scene(d, "showcase.tss", "a.tess", 6);
     fails(
         d,
         &[
@@ -199,18 +183,7 @@ fn a_streamed_translation_fits_in_a_small_address_space() {
 fn translation_streams_by_itself_and_in_memory_is_budgeted() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("tank.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "a.tess",
-            "--depth",
-            "6",
-        ],
-    );
+    build_scene(d, "tank.tss", "a.tess", 6);
     let v = json(
         d,
         &[

@@ -6,7 +6,7 @@
 #![allow(dead_code)]
 
 use std::fs;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 use serde_json::Value;
@@ -91,4 +91,27 @@ pub fn run_capped(dir: &Path, args: &[&str], mib: u64) -> std::process::Output {
         .current_dir(dir)
         .output()
         .expect("run tesseral")
+}
+
+/// The repository's `scenes/` folder.
+pub fn scenes() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+/// Builds `scenes/SCENE` at `depth` into `dir/out` (which must succeed); returns
+/// the command's output.
+pub fn build_scene(dir: &Path, scene: &str, out: &str, depth: u8) -> String {
+    let path = scenes().join(scene);
+    let depth = depth.to_string();
+    ok(
+        dir,
+        &[
+            "build",
+            path.to_str().unwrap(),
+            "-o",
+            out,
+            "--depth",
+            &depth,
+        ],
+    )
 }
