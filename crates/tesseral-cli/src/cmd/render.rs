@@ -55,11 +55,13 @@ pub struct Args {
     #[arg(long, default_value_t = 0)]
     ao: u32,
     /// Cross-section: `x<C`, `y>C`, ... keeps the part on that side of the plane
-    /// (scene units for a scene, voxels for an octree file) and draws the cut faces.
+    /// (scene units for a scene; for a model file, the world units of its frame,
+    /// which are voxels when it has none) and draws the cut faces.
     #[arg(long)]
     cut: Option<String>,
     /// A 2-D slice instead of a 3-D view: `z=C` draws the layer of voxels at C
-    /// (scene units for a scene, voxels for an octree file) with its block outlines.
+    /// (scene units for a scene; for a model file, the world units of its frame,
+    /// which are voxels when it has none) with its block outlines.
     #[arg(long)]
     slice: Option<String>,
     /// Pixels per voxel of a slice (with --slice). [default: 4]
