@@ -32,31 +32,36 @@ fn missed(s: &Scratch) -> HashSet<[i64; 3]> {
     out
 }
 
+/// A random ray for case `case`: its resolution, origin and end. Long rays (up to
+/// 400 cells: many blocks, inside and beyond the dense index), dyadic coordinates
+/// (faces, edges, corners, ties between axes), negative keys, origins far from zero.
+fn random_ray(rng: &mut Pcg64, case: usize) -> (f64, [f64; 3], [f64; 3]) {
+    let res = [0.25, 0.05, 0.125, 1.0][case % 4];
+    let span = res * [4.0, 40.0, 400.0][case % 3];
+    let shift = [0.0, -1.0e4, 3.3e5][case % 3] * res;
+    let snap = |rng: &mut Pcg64, v: f64| {
+        if rng.random_range(0..3) == 0 {
+            (v / res * 4.0).round() * res / 4.0
+        } else {
+            v
+        }
+    };
+    let o = [0, 1, 2].map(|_| {
+        let v = rng.random_range(-res * 8.0..res * 8.0);
+        snap(rng, v) + shift
+    });
+    let e = [0, 1, 2].map(|i| {
+        let v = rng.random_range(-span..span);
+        snap(rng, v) + o[i]
+    });
+    (res, o, e)
+}
+
 #[test]
 fn fast_walk_marks_the_cells_of_the_reference_walk() {
     let mut rng = Pcg64::seed_from_u64(11);
     for case in 0..4000 {
-        let res = [0.25, 0.05, 0.125, 1.0][case % 4];
-        // Long rays (up to 400 cells: many blocks, inside and beyond the dense
-        // index), dyadic coordinates (faces, edges, corners, ties between axes),
-        // axis-parallel rays, negative keys, origins far from zero.
-        let span = res * [4.0, 40.0, 400.0][case % 3];
-        let shift = [0.0, -1.0e4, 3.3e5][case % 3] * res;
-        let snap = |rng: &mut Pcg64, v: f64| {
-            if rng.random_range(0..3) == 0 {
-                (v / res * 4.0).round() * res / 4.0
-            } else {
-                v
-            }
-        };
-        let o = [0, 1, 2].map(|_| {
-            let v = rng.random_range(-res * 8.0..res * 8.0);
-            snap(&mut rng, v) + shift
-        });
-        let mut e = [0, 1, 2].map(|i| {
-            let v = rng.random_range(-span..span);
-            snap(&mut rng, v) + o[i]
-        });
+        let (res, o, mut e) = random_ray(&mut rng, case);
         if case % 7 == 0 {
             let a = rng.random_range(0..3);
             for b in 0..3 {
@@ -166,24 +171,7 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
     let mut rng = Pcg64::seed_from_u64(13);
     let before = JUMPS.load(Ordering::Relaxed);
     for case in 0..4000 {
-        let res = [0.25, 0.05, 0.125, 1.0][case % 4];
-        let span = res * [4.0, 40.0, 400.0][case % 3];
-        let shift = [0.0, -1.0e4, 3.3e5][case % 3] * res;
-        let snap = |rng: &mut Pcg64, v: f64| {
-            if rng.random_range(0..3) == 0 {
-                (v / res * 4.0).round() * res / 4.0
-            } else {
-                v
-            }
-        };
-        let o = [0, 1, 2].map(|_| {
-            let v = rng.random_range(-res * 8.0..res * 8.0);
-            snap(&mut rng, v) + shift
-        });
-        let mut e = [0, 1, 2].map(|i| {
-            let v = rng.random_range(-span..span);
-            snap(&mut rng, v) + o[i]
-        });
+        let (res, o, mut e) = random_ray(&mut rng, case);
         match case % 7 {
             // Along an axis.
             0 => {
