@@ -36,6 +36,8 @@ mod start;
 pub mod stats;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_balance;
 pub mod topology;
 
 pub use chain::{Chain, Checkpoint, Counters, Params, Sample, CHECKPOINT_FORMAT};

@@ -1,0 +1,182 @@
+//! `tesseral map`'s sensor options, its errors on bad scans, and OctoMap's key range.
+
+use super::*;
+
+#[test]
+fn sensor_options_change_the_map() {
+    let dir = setup();
+    let d = dir.path();
+    let base = ["map", "room.log", "--resolution", "0.1", "--json", "-o"];
+    let with = |out: &str, extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.push(out);
+        a.extend_from_slice(extra);
+        json(d, &a)
+    };
+    let plain = with("plain.ot", &[]);
+    // Rays cut at 1 m: fewer hits, the cut rays free only up to the range.
+    let cut = with("cut.ot", &["--max-range", "1"]);
+    assert!(
+        cut["occupied"].as_u64() < plain["occupied"].as_u64(),
+        "{cut} {plain}"
+    );
+    assert!(cut["free"].as_u64() < plain["free"].as_u64());
+    // A threshold above a single hit's probability: one hit is not occupied.
+    let strict = with("strict.ot", &["--threshold", "0.9"]);
+    assert!(
+        strict["occupied"].as_u64() < plain["occupied"].as_u64(),
+        "{strict}"
+    );
+    // Other hit and miss probabilities change the log-odds stored in the .ot.
+    with(
+        "odds.ot",
+        &[
+            "--prob-hit",
+            "0.9",
+            "--prob-miss",
+            "0.2",
+            "--clamp",
+            "0.05,0.99",
+        ],
+    );
+    assert_ne!(
+        fs::read(d.join("odds.ot")).unwrap(),
+        fs::read(d.join("plain.ot")).unwrap()
+    );
+    fails(
+        d,
+        &[
+            "map",
+            "room.log",
+            "-o",
+            "x.bt",
+            "--resolution",
+            "0.1",
+            "--prob-hit",
+            "0.4",
+        ],
+        "hit",
+    );
+    fails(
+        d,
+        &[
+            "map",
+            "room.log",
+            "-o",
+            "x.bt",
+            "--resolution",
+            "0.1",
+            "--clamp",
+            "0.9,0.1",
+        ],
+        "clamp",
+    );
+    fails(
+        d,
+        &["map", "room.log", "-o", "x.bt", "--resolution", "0"],
+        "--resolution",
+    );
+    fails(
+        d,
+        &[
+            "map",
+            "room.log",
+            "-o",
+            "x.bt",
+            "--resolution",
+            "0.1",
+            "--max-range",
+            "-1",
+        ],
+        "--max-range",
+    );
+    assert!(!d.join("x.bt").exists());
+}
+
+#[test]
+fn bad_scans_are_errors_naming_file_and_place() {
+    let dir = setup();
+    let d = dir.path();
+    fs::write(d.join("bad.log"), "NODE 0 0 0 0 0 0\n1 2 3\n1 zz 3\n").unwrap();
+    fails(
+        d,
+        &["map", "bad.log", "-o", "m.bt", "--resolution", "0.1"],
+        "bad.log:3:3",
+    );
+    fs::write(d.join("orphan.log"), "1 2 3\n").unwrap();
+    fails(
+        d,
+        &["map", "orphan.log", "-o", "m.bt", "--resolution", "0.1"],
+        "before the first `NODE",
+    );
+    let mut g = graph::encode(&two_scans());
+    g.truncate(5000);
+    fs::write(d.join("cut.graph"), g).unwrap();
+    fails(
+        d,
+        &["map", "cut.graph", "-o", "m.bt", "--resolution", "0.1"],
+        "cut.graph: byte 4: node 0 claims 400 points; the file is too short",
+    );
+    fs::write(d.join("z.pcd"), "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nPOINTS 1\nDATA binary_compressed\n").unwrap();
+    fails(
+        d,
+        &["map", "z.pcd", "-o", "m.bt", "--resolution", "0.1"],
+        "line 7: PCD `DATA binary_compressed` is not supported",
+    );
+    fails(
+        d,
+        &["map", "room.txt", "-o", "m.bt", "--resolution", "0.1"],
+        "not a scan file",
+    );
+    fails(
+        d,
+        &["map", "missing.log", "-o", "m.bt", "--resolution", "0.1"],
+        "missing.log",
+    );
+    fails(
+        d,
+        &["map", "room.log", "-o", "m.jpg", "--resolution", "0.1"],
+        "does not write .jpg",
+    );
+    fails(
+        d,
+        &["map", "cloud.xyz", "-o", "cloud.xyz", "--resolution", "0.1"],
+        "refusing to overwrite an input",
+    );
+    assert!(!d.join("m.bt").exists());
+}
+
+#[test]
+fn a_map_beyond_octomap_keys_is_refused_in_bt_and_kept_in_tess() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 2,000 m at 1 cm is 200,000 cells from the origin: past OctoMap's 32,768.
+    fs::write(d.join("far.log"), "NODE 0 0 0 0 0 0\n2000 0 0\n").unwrap();
+    fails(
+        d,
+        &["map", "far.log", "-o", "far.bt", "--resolution", "0.01"],
+        "−32768..32767",
+    );
+    fails(
+        d,
+        &["map", "far.log", "-o", "far.ot", "--resolution", "0.01"],
+        "−32768..32767",
+    );
+    let v = json(
+        d,
+        &[
+            "map",
+            "far.log",
+            "-o",
+            "far.tess",
+            "--resolution",
+            "0.01",
+            "--json",
+        ],
+    );
+    assert_eq!(v["occupied"], 1);
+    assert_eq!(v["free"], 200_000);
+    let info = json(d, &["info", "--json", "far.tess"]);
+    assert_eq!(info["voxels"], 1);
+    assert_eq!(info["free_voxels"], 200_000);
+}
