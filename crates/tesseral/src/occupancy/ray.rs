@@ -346,20 +346,4 @@ impl Scratch {
         let s = self.slot(c.map(|x| x >> BLOCK_LOG2));
         self.blocks[s].hit[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
     }
-
-    /// Adds another thread's updates.
-    pub fn merge(mut self, other: Self) -> Self {
-        if self.blocks.len() < other.blocks.len() {
-            return other.merge(self);
-        }
-        for m in other.blocks {
-            let s = self.slot(m.key);
-            let t = &mut self.blocks[s];
-            for w in 0..8 {
-                t.miss[w] |= m.miss[w];
-                t.hit[w] |= m.hit[w];
-            }
-        }
-        self
-    }
 }

@@ -1,5 +1,6 @@
-//! Scan insertion: rays cast in parallel into per-thread hit/miss masks, merged,
-//! sorted in tesseral order of blocks, and applied block by block.
+//! Scan insertion: rays cast in parallel into per-thread hit/miss masks, sorted in
+//! tesseral order of blocks, and applied block by block (a block's masks from several
+//! threads merged there).
 
 use rayon::prelude::*;
 
@@ -96,6 +97,71 @@ fn block_code(b: [i64; 3]) -> u128 {
     encode_wide(u[0], u[1], u[2])
 }
 
+/// A block of a scan: its scratch and its index there.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+struct Place {
+    scratch: u32,
+    index: u32,
+}
+
+/// The blocks of the scratches in tesseral order of their keys (a key in several
+/// scratches: side by side, in scratch order).
+///
+/// The codes' high 64 bits take few values (a scene spans far fewer than 2^21
+/// blocks per axis, and the sign offset splits it in at most eight parts): the blocks
+/// are put in buckets by those bits and each bucket sorted on the low 64 bits, which
+/// moves half the bytes of sorting the whole codes. Many high values (a scan over
+/// thousands of kilometres): one sort of whole codes.
+fn tesseral_order(blocks: &[&[Masks]]) -> Vec<Place> {
+    let codes: Vec<(u128, Place)> = blocks
+        .par_iter()
+        .enumerate()
+        .flat_map_iter(|(s, b)| {
+            b.iter().enumerate().map(move |(i, m)| {
+                let p = Place {
+                    scratch: s as u32,
+                    index: i as u32,
+                };
+                (block_code(m.key), p)
+            })
+        })
+        .collect();
+    let mut highs: Vec<u64> = Vec::new();
+    let mut last = None;
+    for &(c, _) in &codes {
+        let h = (c >> 64) as u64;
+        if last != Some(h) && !highs.contains(&h) {
+            highs.push(h);
+            if highs.len() > 64 {
+                let mut codes = codes;
+                codes.par_sort_unstable();
+                return codes.into_iter().map(|(_, p)| p).collect();
+            }
+        }
+        last = Some(h);
+    }
+    highs.sort_unstable();
+    let mut buckets: Vec<Vec<(u64, Place)>> = vec![Vec::new(); highs.len()];
+    let mut last = (u64::MAX, 0);
+    for &(c, p) in &codes {
+        let h = (c >> 64) as u64;
+        if h != last.0 {
+            last = (
+                h,
+                highs.binary_search(&h).unwrap_or_else(|_| unreachable!()),
+            );
+        }
+        buckets[last.1].push((c as u64, p));
+    }
+    drop(codes);
+    let mut out = Vec::new();
+    for mut b in buckets {
+        b.par_sort_unstable();
+        out.extend(b.into_iter().map(|(_, p)| p));
+    }
+    out
+}
+
 impl OccupancyMap {
     /// Inserts a scan taken from `origin`: see the [module docs](super) for the
     /// semantics (OctoMap's `insertPointCloud`). `max_range` of `None`, negative or
@@ -141,11 +207,11 @@ impl OccupancyMap {
         };
         let (order, skipped) = by_direction(origin, points);
         // Few chunks of the rays in direction order (one per thread alone, four per
-        // thread with more, for balance): each has its own scratch, merged at the end.
+        // thread with more, for balance): each has its own scratch.
         let threads = rayon::current_num_threads();
         let pieces = if threads == 1 { 1 } else { 4 * threads };
         let chunk = order.len().div_ceil(pieces).max(CHUNK);
-        let scratch = order
+        let scratches: Vec<Scratch> = order
             .par_chunks(chunk)
             .with_min_len(1)
             .fold(
@@ -157,18 +223,14 @@ impl OccupancyMap {
                     s
                 },
             )
-            .reduce(|| Scratch::new(block_of_origin), Scratch::merge);
+            .collect();
         stats.skipped = skipped;
         stats.rays = stats.points - skipped;
-        // The blocks in tesseral order: their codes sorted beside their places.
-        let mut order: Vec<(u128, u32)> = scratch
-            .blocks
-            .par_iter()
-            .enumerate()
-            .map(|(i, m)| (block_code(m.key), i as u32))
-            .collect();
-        order.par_sort_unstable();
-        let (hits, misses) = self.apply(&scratch.blocks, &order);
+        // The blocks of all scratches in tesseral order (a block in several scratches
+        // comes once per scratch, side by side: merged as it is applied).
+        let blocks: Vec<&[Masks]> = scratches.iter().map(|s| &s.blocks[..]).collect();
+        let order = tesseral_order(&blocks);
+        let (hits, misses) = self.apply(&blocks, &order);
         stats.hits = hits;
         stats.misses = misses;
         stats
@@ -189,19 +251,83 @@ impl OccupancyMap {
         self.insert_scan(pose.translation, &world, max_range)
     }
 
-    /// Applies the masks of a scan, block by block in the order given; returns the
-    /// numbers of cells hit and missed.
-    fn apply(&mut self, blocks: &[Masks], order: &[(u128, u32)]) -> (u64, u64) {
+    /// Applies the masks of a scan, block by block in the order given (the masks of
+    /// one block, in several scratches, side by side); returns the numbers of cells
+    /// hit and missed.
+    fn apply(&mut self, blocks: &[&[Masks]], order: &[Place]) -> (u64, u64) {
         let fixed = self.fixed;
         let (mut hits, mut misses) = (0u64, 0u64);
-        self.store.reserve(blocks.len() / 4);
-        for &(_, i) in order {
-            let m = &blocks[i as usize];
-            let miss: [u64; 8] = std::array::from_fn(|w| m.miss[w] & !m.hit[w]);
-            hits += u64::from(m.hit.iter().map(|w| w.count_ones()).sum::<u32>());
+        self.store.reserve(order.len() / 4);
+        let mut i = 0;
+        while i < order.len() {
+            let at = |p: &Place| &blocks[p.scratch as usize][p.index as usize];
+            let m = at(&order[i]);
+            let (mut miss, mut hit) = (m.miss, m.hit);
+            i += 1;
+            while i < order.len() && at(&order[i]).key == m.key {
+                let o = at(&order[i]);
+                for w in 0..8 {
+                    miss[w] |= o.miss[w];
+                    hit[w] |= o.hit[w];
+                }
+                i += 1;
+            }
+            for w in 0..8 {
+                miss[w] &= !hit[w];
+            }
+            hits += u64::from(hit.iter().map(|w| w.count_ones()).sum::<u32>());
             misses += u64::from(miss.iter().map(|w| w.count_ones()).sum::<u32>());
-            self.store.update(m.key, &miss, &m.hit, fixed);
+            self.store.update(m.key, &miss, &hit, fixed);
         }
         (hits, misses)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    /// The bucketed order against one sort of whole codes: keys near the origin
+    /// (both signs, few high parts) and keys over the whole range (the fallback), a
+    /// key in several scratches among them.
+    #[test]
+    fn blocks_come_in_tesseral_order_duplicates_side_by_side() {
+        let mut rng = Pcg64::seed_from_u64(5);
+        for (round, span) in [40i64, 1 << 20, 1 << 41, 3].into_iter().enumerate() {
+            let scratches: Vec<Vec<Masks>> = (0..3)
+                .map(|_| {
+                    let mut seen = std::collections::HashSet::new();
+                    (0..2000)
+                        .map(|_| [0, 1, 2].map(|_| rng.random_range(-span..span)))
+                        .filter(|k| seen.insert(*k))
+                        .map(|key| Masks {
+                            miss: [0; 8],
+                            hit: [0; 8],
+                            key,
+                        })
+                        .collect()
+                })
+                .collect();
+            let blocks: Vec<&[Masks]> = scratches.iter().map(|s| &s[..]).collect();
+            let got = tesseral_order(&blocks);
+            let mut want: Vec<(u128, Place)> = blocks
+                .iter()
+                .enumerate()
+                .flat_map(|(s, b)| {
+                    b.iter().enumerate().map(move |(i, m)| {
+                        let p = Place {
+                            scratch: s as u32,
+                            index: i as u32,
+                        };
+                        (block_code(m.key), p)
+                    })
+                })
+                .collect();
+            want.sort_unstable();
+            let want: Vec<Place> = want.into_iter().map(|(_, p)| p).collect();
+            assert_eq!(got, want, "round {round}");
+        }
     }
 }

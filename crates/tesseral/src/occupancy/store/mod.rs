@@ -5,6 +5,7 @@
 
 mod arena;
 mod forms;
+mod fresh;
 mod sparse;
 mod valid;
 
@@ -341,7 +342,8 @@ impl Store {
                 apply_masks(&mut cells, miss, hit, fixed);
                 self.put_slot(s, &cells, fixed);
             }
-            EMPTY | SPARSE => self.update_sparse(s, e, miss, hit, fixed),
+            EMPTY => self.update_empty(s, miss, hit, fixed),
+            SPARSE => self.update_sparse(s, e, miss, hit, fixed),
             DENSE => {
                 let at = e.offset();
                 let mut cells = [0i16; BLOCK_CELLS];
