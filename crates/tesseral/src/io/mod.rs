@@ -36,6 +36,7 @@ mod sniff;
 mod spool;
 pub(crate) mod tess_colours;
 mod tess_file;
+mod tess_v1;
 pub mod vox;
 pub mod xyz;
 

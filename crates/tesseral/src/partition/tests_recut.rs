@@ -66,9 +66,14 @@ fn random_model(rng: &mut rand_pcg::Pcg64, i: usize) -> Model {
 #[derive(Clone, Copy, Debug)]
 enum Input {
     V2,
+    /// Decoded whole when opened.
     V1,
+    /// Opened by `TessFile::open_streaming`: its payload indexed in stretches.
+    V1Streamed,
     Dataset,
 }
+
+const KINDS: [Input; 4] = [Input::V2, Input::V1, Input::V1Streamed, Input::Dataset];
 
 /// Writes `model` as the input `kind` under `dir` (named by `tag`) and opens its
 /// files in code order.
@@ -80,14 +85,19 @@ fn input_files(
     tag: &str,
 ) -> Vec<TessFile> {
     match kind {
-        Input::V2 | Input::V1 => {
+        Input::V2 | Input::V1 | Input::V1Streamed => {
             let path = dir.join(format!("{tag}.tess"));
             let bytes = match kind {
                 Input::V2 => native::tests::encode_chunked(model, rng.random_range(1..6)),
                 _ => native::tests::encode_v1(model),
             };
             std::fs::write(&path, bytes).unwrap();
-            vec![TessFile::open(&path).unwrap()]
+            let f = match kind {
+                Input::V1Streamed => TessFile::open_streaming(&path).unwrap(),
+                _ => TessFile::open(&path).unwrap(),
+            };
+            assert_eq!(f.is_streamed(), !matches!(kind, Input::V1));
+            vec![f]
         }
         Input::Dataset => {
             let ranges = random_ranges(rng, model.tree.depth());
@@ -130,7 +140,7 @@ fn streamed_datasets_equal_the_in_memory_cut() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(15);
     for i in 0..48 {
         let model = random_model(&mut rng, i);
-        let kind = [Input::V2, Input::V1, Input::Dataset][i % 3];
+        let kind = KINDS[i % 4];
         let files = input_files(&mut rng, &model, kind, d, &format!("in{i}"));
         let k = rng.random_range(1..7);
         let ranges = leaf_ranges(&files, k).unwrap();
@@ -198,7 +208,7 @@ fn streamed_xyz_equals_the_in_memory_list() {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(16);
     for i in 0..36 {
         let model = random_model(&mut rng, i);
-        let kind = [Input::V2, Input::V1, Input::Dataset][i % 3];
+        let kind = KINDS[i % 4];
         let files = input_files(&mut rng, &model, kind, d, &format!("x{i}"));
         let facts = leaf_facts(&files).unwrap();
         let t = &model.tree;

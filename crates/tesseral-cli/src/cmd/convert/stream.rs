@@ -41,8 +41,20 @@ fn colour_count(op: &Operand) -> Result<usize> {
 /// only layer is colours, after checking the streamed memory against `--memory`;
 /// `None` (read it in memory) otherwise.
 pub fn open(args: &Args) -> Result<Option<(Operand, usize)>> {
-    let Some(op) = streamed::open_operand(&args.input, &args.budget)? else {
-        return Ok(None);
+    let input = &args.input;
+    let op = if input.is_file() && io::extension(input) == "tess" {
+        // A version-1 file streams too: its payload is indexed in one pass.
+        let f = io::TessFile::open_streaming(input)?;
+        Operand {
+            frame: f.frame(),
+            bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
+            files: vec![f],
+        }
+    } else {
+        match streamed::open_operand(input, &args.budget)? {
+            Some(op) => op,
+            None => return Ok(None),
+        }
     };
     if !op.colours_only()? {
         return Ok(None);
@@ -56,18 +68,17 @@ pub fn open(args: &Args) -> Result<Option<(Operand, usize)>> {
     Ok(Some((op, colours)))
 }
 
-/// A `.tess` file or a dataset into a `.tess` file, chunk by chunk with the colour
-/// regions as streams (`partition::stream_concat`): never the whole tree in
-/// memory. `false` (nothing done) for other inputs and outputs, and for
-/// version-1 files and files with layers other than colours.
+/// A `.tess` file (either version) or a dataset into a `.tess` file, chunk by
+/// chunk with the colour regions as streams (`partition::stream_concat`): never
+/// the whole tree in memory. `false` (nothing done) for other inputs and
+/// outputs, and for files with layers other than colours.
 pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
     if output::is_stdio(out) || io::extension(out) != "tess" {
         return Ok(false);
     }
     let input = &args.input;
-    let is_v2_file =
-        input.is_file() && io::extension(input) == "tess" && !streamed::is_version_1(input)?;
-    if !(tesseral::partition::is_dataset(input) || is_v2_file) {
+    let is_tess = input.is_file() && io::extension(input) == "tess";
+    if !(tesseral::partition::is_dataset(input) || is_tess) {
         return Ok(false);
     }
     let Some((op, _)) = open(args)? else {
@@ -104,8 +115,7 @@ pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
     Ok(true)
 }
 
-/// A `.tess` file (either version; a version-1 file is decoded whole under
-/// `--memory` first) or a dataset into an `.xyz` voxel list (or `-o - --format
+/// A `.tess` file (either version) or a dataset into an `.xyz` voxel list (or `-o - --format
 /// xyz`): one pass counts the voxels and the bounding box (for the header and the
 /// `--max-output` check, before anything is written), a second writes the voxels
 /// a chunk at a time. The bytes of the in-memory path. `false` for other inputs
