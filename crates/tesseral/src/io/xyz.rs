@@ -109,7 +109,7 @@ pub fn write(w: &mut dyn Write, tree: &LinearOctree) -> io::Result<()> {
     Ok(())
 }
 
-/// Writes the header line of a list of `voxels` voxels (what [`write`] starts
+/// Writes the header line of a list of `voxels` voxels (what [`write()`] starts
 /// with), for a writer that streams the leaves with [`write_leaf`].
 ///
 /// # Errors
@@ -122,7 +122,7 @@ pub fn write_header(w: &mut dyn Write, voxels: u64) -> io::Result<()> {
 }
 
 /// Writes the voxels of `leaf` (a leaf of a space whose lowest voxel is
-/// `origin`) one per line, in tesseral order, as [`write`] does.
+/// `origin`) one per line, in tesseral order, as [`write()`] does.
 ///
 /// # Errors
 /// Any I/O error of `w`.
