@@ -101,7 +101,8 @@ fn names(dir: &Path) -> Vec<String> {
 
 /// On seeded random models (colours, frames, empty ones), from a version-2 file,
 /// a version-1 file and a dataset: the streamed `.xyz` (to a file and to standard
-/// output) is the in-memory one byte for byte with the same report; `--parts K`
+/// output) is the in-memory one byte for byte with the same report; into a
+/// `.tess` it streams and writes the model's own file; `--parts K`
 /// streams, and from one file writes the in-memory cut's dataset byte for byte;
 /// the dataset joined again is the original file, and `info` of it is `info` of
 /// the original.
@@ -146,6 +147,14 @@ fn streamed_conversions_equal_the_in_memory_ones() {
             assert_eq!(
                 v["colors"],
                 serde_json::json!(model.colors.as_ref().map(|c| c.voxel_count())),
+                "{what}"
+            );
+            // Into a .tess (a version-1 file too): the model's own file.
+            let v = json(d, &["convert", input, "-o", "t.tess", "--json"]);
+            assert_eq!(v["streamed"], true, "{what}");
+            assert_eq!(
+                fs::read(d.join("t.tess")).unwrap(),
+                fs::read(d.join("m.tess")).unwrap(),
                 "{what}"
             );
             let out = run(d, &["convert", input, "-o", "-", "--format", "xyz"]);
