@@ -5,6 +5,9 @@
 //! voxels the surface touches, for meshes that are not watertight. Meshes going out
 //! (`.stl`, `.obj`, `.ply`, `.glb`) are the exact boundary, or with `--smooth` a
 //! surface-nets surface.
+//!
+//! From a `.tess` file or a dataset, a `.tess` or `.xyz` output streams (a chunk at
+//! a time, [`stream`]), and `--parts K` writes a dataset of K parts ([`parts`]).
 
 use std::path::PathBuf;
 
@@ -14,6 +17,9 @@ use tesseral::mesh::{MeshOptions, Resolution, VoxelizeOptions, MAX_VOXELIZE_DEPT
 
 use super::budget::Budget;
 use super::octree;
+
+mod parts;
+mod stream;
 
 fn output_is_stdout(path: &std::path::Path) -> bool {
     super::output::is_stdio(path)
@@ -50,6 +56,11 @@ pub struct Args {
     /// blocky boundary.
     #[arg(long)]
     pub smooth: bool,
+    /// Write a partitioned dataset of K parts of about equal leaf counts: OUTPUT is
+    /// a directory of `.tess` parts and a `manifest.json` (as `build --parts`). From
+    /// a `.tess` file or a dataset it streams.
+    #[arg(long, value_name = "K", conflicts_with_all = ["smooth", "format"])]
+    pub parts: Option<usize>,
     /// Print a summary as JSON.
     #[arg(long)]
     pub json: bool,
@@ -64,10 +75,6 @@ pub fn run(mut args: Args) -> Result<()> {
     let Some(out) = args.output.take().or(args.output_positional.take()) else {
         bail!("convert: give the output file, as `convert IN OUT` or `convert IN -o OUT`");
     };
-    octree::guard(&out, &[&args.input], &args.limits)?;
-    if output_is_stdout(&out) && args.json {
-        bail!("--json: standard output already holds the octree (-o -)");
-    }
     // Flags that do not apply are errors, not silently ignored.
     let mesh_in = MESH_IN.contains(&io::extension(&args.input).as_str());
     let mesh_out = MESH_OUT.contains(&args.limits.format_of(&out).as_str());
@@ -91,39 +98,23 @@ pub fn run(mut args: Args) -> Result<()> {
             out.display()
         );
     }
-    let resolution = match (args.depth, args.voxel_size) {
-        (Some(d), _) => {
-            if d > MAX_VOXELIZE_DEPTH {
-                bail!("--depth {d}: at most {MAX_VOXELIZE_DEPTH}");
-            }
-            Resolution::Depth(d)
-        }
-        (None, Some(h)) => {
-            if !(h.is_finite() && h > 0.0) {
-                bail!("--voxel-size {h}: must be a positive number");
-            }
-            Resolution::VoxelSize(h)
-        }
-        (None, None) => Resolution::Depth(8),
-    };
-    let read = ReadOptions {
-        mesh: VoxelizeOptions {
-            resolution,
-            surface_only: args.surface_only,
-            // A crossing is 8 bytes, held about three times over while it is
-            // sorted and indexed.
-            max_crossings: usize::try_from(args.budget.memory / 24).unwrap_or(usize::MAX),
-            max_leaves: args.budget.leaf_cap(),
-        },
-    };
+    let read = read_options(&args)?;
+    if let Some(k) = args.parts {
+        return parts::run(&args, &out, k, &read);
+    }
+    octree::guard(&out, &[&args.input], &args.limits)?;
+    if output_is_stdout(&out) && args.json {
+        bail!("--json: standard output already holds the octree (-o -)");
+    }
     let write = WriteOptions {
         mesh: MeshOptions {
             smooth: args.smooth,
         },
     };
-    if streamed(&args, &out)? {
+    if stream::to_tess(&args, &out)? || stream::to_xyz(&args, &out)? {
         return Ok(());
     }
+    stream::check_in_memory(&args)?;
     let model = octree::read_model(&args.input, &args.budget, &read)?;
     octree::save(&out, &model, &args.limits, &write)?;
     if args.json {
@@ -147,64 +138,32 @@ pub fn run(mut args: Args) -> Result<()> {
     Ok(())
 }
 
-/// A version-2 `.tess` file, or a dataset of them, into a `.tess` file, chunk by
-/// chunk with the colour regions as streams (`partition::stream_concat`): never the
-/// whole tree in memory. `false` (nothing done) for other inputs and outputs, and
-/// for files with layers other than colours.
-fn streamed(args: &Args, out: &std::path::Path) -> Result<bool> {
-    use tesseral::io::TessFile;
-    use tesseral::partition::{is_dataset, open_part, read_manifest};
-    if output_is_stdout(out) || io::extension(out) != "tess" {
-        return Ok(false);
-    }
-    let input = &args.input;
-    let size = |p: &std::path::Path| std::fs::metadata(p).map_or(0, |m| m.len());
-    let (files, frame, bytes) = if is_dataset(input) {
-        let m = read_manifest(input)?;
-        let mut files = Vec::with_capacity(m.parts.len());
-        let mut bytes = 0u64;
-        for (i, p) in m.parts.iter().enumerate() {
-            bytes += size(&input.join(&p.file));
-            files.push(open_part(input, &m, i)?);
+/// How the input is read: a mesh voxelized at `--depth` or `--voxel-size`, within
+/// `--memory`.
+fn read_options(args: &Args) -> Result<ReadOptions> {
+    let resolution = match (args.depth, args.voxel_size) {
+        (Some(d), _) => {
+            if d > MAX_VOXELIZE_DEPTH {
+                bail!("--depth {d}: at most {MAX_VOXELIZE_DEPTH}");
+            }
+            Resolution::Depth(d)
         }
-        let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
-        (files, frame, bytes)
-    } else if input.is_file() && io::extension(input) == "tess" {
-        let f = TessFile::open(input)?;
-        let frame = f.frame();
-        (vec![f], frame, size(input))
-    } else {
-        return Ok(false);
+        (None, Some(h)) => {
+            if !(h.is_finite() && h > 0.0) {
+                bail!("--voxel-size {h}: must be a positive number");
+            }
+            Resolution::VoxelSize(h)
+        }
+        (None, None) => Resolution::Depth(8),
     };
-    for f in &files {
-        if !f.is_streamed() || (f.has_layers() && f.colour_streams()?.is_none()) {
-            return Ok(false);
-        }
-    }
-    // The copy holds the same leaves and colours: about the inputs' size.
-    super::output::check_size(out, bytes, args.limits.limits.max_output)?;
-    let spool_dir = super::streamed::spool_dir(out);
-    let mut summary = tesseral::partition::StreamSummary::default();
-    io::write_atomic(out, |w| {
-        summary = tesseral::partition::stream_concat(&files, frame, w, &spool_dir)
-            .map_err(std::io::Error::other)?;
-        Ok(())
+    Ok(ReadOptions {
+        mesh: VoxelizeOptions {
+            resolution,
+            surface_only: args.surface_only,
+            // A crossing is 8 bytes, held about three times over while it is
+            // sorted and indexed.
+            max_crossings: usize::try_from(args.budget.memory / 24).unwrap_or(usize::MAX),
+            max_leaves: args.budget.leaf_cap(),
+        },
     })
-    .map_err(|e| anyhow::anyhow!("writing {}: {e}", out.display()))?;
-    if args.json {
-        let first = &files[0];
-        let summary = serde_json::json!({
-            "input": args.input,
-            "output": out,
-            "voxels": summary.voxels,
-            "leaves": summary.leaves,
-            "depth": first.depth(),
-            "origin": first.origin(),
-            "voxel_size": frame.voxel_size,
-            "translate": frame.translate,
-            "streamed": true,
-        });
-        crate::outln!("{summary}")?;
-    }
-    Ok(true)
 }

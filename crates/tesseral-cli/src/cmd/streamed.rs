@@ -53,7 +53,7 @@ fn file_len(path: &Path) -> Result<u64> {
 }
 
 /// Whether `path` is a `.tess` file of version 1 (one payload, decoded whole).
-fn is_version_1(path: &Path) -> Result<bool> {
+pub fn is_version_1(path: &Path) -> Result<bool> {
     use std::io::Read;
     let mut head = [0u8; 10];
     let mut f =

@@ -43,20 +43,7 @@ const MESH_BYTES_PER_LEAF: u64 = 12 * 50;
 pub fn estimate_output_bytes(tree: &LinearOctree, ext: &str) -> Option<u64> {
     let leaves = tree.leaf_count() as u64;
     let bytes = match ext {
-        "xyz" => {
-            let line = match tree.bbox() {
-                // Three numbers, two spaces and a newline.
-                Some((lo, hi)) => {
-                    let width = (0..3)
-                        .map(|a| decimal_width(lo[a]).max(decimal_width(hi[a])))
-                        .max()
-                        .unwrap_or(1);
-                    3 * width + 3
-                }
-                None => 0,
-            };
-            80u64.saturating_add(tree.voxel_count().saturating_mul(line))
-        }
+        "xyz" => estimate_xyz_bytes(tree.voxel_count(), tree.bbox()),
         // Header, frame and trailer; ten bytes a leaf at most; 68 bytes a chunk (its
         // header, checksum and index entry).
         "tess" => 200u64
@@ -81,6 +68,31 @@ pub fn estimate_output_bytes(tree: &LinearOctree, ext: &str) -> Option<u64> {
         _ => return None,
     };
     Some(bytes)
+}
+
+/// The `.xyz` estimate of [`estimate_output_bytes`] from the voxel count and the
+/// bounding box (lowest and highest voxels, `None` when empty), for a writer that
+/// counts them without holding the tree: one line per voxel, each as long as the
+/// widest coordinates allow (an upper bound).
+///
+/// ```
+/// assert_eq!(tesseral::io::estimate_xyz_bytes(0, None), 80);
+/// assert!(tesseral::io::estimate_xyz_bytes(2, Some(([0; 3], [9; 3]))) >= 2 * 6);
+/// ```
+#[must_use]
+pub fn estimate_xyz_bytes(voxels: u64, bbox: Option<([i64; 3], [i64; 3])>) -> u64 {
+    let line = match bbox {
+        // Three numbers, two spaces and a newline.
+        Some((lo, hi)) => {
+            let width = (0..3)
+                .map(|a| decimal_width(lo[a]).max(decimal_width(hi[a])))
+                .max()
+                .unwrap_or(1);
+            3 * width + 3
+        }
+        None => 0,
+    };
+    80u64.saturating_add(voxels.saturating_mul(line))
 }
 
 /// Estimates the size of a PNG image of `width` × `height` RGB pixels: at most

@@ -36,6 +36,7 @@ mod sniff;
 mod spool;
 pub(crate) mod tess_colours;
 mod tess_file;
+mod tess_v1;
 pub mod vox;
 pub mod xyz;
 
@@ -43,7 +44,7 @@ mod error;
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
 pub use chunked::{ChunkInfo, TessWriter, DEFAULT_CHUNK_LEAVES};
 pub use error::FormatError;
-pub use estimate::{estimate_image_bytes, estimate_output_bytes};
+pub use estimate::{estimate_image_bytes, estimate_output_bytes, estimate_xyz_bytes};
 pub use reframe::reframe;
 pub use sniff::sniff_format;
 pub use spool::LeafSpool;

@@ -19,6 +19,8 @@ pub struct RegionLeaves<'a> {
     space_end: u64,
     depth: u8,
     failed: bool,
+    /// What the leaves are, in errors.
+    what: &'static str,
 }
 
 impl Iterator for RegionLeaves<'_> {
@@ -31,7 +33,8 @@ impl Iterator for RegionLeaves<'_> {
         self.left -= 1;
         let r = self.step();
         self.failed = r.is_err();
-        Some(r.map_err(|m| FormatError::corrupt(format!("colour section: {m}"))))
+        let what = self.what;
+        Some(r.map_err(|m| FormatError::corrupt(format!("{what}: {m}"))))
     }
 }
 
@@ -73,6 +76,32 @@ impl<'a> RegionLeaves<'a> {
             space_end: 1u64 << (3 * u32::from(depth)),
             depth,
             failed: false,
+            what: "colour section",
+        }
+    }
+
+    /// The `count` leaves written from `bytes[start..end]` as one stream (a
+    /// version-1 file's payload), checked as they are decoded; `what` names them in
+    /// errors.
+    pub(crate) fn over(
+        bytes: &'a [u8],
+        (start, end): (usize, usize),
+        count: u64,
+        depth: u8,
+        what: &'static str,
+    ) -> Self {
+        RegionLeaves {
+            r: Reader {
+                bytes: &bytes[..end],
+                pos: start,
+            },
+            left: count,
+            packed: 0,
+            prev_end: None,
+            space_end: 1u64 << (3 * u32::from(depth)),
+            depth,
+            failed: false,
+            what,
         }
     }
 }
@@ -162,6 +191,22 @@ pub(crate) fn colour_regions<'a>(
         pos: start,
     };
     let flags = r.u16()?;
+    colour_regions_flagged(bytes, flags, (r.pos, end), depth, done)
+}
+
+/// As [`colour_regions`], for sections `bytes[start..end]` that do not start with
+/// their flags (a version-1 file keeps them in its header).
+pub(crate) fn colour_regions_flagged<'a>(
+    bytes: &'a [u8],
+    flags: u16,
+    (start, end): (usize, usize),
+    depth: u8,
+    done: &dyn Fn(usize, usize),
+) -> Result<Option<Vec<(Rgba, RegionLeaves<'a>)>>, String> {
+    let mut r = Reader {
+        bytes: &bytes[..end],
+        pos: start,
+    };
     if flags & !(FLAG_FRAME | FLAG_COLOR_LAYER) != 0 {
         return Ok(None);
     }
@@ -207,6 +252,7 @@ pub(crate) fn colour_regions<'a>(
                 space_end: 1u64 << (3 * u32::from(depth)),
                 depth,
                 failed: false,
+                what: "colour section",
             },
         ));
     }

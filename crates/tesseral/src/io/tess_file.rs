@@ -18,6 +18,9 @@ enum Body {
     Chunked(Bytes, Layout),
     /// Version 1 (one payload): decoded whole, shown as chunks of the decoded leaves.
     Decoded(LinearOctree),
+    /// Version 1 opened by [`TessFile::open_streaming`]: the bytes and an index of
+    /// the payload in stretches, decoded one at a time.
+    Payload(Bytes, super::tess_v1::V1Index),
 }
 
 enum Bytes {
@@ -80,6 +83,55 @@ impl TessFile {
         Self::from_body(bytes, path)
     }
 
+    /// As [`TessFile::open`], but a version-1 file is not decoded whole: its
+    /// checksum is computed over the mapped bytes, its payload (sorted leaves) is
+    /// indexed in one pass in stretches of [`DEFAULT_CHUNK_LEAVES`] leaves that
+    /// play the part of chunks, and its colour layer is read as streams
+    /// ([`TessFile::colour_streams`]). The file then streams as a version-2 file
+    /// does ([`TessFile::is_streamed`]), holding a few bytes per stretch.
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn open_streaming(path: &Path) -> Result<Self, FormatError> {
+        let file = std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
+        // SAFETY: as in `open`.
+        let bytes = match unsafe { memmap2::Mmap::map(&file) } {
+            Ok(m) => Bytes::Map(m),
+            Err(_) => Bytes::Owned(super::read_limited(path, super::MAX_FILE_BYTES)?),
+        };
+        Self::from_body_streaming(bytes, path)
+    }
+
+    /// As [`TessFile::open_streaming`], for bytes held in memory; `path` names
+    /// them in errors.
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn from_bytes_streaming(bytes: Vec<u8>, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body_streaming(Bytes::Owned(bytes), path)
+    }
+
+    fn from_body_streaming(bytes: Bytes, path: &Path) -> Result<Self, FormatError> {
+        let is_v1 = bytes.len() >= 10
+            && bytes[..8] == super::native::MAGIC
+            && u16::from_le_bytes([bytes[8], bytes[9]]) == super::native::VERSION_1;
+        if !is_v1 {
+            return Self::from_body(bytes, path);
+        }
+        let (index, frame) = super::tess_v1::index_v1(&bytes, &|a, b| release_map(&bytes, a, b))
+            .map_err(|m| FormatError::corrupt(m).with_path(path))?;
+        let layers = index.flags & !super::sections::FLAG_FRAME != 0;
+        Ok(Self {
+            path: path.to_owned(),
+            body: Body::Payload(bytes, index),
+            extras: Extras {
+                frame,
+                ..Extras::default()
+            },
+            layers,
+        })
+    }
+
     /// Opens `.tess` bytes held in memory; `path` names them in errors.
     ///
     /// # Errors
@@ -130,10 +182,11 @@ impl TessFile {
         })
     }
 
-    /// Whether the file is chunked (version 2) and so read chunk by chunk.
+    /// Whether the file is read chunk by chunk: version 2, or version 1 opened
+    /// by [`TessFile::open_streaming`].
     #[must_use]
     pub fn is_streamed(&self) -> bool {
-        matches!(self.body, Body::Chunked(..))
+        matches!(self.body, Body::Chunked(..) | Body::Payload(..))
     }
 
     /// The depth of the space.
@@ -141,6 +194,7 @@ impl TessFile {
     pub fn depth(&self) -> u8 {
         match &self.body {
             Body::Chunked(_, l) => l.depth,
+            Body::Payload(_, x) => x.depth,
             Body::Decoded(t) => t.depth(),
         }
     }
@@ -150,6 +204,7 @@ impl TessFile {
     pub fn origin(&self) -> Voxel {
         match &self.body {
             Body::Chunked(_, l) => l.origin,
+            Body::Payload(_, x) => x.origin,
             Body::Decoded(t) => t.origin(),
         }
     }
@@ -171,6 +226,7 @@ impl TessFile {
     pub fn leaf_count(&self) -> u64 {
         match &self.body {
             Body::Chunked(_, l) => l.leaf_count,
+            Body::Payload(_, x) => x.leaf_count,
             Body::Decoded(t) => t.leaf_count() as u64,
         }
     }
@@ -180,6 +236,7 @@ impl TessFile {
     pub fn chunks(&self) -> Vec<ChunkInfo> {
         match &self.body {
             Body::Chunked(_, l) => l.chunks.clone(),
+            Body::Payload(_, x) => x.chunks.clone(),
             Body::Decoded(t) => t
                 .leaves()
                 .chunks(DEFAULT_CHUNK_LEAVES)
@@ -196,7 +253,7 @@ impl TessFile {
     /// The mapped bytes of a version-2 file (for resuming colour regions).
     pub(crate) fn mapped(&self) -> Option<&[u8]> {
         match &self.body {
-            Body::Chunked(b, _) => Some(b),
+            Body::Chunked(b, _) | Body::Payload(b, _) => Some(b),
             Body::Decoded(_) => None,
         }
     }
@@ -218,6 +275,9 @@ impl TessFile {
         match &self.body {
             Body::Chunked(b, l) => {
                 chunk_leaves(b, l, i).map_err(|m| FormatError::corrupt(m).with_path(&self.path))
+            }
+            Body::Payload(b, x) => {
+                super::tess_v1::v1_chunk(b, x, i).map_err(|e| e.with_path(&self.path))
             }
             Body::Decoded(t) => Ok(t
                 .leaves()
@@ -275,6 +335,16 @@ impl TessFile {
                 },
             )
             .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
+            Body::Payload(bytes, x) => super::tess_colours::colour_regions_flagged(
+                bytes,
+                x.flags,
+                x.sections,
+                x.depth,
+                &|a, b| {
+                    release_map(bytes, a, b);
+                },
+            )
+            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
             Body::Decoded(_) => Ok(None),
         }
     }
@@ -291,7 +361,7 @@ impl TessFile {
         &self,
     ) -> Result<Option<Vec<(crate::model::Rgba, LeafIter<'_>)>>, FormatError> {
         match &self.body {
-            Body::Chunked(..) => Ok(self.colour_streams()?.map(|v| {
+            Body::Chunked(..) | Body::Payload(..) => Ok(self.colour_streams()?.map(|v| {
                 v.into_iter()
                     .map(|(c, r)| (c, Box::new(r) as LeafIter<'_>))
                     .collect()
@@ -324,7 +394,7 @@ impl TessFile {
     /// flat; nothing changes for files held in memory. Advice only: errors are
     /// ignored.
     pub fn release(&self, bytes: std::ops::Range<u64>) {
-        if let Body::Chunked(b, _) = &self.body {
+        if let Body::Chunked(b, _) | Body::Payload(b, _) = &self.body {
             let len = b.len() as u64;
             release_map(
                 b,
@@ -339,6 +409,9 @@ impl TessFile {
     /// # Errors
     /// As [`TessFile::chunk`].
     pub fn to_model(&self) -> Result<Model, FormatError> {
+        if let Body::Payload(bytes, _) = &self.body {
+            return super::native::decode(bytes).map_err(|e| e.with_path(&self.path));
+        }
         let mut leaves = Vec::with_capacity(self.leaf_count() as usize);
         for l in self.leaves() {
             leaves.push(l?);
@@ -352,7 +425,7 @@ impl TessFile {
                 super::native::decode_sections(bytes, layout, &space)
                     .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?
             }
-            Body::Decoded(_) => self.extras.clone(),
+            Body::Decoded(_) | Body::Payload(..) => self.extras.clone(),
         };
         let model = extras.into_model(tree);
         super::sections::check_parts(&model)

@@ -102,12 +102,34 @@ pub fn parse(mut reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
 /// # Errors
 /// Any I/O error of `w`.
 pub fn write(w: &mut dyn Write, tree: &LinearOctree) -> io::Result<()> {
+    write_header(w, tree.voxel_count())?;
+    for [x, y, z] in tree.voxels() {
+        writeln!(w, "{x} {y} {z}")?;
+    }
+    Ok(())
+}
+
+/// Writes the header line of a list of `voxels` voxels (what [`write()`] starts
+/// with), for a writer that streams the leaves with [`write_leaf`].
+///
+/// # Errors
+/// Any I/O error of `w`.
+pub fn write_header(w: &mut dyn Write, voxels: u64) -> io::Result<()> {
     writeln!(
         w,
-        "# tesseral voxel list: {} voxels, one `x y z` per line",
-        tree.voxel_count()
-    )?;
-    for [x, y, z] in tree.voxels() {
+        "# tesseral voxel list: {voxels} voxels, one `x y z` per line"
+    )
+}
+
+/// Writes the voxels of `leaf` (a leaf of a space whose lowest voxel is
+/// `origin`) one per line, in tesseral order, as [`write()`] does.
+///
+/// # Errors
+/// Any I/O error of `w`.
+pub fn write_leaf(w: &mut dyn Write, origin: Voxel, leaf: crate::linear::Leaf) -> io::Result<()> {
+    for c in leaf.code()..leaf.end() {
+        let r = crate::code::decode(c);
+        let [x, y, z] = [0, 1, 2].map(|a| origin[a] + i64::from(r[a]));
         writeln!(w, "{x} {y} {z}")?;
     }
     Ok(())

@@ -161,7 +161,7 @@ pub fn stream_set_op_in(
 
 /// An operand's colour regions: each colour's regions of all its files, chained
 /// in file order.
-fn operand_colours<'a>(
+pub(super) fn operand_colours<'a>(
     files: &'a [TessFile],
 ) -> Result<Vec<(Rgba, crate::io::LeafIter<'a>)>, PartitionError> {
     let mut out: Vec<(Rgba, crate::io::LeafIter<'a>)> = Vec::new();

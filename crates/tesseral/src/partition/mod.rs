@@ -24,6 +24,7 @@ mod blocks;
 pub mod dataset;
 mod merge;
 mod models;
+mod recut;
 mod shuffle;
 mod stream;
 mod translate;
@@ -36,6 +37,7 @@ pub use merge::{stream_concat, stream_set_op, stream_set_op_files, stream_set_op
 pub use models::{
     build_scene_range, embedded_ranges, join_models, move_and_split, set_op_models, split_model,
 };
+pub use recut::{leaf_facts, leaf_ranges, stream_dataset, write_xyz, LeafFacts};
 pub use shuffle::{
     balanced_ranges_exact, join_pieces, reach, set_op_part, translated_sample, translated_space,
     union_bbox, SAMPLE_PER_PART,
@@ -325,5 +327,7 @@ mod tests_shuffle;
 
 #[cfg(test)]
 mod tests_parts;
+#[cfg(test)]
+mod tests_recut;
 #[cfg(test)]
 mod tests_translate;
