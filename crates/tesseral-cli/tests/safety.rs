@@ -301,9 +301,17 @@ fn interrupted_convert(signal: &str, status: i32) {
         d,
         &["scale", "one.xyz", "--by", "2^10", "-o", "big.tess"],
     ));
+    let args = ["convert", "big.tess", "big.xyz", "--max-output", "1T"];
+    interrupted(d, &args, signal, status);
+    assert_eq!(names(d), ["big.tess", "one.xyz"]);
+}
+
+/// Runs `args` in `d`, sends `signal` once a temporary (`*.tmp`) exists and has had a
+/// moment to fill, and checks the exit status.
+fn interrupted(d: &Path, args: &[&str], signal: &str, status: i32) {
     let mut child = Command::new(env!("CARGO_BIN_EXE_tesseral"))
         .current_dir(d)
-        .args(["convert", "big.tess", "big.xyz", "--max-output", "1T"])
+        .args(args)
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
         .spawn()
@@ -315,7 +323,7 @@ fn interrupted_convert(signal: &str, status: i32) {
             start.elapsed() < Duration::from_secs(60),
             "no temporary appeared"
         );
-        assert!(child.try_wait().unwrap().is_none(), "convert ended early");
+        assert!(child.try_wait().unwrap().is_none(), "{args:?} ended early");
         std::thread::sleep(Duration::from_millis(20));
     }
     // Let it write for a moment, so the temporary holds data.
@@ -334,7 +342,19 @@ fn interrupted_convert(signal: &str, status: i32) {
         .read_to_string(&mut err)
         .unwrap();
     assert_eq!(exit.code(), Some(status), "{err}");
-    assert_eq!(names(d), ["big.tess", "one.xyz"]);
+}
+
+/// Ctrl-C during `build --parts` removes the staged dataset directory with the parts
+/// written so far; the dataset never appears.
+#[test]
+fn sigint_removes_a_staged_dataset() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let scene = common::scenes().join("fig4c-spheroid.tss");
+    let scene = scene.to_str().unwrap();
+    let args = ["build", scene, "--parts", "4", "-o", "ds", "--depth", "13"];
+    interrupted(d, &args, "-INT", 130);
+    assert_eq!(names(d), Vec::<String>::new());
 }
 
 /// Issue 12, item 6: Ctrl-C during a long `convert` left `big.xyz.<pid>.tmp`.

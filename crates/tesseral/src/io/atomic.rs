@@ -39,7 +39,8 @@ fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
 }
 
 /// Removes every temporary file that a [`write_atomic`] in progress has created and
-/// not yet renamed into place, and returns how many were removed.
+/// not yet renamed into place (and every directory a [`StagedDir`](super::StagedDir)
+/// is filling), and returns how many were removed.
 ///
 /// Meant for a signal handler that is about to end the process (the write in
 /// progress then fails or is never finished). Safe to call from any thread at any
@@ -57,7 +58,13 @@ pub fn remove_pending_temporaries() -> usize {
     let mut list = pending();
     let mut removed = 0;
     for path in list.drain(..) {
-        if fs::remove_file(&path).is_ok() {
+        // A staged dataset directory (`StagedDir`) goes with its contents.
+        let gone = if path.is_dir() {
+            fs::remove_dir_all(&path)
+        } else {
+            fs::remove_file(&path)
+        };
+        if gone.is_ok() {
             removed += 1;
         }
     }
@@ -90,10 +97,11 @@ pub fn pending_temporaries() -> Vec<PathBuf> {
 }
 
 /// Keeps a temporary's path in the registry for as long as it lives.
-struct Registered(PathBuf);
+#[derive(Debug)]
+pub(super) struct Registered(PathBuf);
 
 impl Registered {
-    fn new(path: PathBuf) -> Self {
+    pub(super) fn new(path: PathBuf) -> Self {
         pending().push(path.clone());
         Self(path)
     }

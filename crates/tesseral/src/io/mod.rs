@@ -41,6 +41,7 @@ pub mod vox;
 pub mod xyz;
 
 mod error;
+mod staged;
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
 pub use chunked::{ChunkInfo, TessWriter, DEFAULT_CHUNK_LEAVES};
 pub use error::FormatError;
@@ -48,6 +49,7 @@ pub use estimate::{estimate_image_bytes, estimate_output_bytes, estimate_xyz_byt
 pub use reframe::reframe;
 pub use sniff::sniff_format;
 pub use spool::LeafSpool;
+pub use staged::StagedDir;
 pub use tess_colours::RegionLeaves;
 pub use tess_file::{LeafIter, TessFile};
 

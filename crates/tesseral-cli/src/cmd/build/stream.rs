@@ -138,7 +138,8 @@ fn progress_bar(cells: u64, estimate: u64) -> Option<indicatif::ProgressBar> {
 }
 
 /// Builds `scene` into the dataset directory `dir` as `k` parts (each streamed),
-/// after the same memory check as a streamed build.
+/// after the same memory check as a streamed build; a reader of `dir` sees the old
+/// dataset or the new one, never a mixture.
 pub fn build_parts(
     path: &Path,
     scene: &Scene,
@@ -169,11 +170,11 @@ pub fn build_parts(
         " or lower the depth",
     )?;
     drop(plan);
-    Ok(tesseral::partition::build_scene_dataset(
-        scene,
-        dir,
-        k,
-        window,
-        &mut |_, _| {},
-    )?)
+    // Written into a hidden directory beside DIR and renamed into place at the end
+    // (an old dataset there moved aside, then removed); Ctrl-C removes it.
+    let staged = tesseral::io::StagedDir::beside(dir)?;
+    let parts =
+        tesseral::partition::build_scene_dataset(scene, staged.path(), k, window, &mut |_, _| {})?;
+    staged.commit(dir)?;
+    Ok(parts)
 }

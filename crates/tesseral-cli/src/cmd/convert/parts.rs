@@ -9,7 +9,7 @@
 //! renamed into place at the end; an old dataset at DIR is renamed aside first and
 //! removed after, so a reader sees the old dataset or the new one, never a mix.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::{bail, Context, Result};
 use tesseral::io::ReadOptions;
@@ -52,42 +52,6 @@ fn guard(dir: &Path, input: &Path) -> Result<()> {
     Ok(())
 }
 
-/// A new hidden directory beside `dir` to write the dataset into.
-fn stage(dir: &Path) -> Result<tempfile::TempDir> {
-    let parent = match dir.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let name = dir.file_name().unwrap_or_default().to_string_lossy();
-    tempfile::Builder::new()
-        .prefix(&format!(".{name}."))
-        .suffix(".tmp")
-        .tempdir_in(parent)
-        .with_context(|| format!("making a directory beside {}", dir.display()))
-}
-
-/// Moves the dataset written in `staged` to `dir`: renamed into place, an old
-/// dataset (or empty directory) there renamed aside first and removed after.
-fn commit(staged: tempfile::TempDir, dir: &Path) -> Result<()> {
-    let what = || format!("moving the new dataset to {}", dir.display());
-    if !dir.exists() {
-        std::fs::rename(staged.path(), dir).with_context(what)?;
-        let _ = staged.keep();
-        return Ok(());
-    }
-    let mut old = staged.path().as_os_str().to_owned();
-    old.push(".old");
-    let old = PathBuf::from(old);
-    std::fs::rename(dir, &old).with_context(what)?;
-    if let Err(e) = std::fs::rename(staged.path(), dir) {
-        let _ = std::fs::rename(&old, dir);
-        return Err(e).with_context(what);
-    }
-    let _ = staged.keep();
-    std::fs::remove_dir_all(&old)
-        .with_context(|| format!("removing the old dataset, moved to {}", old.display()))
-}
-
 /// Writes `args.input` as a dataset of `k` parts in `dir`.
 pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> {
     if k == 0 {
@@ -104,10 +68,10 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             let estimate = op.bytes.saturating_add(k as u64 * 256);
             output::check_size(dir, estimate, args.limits.limits.max_output)?;
             let ranges = partition::leaf_ranges(&op.files, k)?;
-            let staged = stage(dir)?;
+            let staged = tesseral::io::StagedDir::beside(dir)?;
             let parts = partition::stream_dataset(&op.files, op.frame, &ranges, staged.path())
                 .with_context(|| format!("writing {}", dir.display()))?;
-            commit(staged, dir)?;
+            staged.commit(dir)?;
             (parts, op.space(), op.frame)
         }
         None => {
@@ -119,7 +83,7 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             let ranges = partition::balanced_ranges_of(tree, k);
             let cut = partition::split_model(&model, &ranges)
                 .with_context(|| format!("cutting {} into parts", args.input.display()))?;
-            let staged = stage(dir)?;
+            let staged = tesseral::io::StagedDir::beside(dir)?;
             let mut parts = Vec::with_capacity(ranges.len());
             for (i, (p, m)) in ranges.iter().zip(&cut).enumerate() {
                 parts.push(partition::write_model_part(staged.path(), i, *p, m)?);
@@ -131,7 +95,7 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
                 model.frame,
                 &parts,
             )?;
-            commit(staged, dir)?;
+            staged.commit(dir)?;
             (parts, (tree.depth(), tree.origin()), model.frame)
         }
     };
