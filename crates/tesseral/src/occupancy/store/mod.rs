@@ -4,18 +4,17 @@
 //! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]).
 
 mod arena;
+mod dir;
 mod forms;
 mod sparse;
 mod valid;
 
-use rustc_hash::FxHashMap;
-
 use super::sensor::{Fixed, UNKNOWN};
 use arena::{Arena, UNIT};
+use dir::Directory;
 use forms::{
-    apply_masks, bits_words, choose, decode, palette_index, palette_single, palette_update,
-    sparse_get, units_of, write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE,
-    SPARSE, UNIFORM,
+    apply_masks, bits_words, choose, decode, palette_single, palette_update, sparse_get, units_of,
+    write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
 };
 
 /// Cells per block side (log2).
@@ -24,6 +23,24 @@ pub(crate) const BLOCK_LOG2: u32 = 3;
 pub(crate) const BLOCK_CELLS: usize = 512;
 /// Blocks per superblock.
 const TABLE: usize = 512;
+
+/// Cells looked up together by [`Store::get_many`].
+pub(crate) const BATCH: usize = 32;
+
+/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
+    // address is that of a live reference anyway).
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
 
 /// A block's coordinates: cell >> 3 per axis.
 pub(crate) type BlockKey = [i64; 3];
@@ -118,7 +135,7 @@ pub(crate) type Cells = [i16; BLOCK_CELLS];
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Store {
     /// Superblock (block >> 3) to its table's number.
-    top: FxHashMap<BlockKey, u32>,
+    dir: Directory,
     /// The superblocks' keys, by number.
     keys: Vec<BlockKey>,
     /// The tables, 512 entries each, by number.
@@ -133,35 +150,113 @@ pub(crate) struct Store {
     scratch: Vec<u32>,
     /// Compactions of the arena so far.
     compactions: usize,
+    /// Whether a block was refused for want of room in the arena.
+    overflowed: bool,
 }
 
 impl Store {
     /// The stored value of a cell (`UNKNOWN` when unknown).
-    #[inline]
+    #[inline(always)]
     pub fn get(&self, cell: [i64; 3]) -> i16 {
         let (b, i) = split(cell);
-        let Some(&t) = self.top.get(&b.map(|c| c >> BLOCK_LOG2)) else {
-            return UNKNOWN;
-        };
-        let e = self.tables[t as usize * TABLE + local(b)];
-        let at = e.offset() as usize * UNIT;
+        match self.find(b) {
+            Some(s) => self.value(self.tables[s], i),
+            None => UNKNOWN,
+        }
+    }
+
+    /// The value of cell `i` of the block of entry `e`.
+    #[inline(always)]
+    fn value(&self, e: Entry, i: usize) -> i16 {
+        let tag = e.tag();
+        if tag <= UNIFORM {
+            return if tag == EMPTY {
+                UNKNOWN
+            } else {
+                (e.0 >> 16) as u16 as i16
+            };
+        }
         let words = &self.arena.words;
-        match e.tag() {
-            EMPTY => UNKNOWN,
-            UNIFORM => (e.0 >> 16) as u16 as i16,
-            SPARSE => sparse_get(&words[at..], i),
-            DENSE => words[at + i] as i16,
+        let at = e.offset() as usize * UNIT;
+        if tag == SPARSE {
+            return sparse_get(&words[at..], i);
+        }
+        // A palette of width w, or a dense block read as a palette of width 16
+        // whose cells are their values (tags 3 to 7): no branch on the width. The
+        // value list's first line is fetched while the cell's bits are read.
+        let w = 1usize << (tag - PALETTE);
+        if let Some(x) = words.get(at + bits_words(w as u32) + 1) {
+            prefetch(x);
+        }
+        let bit = i * w;
+        let j = (words[at + (bit >> 4)] >> (bit & 15)) as usize & ((1 << w) - 1);
+        let v = if tag == DENSE {
+            at + i
+        } else {
+            at + bits_words(w as u32) + 1 + j
+        };
+        words[v] as i16
+    }
+
+    /// The values of `cells` into `out` (as many), as [`get`](Self::get) would give
+    /// them, in three passes that each prefetch what the next one reads: the table
+    /// entries, then the blocks' words in the arena. The cache misses of up to
+    /// [`BATCH`] cells overlap rather than follow one another.
+    ///
+    /// # Panics
+    /// When `cells` and `out` differ in length.
+    pub fn get_many(&self, cells: &[[i64; 3]], out: &mut [i16]) {
+        assert_eq!(cells.len(), out.len(), "as many values as cells");
+        let mut slots = [usize::MAX; BATCH];
+        let mut entries = [Entry::EMPTY; BATCH];
+        for (cells, out) in cells.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+            for (s, &c) in slots.iter_mut().zip(cells) {
+                *s = self.find(split(c).0).unwrap_or(usize::MAX);
+                if let Some(e) = self.tables.get(*s) {
+                    prefetch(e);
+                }
+            }
+            for ((e, &s), &c) in entries.iter_mut().zip(&slots).zip(cells) {
+                *e = self.tables.get(s).copied().unwrap_or(Entry::EMPTY);
+                self.prefetch_cell(*e, local(c));
+            }
+            for ((o, &e), &c) in out.iter_mut().zip(&entries).zip(cells) {
+                *o = self.value(e, local(c));
+            }
+        }
+    }
+
+    /// Prefetches the arena words that [`value`](Self::value) reads for cell `i` of
+    /// the block of entry `e`.
+    #[inline]
+    fn prefetch_cell(&self, e: Entry, i: usize) {
+        let tag = e.tag();
+        if tag <= UNIFORM {
+            return;
+        }
+        let at = e.offset() as usize * UNIT;
+        let (a, b) = match tag {
+            // The header and the first cells; then the middle of the list, where
+            // the binary search starts, is often in the next line.
+            SPARSE => (at, at + 4 * UNIT),
+            DENSE => (at + i, at + i),
             t => {
                 let w = 1 << (t - PALETTE);
-                let words = &words[at..];
-                words[bits_words(w) + 1 + palette_index(words, w, i)] as i16
+                (at + (i * w >> 4), at + bits_words(w as u32) + 1)
+            }
+        };
+        let words = &self.arena.words;
+        for k in [a, b] {
+            if let Some(x) = words.get(k) {
+                prefetch(x);
             }
         }
     }
 
     /// The slot of block `b` in the tables, if its superblock has a table.
+    #[inline(always)]
     fn find(&self, b: BlockKey) -> Option<usize> {
-        let t = *self.top.get(&b.map(|c| c >> BLOCK_LOG2))?;
+        let t = self.dir.get(b.map(|c| c >> BLOCK_LOG2))?;
         Some(t as usize * TABLE + local(b))
     }
 
@@ -172,7 +267,7 @@ impl Store {
             Some((k, t)) if k == s => t,
             _ => {
                 let n = self.keys.len() as u32;
-                let t = *self.top.entry(s).or_insert(n);
+                let t = self.dir.get_or_insert(s, n);
                 if t == n {
                     if self.tables.len() == self.tables.capacity() {
                         // A quarter more, not double: the capacity is counted.
@@ -248,18 +343,42 @@ impl Store {
     }
 
     /// Gives slot `s` (emptied first) a new block of `units` units with this tag;
-    /// returns the block's words.
-    fn place(&mut self, s: usize, tag: u32, units: usize) -> &mut [u16] {
+    /// returns the block's words. `None`, leaving the slot as it was, when the arena
+    /// has no room for it (past its limit): then [`Store::overflowed`] tells.
+    fn place(&mut self, s: usize, tag: u32, units: usize) -> Option<&mut [u16]> {
         let old = self.tables[s];
         let at = if old.in_arena() && units_of(old.tag(), self.words_of(old)) == units {
             old.offset()
         } else {
+            if !self.arena.has_room(units) {
+                self.overflowed = true;
+                return None;
+            }
             self.clear(s);
             self.blocks += 1;
-            self.arena.alloc(units)
+            // Clearing may compact the arena, which only makes room.
+            self.arena.alloc(units).expect("room checked")
         };
         self.tables[s] = Entry::at(tag, at);
-        self.arena.get_mut(at, units * UNIT)
+        Some(self.arena.get_mut(at, units * UNIT))
+    }
+
+    /// Whether a block was refused for want of room in the arena (so that some
+    /// updates were dropped), since the store was made.
+    pub fn overflowed(&self) -> bool {
+        self.overflowed
+    }
+
+    /// The arena's limit in bytes.
+    pub fn limit_bytes(&self) -> usize {
+        self.arena.limit * UNIT * 2
+    }
+
+    /// Lowers the arena's limit to `units` units (a test hook: the real limit,
+    /// 8 GiB, is too big for a test).
+    #[cfg(test)]
+    pub fn set_limit_units(&mut self, units: usize) {
+        self.arena.limit = units;
     }
 
     /// Moves every arena block to a new arena, in table order, leaving no free chunk.
@@ -277,6 +396,7 @@ impl Store {
         }
         self.arena = Arena {
             words,
+            limit: self.arena.limit,
             ..Arena::default()
         };
         self.compactions += 1;
@@ -316,11 +436,21 @@ impl Store {
                         .filter(|(_, &v)| v != UNKNOWN)
                         .map(|(i, &v)| (i as u32) << 16 | u32::from(v as u16)),
                 );
-                write_sparse(self.place(s, tag, units), &list);
+                if let Some(words) = self.place(s, tag, units) {
+                    write_sparse(words, &list);
+                }
                 self.scratch = list;
             }
-            DENSE => write_dense(self.place(s, tag, units), cells),
-            t => write_palette(self.place(s, t, units), 1 << (t - PALETTE), &census),
+            DENSE => {
+                if let Some(words) = self.place(s, tag, units) {
+                    write_dense(words, cells);
+                }
+            }
+            t => {
+                if let Some(words) = self.place(s, t, units) {
+                    write_palette(words, 1 << (t - PALETTE), &census);
+                }
+            }
         }
     }
 
@@ -374,7 +504,7 @@ impl Store {
 
     /// Reserves room for `n` more blocks.
     pub fn reserve(&mut self, n: usize) {
-        self.top.reserve(n / TABLE);
+        self.dir.reserve(n / TABLE);
     }
 
     /// Calls `f` on every block's known cells: `(index in block, value)`, or once
@@ -429,18 +559,28 @@ impl Store {
         });
     }
 
+    /// Whether lookups go through the dense directory (not the hash map).
+    #[cfg(test)]
+    pub fn dense_directory(&self) -> bool {
+        self.dir.is_dense()
+    }
+
+    /// Units in the arena (in use or free).
+    #[cfg(test)]
+    pub fn arena_units(&self) -> usize {
+        self.arena.len_units()
+    }
+
     /// Compactions of the arena so far.
     #[cfg(test)]
     pub fn compactions(&self) -> usize {
         self.compactions
     }
 
-    /// Bytes held: the directory's buckets, tables and keys, the arena (capacities)
-    /// and the merge buffer.
+    /// Bytes held: the directory, tables and keys, the arena (capacities) and the
+    /// merge buffer.
     pub fn bytes(&self) -> usize {
-        // hashbrown: key + value per bucket, plus one control byte.
-        let bucket = std::mem::size_of::<(BlockKey, u32)>() + 1;
-        self.top.capacity() * bucket
+        self.dir.bytes()
             + self.keys.capacity() * std::mem::size_of::<BlockKey>()
             + self.tables.capacity() * std::mem::size_of::<Entry>()
             + self.arena.bytes()
