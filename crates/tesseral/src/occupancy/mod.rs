@@ -43,6 +43,8 @@ mod tests_dense;
 #[cfg(test)]
 mod tests_lookup;
 #[cfg(test)]
+mod tests_map;
+#[cfg(test)]
 mod tests_ray;
 #[cfg(test)]
 mod tests_store;

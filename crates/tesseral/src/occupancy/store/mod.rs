@@ -1,11 +1,14 @@
-//! Blocks of 8×8×8 cells, found through a two-level directory (a hash map of
-//! superblocks of 8×8×8 blocks, each a flat table of 512 block entries) and held in
+//! Blocks of 8×8×8 cells, found through a two-level directory (superblocks of
+//! 8×8×8 blocks, each a flat table of 512 block entries) and held in
 //! one arena in the smallest of four forms: uniform (in the entry), sparse, palette
-//! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]).
+//! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]). The
+//! directory is dense over the superblocks' bounding box while that box is small
+//! enough, a hash map otherwise (see [`dir`]); reads are in [`lookup`].
 
 mod arena;
 mod dir;
 mod forms;
+mod lookup;
 mod sparse;
 mod valid;
 
@@ -13,9 +16,10 @@ use super::sensor::{Fixed, UNKNOWN};
 use arena::{Arena, UNIT};
 use dir::Directory;
 use forms::{
-    apply_masks, bits_words, choose, decode, palette_single, palette_update, sparse_get, units_of,
-    write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
+    apply_masks, choose, decode, palette_single, palette_update, units_of, write_dense,
+    write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
 };
+pub(crate) use lookup::BATCH;
 
 /// Cells per block side (log2).
 pub(crate) const BLOCK_LOG2: u32 = 3;
@@ -23,24 +27,6 @@ pub(crate) const BLOCK_LOG2: u32 = 3;
 pub(crate) const BLOCK_CELLS: usize = 512;
 /// Blocks per superblock.
 const TABLE: usize = 512;
-
-/// Cells looked up together by [`Store::get_many`].
-pub(crate) const BATCH: usize = 32;
-
-/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
-    // address is that of a live reference anyway).
-    #[cfg(target_arch = "x86_64")]
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            (x as *const T).cast(),
-        );
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
 
 /// A block's coordinates: cell >> 3 per axis.
 pub(crate) type BlockKey = [i64; 3];
@@ -155,104 +141,6 @@ pub(crate) struct Store {
 }
 
 impl Store {
-    /// The stored value of a cell (`UNKNOWN` when unknown).
-    #[inline(always)]
-    pub fn get(&self, cell: [i64; 3]) -> i16 {
-        let (b, i) = split(cell);
-        match self.find(b) {
-            Some(s) => self.value(self.tables[s], i),
-            None => UNKNOWN,
-        }
-    }
-
-    /// The value of cell `i` of the block of entry `e`.
-    #[inline(always)]
-    fn value(&self, e: Entry, i: usize) -> i16 {
-        let tag = e.tag();
-        if tag <= UNIFORM {
-            return if tag == EMPTY {
-                UNKNOWN
-            } else {
-                (e.0 >> 16) as u16 as i16
-            };
-        }
-        let words = &self.arena.words;
-        let at = e.offset() as usize * UNIT;
-        if tag == SPARSE {
-            return sparse_get(&words[at..], i);
-        }
-        // A palette of width w, or a dense block read as a palette of width 16
-        // whose cells are their values (tags 3 to 7): no branch on the width. The
-        // value list's first line is fetched while the cell's bits are read.
-        let w = 1usize << (tag - PALETTE);
-        if let Some(x) = words.get(at + bits_words(w as u32) + 1) {
-            prefetch(x);
-        }
-        let bit = i * w;
-        let j = (words[at + (bit >> 4)] >> (bit & 15)) as usize & ((1 << w) - 1);
-        let v = if tag == DENSE {
-            at + i
-        } else {
-            at + bits_words(w as u32) + 1 + j
-        };
-        words[v] as i16
-    }
-
-    /// The values of `cells` into `out` (as many), as [`get`](Self::get) would give
-    /// them, in three passes that each prefetch what the next one reads: the table
-    /// entries, then the blocks' words in the arena. The cache misses of up to
-    /// [`BATCH`] cells overlap rather than follow one another.
-    ///
-    /// # Panics
-    /// When `cells` and `out` differ in length.
-    pub fn get_many(&self, cells: &[[i64; 3]], out: &mut [i16]) {
-        assert_eq!(cells.len(), out.len(), "as many values as cells");
-        let mut slots = [usize::MAX; BATCH];
-        let mut entries = [Entry::EMPTY; BATCH];
-        for (cells, out) in cells.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
-            for (s, &c) in slots.iter_mut().zip(cells) {
-                *s = self.find(split(c).0).unwrap_or(usize::MAX);
-                if let Some(e) = self.tables.get(*s) {
-                    prefetch(e);
-                }
-            }
-            for ((e, &s), &c) in entries.iter_mut().zip(&slots).zip(cells) {
-                *e = self.tables.get(s).copied().unwrap_or(Entry::EMPTY);
-                self.prefetch_cell(*e, local(c));
-            }
-            for ((o, &e), &c) in out.iter_mut().zip(&entries).zip(cells) {
-                *o = self.value(e, local(c));
-            }
-        }
-    }
-
-    /// Prefetches the arena words that [`value`](Self::value) reads for cell `i` of
-    /// the block of entry `e`.
-    #[inline]
-    fn prefetch_cell(&self, e: Entry, i: usize) {
-        let tag = e.tag();
-        if tag <= UNIFORM {
-            return;
-        }
-        let at = e.offset() as usize * UNIT;
-        let (a, b) = match tag {
-            // The header and the first cells; then the middle of the list, where
-            // the binary search starts, is often in the next line.
-            SPARSE => (at, at + 4 * UNIT),
-            DENSE => (at + i, at + i),
-            t => {
-                let w = 1 << (t - PALETTE);
-                (at + (i * w >> 4), at + bits_words(w as u32) + 1)
-            }
-        };
-        let words = &self.arena.words;
-        for k in [a, b] {
-            if let Some(x) = words.get(k) {
-                prefetch(x);
-            }
-        }
-    }
-
     /// The slot of block `b` in the tables, if its superblock has a table.
     #[inline(always)]
     fn find(&self, b: BlockKey) -> Option<usize> {
