@@ -39,7 +39,7 @@ impl Arena {
     /// Whether [`alloc`](Self::alloc) of `units` units would succeed.
     pub fn has_room(&self, units: usize) -> bool {
         self.free.get(units).is_some_and(|f| !f.is_empty())
-            || self.len_units() + units <= self.limit
+            || self.len_units() + units <= self.limit.min(MAX_UNITS)
     }
 
     /// A chunk of `units` units (contents unspecified), as its offset in units, or
