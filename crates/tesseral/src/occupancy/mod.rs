@@ -12,8 +12,9 @@
 //! # Layout
 //! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
 //! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]), found
-//! through a two-level directory: a hash map of superblocks (8×8×8 blocks), each a
-//! flat table of 512 four-byte block entries. A block is *uniform* (all 512 cells
+//! through a two-level directory: superblocks (8×8×8 blocks; found by index
+//! arithmetic in a dense array over their bounding box, or through a hash map when
+//! they lie far apart), each a flat table of 512 four-byte block entries. A block is *uniform* (all 512 cells
 //! clamped to the same value: the entry alone, as OctoMap prunes), *sparse* (its
 //! known cells, 2 bytes each, and up to six distinct values), a *palette* (1, 2, 4
 //! or 8 bits a cell and a list of the values) or *dense* (512 log-odds), whichever
