@@ -8,7 +8,9 @@
 # Every tool reads the same scan files; each prints one RESULT line: insertion wall
 # and CPU seconds, rays per second (wall), its own memory count (tesseral `bytes`,
 # Bonxai `memUsage()`, OctoMap `memoryUsage()`), occupied and free cells, ns per
-# lookup of 10^6 random cells drawn from the scans' end points, and peak RSS.
+# lookup of 10^6 random cells drawn from the scans' end points (wall, then lookup_cpu_ns
+# in process CPU time; tesseral adds lookup_many_ns and lookup_many_cpu_ns, the same
+# cells through its batched log_odds_many), and peak RSS.
 # One core: `taskset -c 0` and RAYON_NUM_THREADS=1; two cores: RAYON_NUM_THREADS=2 on
 # cores 0,1 (only tesseral is parallel).
 #

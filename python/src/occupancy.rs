@@ -77,6 +77,7 @@ impl OccupancyMap {
         check_work(&self.map, origin, &pts, max_range, max_cells)?;
         let m = &mut self.map;
         let s = py.allow_threads(|| m.insert_scan(origin, &pts, max_range));
+        m.check_capacity().map_err(value_error)?;
         let d = PyDict::new(py);
         d.set_item("points", s.points)?;
         d.set_item("rays", s.rays)?;
@@ -106,7 +107,8 @@ impl OccupancyMap {
         Ok(out.into_pyarray(py))
     }
 
-    /// The log-odds of each cell of an N×3 int64 array (NaN where unknown).
+    /// The log-odds of each cell of an N×3 int64 array (NaN where unknown), looked
+    /// up in batches whose memory accesses overlap (`log_odds_many`).
     fn log_odds<'py>(
         &self,
         py: Python<'py>,
@@ -115,9 +117,9 @@ impl OccupancyMap {
         let c = rows(&cells)?;
         let m = &self.map;
         let out: Vec<f32> = py.allow_threads(|| {
-            c.iter()
-                .map(|&v| m.log_odds(v).unwrap_or(f32::NAN))
-                .collect()
+            let mut v = vec![None; c.len()];
+            m.log_odds_many(&c, &mut v);
+            v.into_iter().map(|l| l.unwrap_or(f32::NAN)).collect()
         });
         Ok(out.into_pyarray(py))
     }

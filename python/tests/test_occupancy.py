@@ -69,3 +69,25 @@ def test_a_far_point_is_refused_before_it_is_cast():
     with pytest.raises(ValueError, match="past max_cells"):
         d.insert_scan((0.5, 0.5, 0.5), np.array([[1e12, 0.5, 0.5]]))
     assert len(d) == 0
+
+
+def test_batched_log_odds_agree_with_one_cell_at_a_time_and_with_state():
+    # `log_odds` on many cells goes through the batched lookup (batches of 32 whose
+    # memory accesses are prefetched together); one row at a time, and `state`,
+    # must give the same answers, far from the origin and at negative keys too.
+    rng = np.random.default_rng(11)
+    m = t.OccupancyMap(0.1)
+    origin = np.array([-1.0e6, 2.5e5, -3.0])
+    for _ in range(3):
+        pts = origin + rng.uniform(-4.0, 4.0, size=(400, 3))
+        m.insert_scan(tuple(origin), pts)
+    base = m.cells_of(origin[None, :])[0]
+    cells = base + rng.integers(-45, 45, size=(3001, 3))
+    cells = np.concatenate([cells, m.cells_of(pts)]).astype(np.int64)
+    many = m.log_odds(cells)
+    one = np.array([m.log_odds(c[None, :])[0] for c in cells], dtype=np.float32)
+    np.testing.assert_array_equal(many, one)
+    st = m.state(cells)
+    assert np.array_equal(np.isnan(many), st == 0)
+    assert (st == 2).any() and (st == 1).any() and (st == 0).any()
+    assert np.array_equal(many[st == 2] >= 0, np.ones((st == 2).sum(), dtype=bool))

@@ -12,7 +12,10 @@
 //!   model, then looks up 10⁶ cells drawn at random from the scans' end points (the
 //!   same splitmix64 draws as the C++ drivers) and prints one `RESULT` line: scans,
 //!   rays, insertion wall and CPU seconds, rays per second (wall), the map's bytes,
-//!   occupied and free cells, lookup ns.
+//!   occupied and free cells, lookup ns (a loop of `log_odds`, as the peers' loops
+//!   of single lookups; wall, then `lookup_cpu_ns` in process CPU time), cells
+//!   known, and `lookup_many_ns`, `lookup_many_cpu_ns`: the same cells through the
+//!   batched `log_odds_many`, per cell.
 //!
 //! The rayon pool size is `RAYON_NUM_THREADS` (one core: `RAYON_NUM_THREADS=1`).
 
@@ -129,20 +132,30 @@ fn main() -> std::io::Result<()> {
                     map.cell_of(s.points[(r.next() % s.points.len() as u64) as usize])
                 })
                 .collect();
-            let t = Instant::now();
+            let (t, c) = (Instant::now(), process_cpu());
             let known = cells
                 .iter()
                 .filter(|&&c| map.log_odds(std::hint::black_box(c)).is_some())
                 .count();
-            let lookup = t.elapsed().as_secs_f64();
+            let (lookup, lookup_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
+            // The same cells through the batched lookup (prefetching in passes).
+            let mut out = vec![None; cells.len()];
+            let (t, c) = (Instant::now(), process_cpu());
+            map.log_odds_many(std::hint::black_box(&cells), &mut out);
+            let known_many = out.iter().filter(|v| v.is_some()).count();
+            let (many, many_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
+            assert_eq!(known_many, known, "batched and single lookups agree");
             println!(
-                "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known}",
+                "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known} lookup_cpu_ns {:.1} lookup_many_ns {:.1} lookup_many_cpu_ns {:.1}",
                 sc.len(),
                 rays as f64 / wall,
                 map.bytes(),
                 map.occupied_count(),
                 map.free_count(),
                 lookup * 1e3,
+                lookup_cpu * 1e3,
+                many * 1e3,
+                many_cpu * 1e3,
             );
         }
         other => panic!("unknown command {other}: gen, xyz or run"),

@@ -169,6 +169,9 @@ pub fn run(args: Args) -> Result<()> {
                 format!("{}: scan {} of {}", path.display(), i + 1, scans.len())
             })?;
             insert(&mut map, s, &args, &mut t);
+            map.check_capacity().with_context(|| {
+                format!("{}: scan {} of {}", path.display(), i + 1, scans.len())
+            })?;
             bar.inc(1);
         }
     }

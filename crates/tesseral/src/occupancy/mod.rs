@@ -12,8 +12,9 @@
 //! # Layout
 //! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
 //! 8×8×8 blocks (the bit-block size of [`crate::dynamic::DynamicOctree`]), found
-//! through a two-level directory: a hash map of superblocks (8×8×8 blocks), each a
-//! flat table of 512 four-byte block entries. A block is *uniform* (all 512 cells
+//! through a two-level directory: superblocks (8×8×8 blocks; found by index
+//! arithmetic in a dense array over their bounding box, or through a hash map when
+//! they lie far apart), each a flat table of 512 four-byte block entries. A block is *uniform* (all 512 cells
 //! clamped to the same value: the entry alone, as OctoMap prunes), *sparse* (its
 //! known cells, 2 bytes each, and up to six distinct values), a *palette* (1, 2, 4
 //! or 8 bits a cell and a list of the values) or *dense* (512 log-odds), whichever
@@ -41,6 +42,10 @@ mod tests;
 #[cfg(test)]
 mod tests_dense;
 #[cfg(test)]
+mod tests_lookup;
+#[cfg(test)]
+mod tests_map;
+#[cfg(test)]
 mod tests_ray;
 #[cfg(test)]
 mod tests_store;
@@ -65,6 +70,18 @@ pub enum OccupancyError {
     /// A model cannot be read as a map (its frame, or its extent).
     #[error("model: {0}")]
     Model(String),
+    /// The map's blocks outgrew the most its arena addresses (8 GiB of blocks, as
+    /// far as a block entry's offset reaches): the updates of the blocks that did not
+    /// fit were dropped, the map is otherwise valid.
+    #[error(
+        "the map's blocks would pass {limit_bytes} bytes, the most a map addresses: \
+         some updates were dropped (use a coarser resolution or a shorter max range, \
+         or split the scans into several maps)"
+    )]
+    Capacity {
+        /// The limit, in bytes of blocks.
+        limit_bytes: usize,
+    },
     /// The octree operation failed.
     #[error(transparent)]
     Octree(#[from] crate::linear::OctreeError),
@@ -155,9 +172,12 @@ impl OccupancyMap {
     /// A cell's state.
     ///
     /// # Runtime
-    /// O(1): one hash probe for the superblock, one table load, one or two loads
-    /// in the block (a binary search over its cells in a sparse block).
+    /// O(1): the superblock's table found by index arithmetic in a dense directory
+    /// (or one hash probe when the map's superblocks lie far apart), one table load,
+    /// one or two loads in the block (a binary search over its cells in a sparse
+    /// block).
     #[must_use]
+    #[inline]
     pub fn state(&self, cell: [i64; 3]) -> CellState {
         match self.store.get(cell) {
             UNKNOWN => CellState::Unknown,
@@ -168,11 +188,59 @@ impl OccupancyMap {
 
     /// A known cell's log-odds (a multiple of the fixed-point step).
     #[must_use]
+    #[inline]
     pub fn log_odds(&self, cell: [i64; 3]) -> Option<f32> {
         match self.store.get(cell) {
             UNKNOWN => None,
             v => Some(self.fixed.to_f32(v)),
         }
+    }
+
+    /// The log-odds of many cells, as [`log_odds`](Self::log_odds) gives them one by
+    /// one, into `out`. Faster than a loop of `log_odds` on a map bigger than the
+    /// CPU's caches: the cells are looked up in batches whose memory accesses are
+    /// prefetched together, so that their cache misses overlap.
+    ///
+    /// # Runtime
+    /// O(n), with the cost of one lookup as [`state`](Self::state).
+    ///
+    /// # Panics
+    /// When `cells` and `out` differ in length.
+    ///
+    /// ```
+    /// use tesseral::occupancy::{OccupancyMap, SensorModel};
+    /// let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    /// map.insert_scan([0.05, 0.05, 0.05], &[[1.05, 0.05, 0.05]], None);
+    /// let cells = [[10, 0, 0], [3, 0, 0], [11, 0, 0]];
+    /// let mut out = [None; 3];
+    /// map.log_odds_many(&cells, &mut out);
+    /// assert_eq!(out, cells.map(|c| map.log_odds(c)));
+    /// ```
+    pub fn log_odds_many(&self, cells: &[[i64; 3]], out: &mut [Option<f32>]) {
+        assert_eq!(cells.len(), out.len(), "as many values as cells");
+        let mut values = [UNKNOWN; store::BATCH];
+        for (cells, out) in cells.chunks(store::BATCH).zip(out.chunks_mut(store::BATCH)) {
+            let values = &mut values[..cells.len()];
+            self.store.get_many(cells, values);
+            for (o, &v) in out.iter_mut().zip(values.iter()) {
+                *o = (v != UNKNOWN).then(|| self.fixed.to_f32(v));
+            }
+        }
+    }
+
+    /// Whether every update so far was stored.
+    ///
+    /// # Errors
+    /// [`OccupancyError::Capacity`] once a block was refused because the map's blocks
+    /// would pass 8 GiB (the most a block entry addresses): the updates to that block
+    /// were dropped, the map is otherwise valid. Check after each scan.
+    pub fn check_capacity(&self) -> Result<(), OccupancyError> {
+        if self.store.overflowed() {
+            return Err(OccupancyError::Capacity {
+                limit_bytes: self.store.limit_bytes(),
+            });
+        }
+        Ok(())
     }
 
     /// Sets a cell's log-odds (clamped), or forgets it with `None`.

@@ -7,7 +7,7 @@ pub(crate) const UNIT: usize = 8;
 /// The most units the arena addresses (29 bits of a block entry): 8 GiB.
 pub(crate) const MAX_UNITS: usize = 1 << 29;
 
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone)]
 pub(crate) struct Arena {
     /// The words, `UNIT` per unit; a block starts at a unit.
     pub words: Vec<u16>,
@@ -15,6 +15,19 @@ pub(crate) struct Arena {
     pub free: Vec<Vec<u32>>,
     /// Units in free chunks.
     pub free_units: usize,
+    /// The most units the arena may hold ([`MAX_UNITS`], less in tests).
+    pub limit: usize,
+}
+
+impl Default for Arena {
+    fn default() -> Self {
+        Self {
+            words: Vec::new(),
+            free: Vec::new(),
+            free_units: 0,
+            limit: MAX_UNITS,
+        }
+    }
 }
 
 impl Arena {
@@ -23,20 +36,24 @@ impl Arena {
         self.words.len() / UNIT
     }
 
-    /// A chunk of `units` units (contents unspecified), as its offset in units.
-    ///
-    /// # Panics
-    /// When the arena would pass [`MAX_UNITS`] (8 GiB of blocks).
-    pub fn alloc(&mut self, units: usize) -> u32 {
+    /// Whether [`alloc`](Self::alloc) of `units` units would succeed.
+    pub fn has_room(&self, units: usize) -> bool {
+        self.free.get(units).is_some_and(|f| !f.is_empty())
+            || self.len_units() + units <= self.limit.min(MAX_UNITS)
+    }
+
+    /// A chunk of `units` units (contents unspecified), as its offset in units, or
+    /// `None` when the arena would pass its limit (at most [`MAX_UNITS`], 8 GiB of
+    /// blocks, as far as a block entry's 29 bits of offset reach).
+    pub fn alloc(&mut self, units: usize) -> Option<u32> {
         if let Some(at) = self.free.get_mut(units).and_then(Vec::pop) {
             self.free_units -= units;
-            return at;
+            return Some(at);
         }
         let at = self.len_units();
-        assert!(
-            at + units <= MAX_UNITS,
-            "occupancy map: more than 8 GiB of blocks"
-        );
+        if at + units > self.limit.min(MAX_UNITS) {
+            return None;
+        }
         let need = self.words.len() + units * UNIT;
         if need > self.words.capacity() {
             // Grow by an eighth, not a doubling: the capacity is counted in `bytes`.
@@ -44,7 +61,7 @@ impl Arena {
             self.words.reserve_exact(extra);
         }
         self.words.resize(need, 0);
-        at as u32
+        Some(at as u32)
     }
 
     /// Frees the chunk of `units` units at `at`.

@@ -1,23 +1,29 @@
-//! Blocks of 8×8×8 cells, found through a two-level directory (a hash map of
-//! superblocks of 8×8×8 blocks, each a flat table of 512 block entries) and held in
+//! Blocks of 8×8×8 cells, found through a two-level directory (superblocks of
+//! 8×8×8 blocks, each a flat table of 512 block entries) and held in
 //! one arena in the smallest of four forms: uniform (in the entry), sparse, palette
-//! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]).
+//! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]). The
+//! directory is dense over the superblocks' bounding box while that box is small
+//! enough, a hash map otherwise (see [`dir`]); reads are in [`lookup`].
 
 mod arena;
+mod dir;
 mod forms;
+<<<<<<< HEAD
 mod fresh;
+=======
+mod lookup;
+>>>>>>> s4-occlook
 mod sparse;
 mod valid;
 
-use rustc_hash::FxHashMap;
-
 use super::sensor::{Fixed, UNKNOWN};
 use arena::{Arena, UNIT};
+use dir::Directory;
 use forms::{
-    apply_masks, bits_words, choose, decode, palette_index, palette_single, palette_update,
-    sparse_get, units_of, write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE,
-    SPARSE, UNIFORM,
+    apply_masks, choose, decode, palette_single, palette_update, units_of, write_dense,
+    write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
 };
+pub(crate) use lookup::BATCH;
 
 /// Cells per block side (log2).
 pub(crate) const BLOCK_LOG2: u32 = 3;
@@ -119,7 +125,7 @@ pub(crate) type Cells = [i16; BLOCK_CELLS];
 #[derive(Debug, Clone, Default)]
 pub(crate) struct Store {
     /// Superblock (block >> 3) to its table's number.
-    top: FxHashMap<BlockKey, u32>,
+    dir: Directory,
     /// The superblocks' keys, by number.
     keys: Vec<BlockKey>,
     /// The tables, 512 entries each, by number.
@@ -134,35 +140,15 @@ pub(crate) struct Store {
     scratch: Vec<u32>,
     /// Compactions of the arena so far.
     compactions: usize,
+    /// Whether a block was refused for want of room in the arena.
+    overflowed: bool,
 }
 
 impl Store {
-    /// The stored value of a cell (`UNKNOWN` when unknown).
-    #[inline]
-    pub fn get(&self, cell: [i64; 3]) -> i16 {
-        let (b, i) = split(cell);
-        let Some(&t) = self.top.get(&b.map(|c| c >> BLOCK_LOG2)) else {
-            return UNKNOWN;
-        };
-        let e = self.tables[t as usize * TABLE + local(b)];
-        let at = e.offset() as usize * UNIT;
-        let words = &self.arena.words;
-        match e.tag() {
-            EMPTY => UNKNOWN,
-            UNIFORM => (e.0 >> 16) as u16 as i16,
-            SPARSE => sparse_get(&words[at..], i),
-            DENSE => words[at + i] as i16,
-            t => {
-                let w = 1 << (t - PALETTE);
-                let words = &words[at..];
-                words[bits_words(w) + 1 + palette_index(words, w, i)] as i16
-            }
-        }
-    }
-
     /// The slot of block `b` in the tables, if its superblock has a table.
+    #[inline(always)]
     fn find(&self, b: BlockKey) -> Option<usize> {
-        let t = *self.top.get(&b.map(|c| c >> BLOCK_LOG2))?;
+        let t = self.dir.get(b.map(|c| c >> BLOCK_LOG2))?;
         Some(t as usize * TABLE + local(b))
     }
 
@@ -173,7 +159,7 @@ impl Store {
             Some((k, t)) if k == s => t,
             _ => {
                 let n = self.keys.len() as u32;
-                let t = *self.top.entry(s).or_insert(n);
+                let t = self.dir.get_or_insert(s, n);
                 if t == n {
                     if self.tables.len() == self.tables.capacity() {
                         // A quarter more, not double: the capacity is counted.
@@ -249,18 +235,42 @@ impl Store {
     }
 
     /// Gives slot `s` (emptied first) a new block of `units` units with this tag;
-    /// returns the block's words.
-    fn place(&mut self, s: usize, tag: u32, units: usize) -> &mut [u16] {
+    /// returns the block's words. `None`, leaving the slot as it was, when the arena
+    /// has no room for it (past its limit): then [`Store::overflowed`] tells.
+    fn place(&mut self, s: usize, tag: u32, units: usize) -> Option<&mut [u16]> {
         let old = self.tables[s];
         let at = if old.in_arena() && units_of(old.tag(), self.words_of(old)) == units {
             old.offset()
         } else {
+            if !self.arena.has_room(units) {
+                self.overflowed = true;
+                return None;
+            }
             self.clear(s);
             self.blocks += 1;
-            self.arena.alloc(units)
+            // Clearing may compact the arena, which only makes room.
+            self.arena.alloc(units).expect("room checked")
         };
         self.tables[s] = Entry::at(tag, at);
-        self.arena.get_mut(at, units * UNIT)
+        Some(self.arena.get_mut(at, units * UNIT))
+    }
+
+    /// Whether a block was refused for want of room in the arena (so that some
+    /// updates were dropped), since the store was made.
+    pub fn overflowed(&self) -> bool {
+        self.overflowed
+    }
+
+    /// The arena's limit in bytes.
+    pub fn limit_bytes(&self) -> usize {
+        self.arena.limit * UNIT * 2
+    }
+
+    /// Lowers the arena's limit to `units` units (a test hook: the real limit,
+    /// 8 GiB, is too big for a test).
+    #[cfg(test)]
+    pub fn set_limit_units(&mut self, units: usize) {
+        self.arena.limit = units;
     }
 
     /// Moves every arena block to a new arena, in table order, leaving no free chunk.
@@ -278,6 +288,7 @@ impl Store {
         }
         self.arena = Arena {
             words,
+            limit: self.arena.limit,
             ..Arena::default()
         };
         self.compactions += 1;
@@ -317,11 +328,21 @@ impl Store {
                         .filter(|(_, &v)| v != UNKNOWN)
                         .map(|(i, &v)| (i as u32) << 16 | u32::from(v as u16)),
                 );
-                write_sparse(self.place(s, tag, units), &list);
+                if let Some(words) = self.place(s, tag, units) {
+                    write_sparse(words, &list);
+                }
                 self.scratch = list;
             }
-            DENSE => write_dense(self.place(s, tag, units), cells),
-            t => write_palette(self.place(s, t, units), 1 << (t - PALETTE), &census),
+            DENSE => {
+                if let Some(words) = self.place(s, tag, units) {
+                    write_dense(words, cells);
+                }
+            }
+            t => {
+                if let Some(words) = self.place(s, t, units) {
+                    write_palette(words, 1 << (t - PALETTE), &census);
+                }
+            }
         }
     }
 
@@ -376,7 +397,7 @@ impl Store {
 
     /// Reserves room for `n` more blocks.
     pub fn reserve(&mut self, n: usize) {
-        self.top.reserve(n / TABLE);
+        self.dir.reserve(n / TABLE);
     }
 
     /// Calls `f` on every block's known cells: `(index in block, value)`, or once
@@ -431,18 +452,28 @@ impl Store {
         });
     }
 
+    /// Whether lookups go through the dense directory (not the hash map).
+    #[cfg(test)]
+    pub fn dense_directory(&self) -> bool {
+        self.dir.is_dense()
+    }
+
+    /// Units in the arena (in use or free).
+    #[cfg(test)]
+    pub fn arena_units(&self) -> usize {
+        self.arena.len_units()
+    }
+
     /// Compactions of the arena so far.
     #[cfg(test)]
     pub fn compactions(&self) -> usize {
         self.compactions
     }
 
-    /// Bytes held: the directory's buckets, tables and keys, the arena (capacities)
-    /// and the merge buffer.
+    /// Bytes held: the directory, tables and keys, the arena (capacities) and the
+    /// merge buffer.
     pub fn bytes(&self) -> usize {
-        // hashbrown: key + value per bucket, plus one control byte.
-        let bucket = std::mem::size_of::<(BlockKey, u32)>() + 1;
-        self.top.capacity() * bucket
+        self.dir.bytes()
             + self.keys.capacity() * std::mem::size_of::<BlockKey>()
             + self.tables.capacity() * std::mem::size_of::<Entry>()
             + self.arena.bytes()

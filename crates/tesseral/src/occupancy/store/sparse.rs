@@ -70,7 +70,9 @@ impl Store {
         let values_all = if n < BLOCK_CELLS { k + 1 } else { k };
         let (tag, units) = choose(n, values_all, k);
         if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
-            write_sparse(self.place(s, SPARSE, units), &out);
+            if let Some(words) = self.place(s, SPARSE, units) {
+                write_sparse(words, &out);
+            }
             self.scratch = out;
         } else {
             let mut cells = [UNKNOWN; BLOCK_CELLS];

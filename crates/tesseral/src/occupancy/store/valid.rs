@@ -20,13 +20,10 @@ impl Store {
     /// # Panics
     /// When an invariant is broken.
     pub fn assert_valid(&self, fixed: Fixed) {
-        assert_eq!(self.keys.len(), self.top.len(), "one key per table");
+        self.dir.assert_valid(&self.keys);
         assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
-        for (t, k) in self.keys.iter().enumerate() {
-            assert_eq!(self.top.get(k), Some(&(t as u32)), "superblock {k:?}");
-        }
         if let Some((k, t)) = self.last {
-            assert_eq!(self.top.get(&k), Some(&t), "the last superblock");
+            assert_eq!(self.dir.get(k), Some(t), "the last superblock");
         }
         let n_units = self.arena.len_units();
         assert_eq!(self.arena.words.len(), n_units * UNIT, "arena length");

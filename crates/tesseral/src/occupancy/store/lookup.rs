@@ -1,0 +1,125 @@
+//! Reading cells: one at a time ([`Store::get`]) or in batches whose memory
+//! accesses are prefetched in passes ([`Store::get_many`]).
+
+use super::arena::UNIT;
+use super::forms::{bits_words, sparse_get, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
+use super::{local, split, Entry, Store};
+use crate::occupancy::sensor::UNKNOWN;
+
+/// Cells looked up together by [`Store::get_many`].
+pub(crate) const BATCH: usize = 32;
+
+/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
+    // address is that of a live reference anyway).
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}
+
+impl Store {
+    /// The stored value of a cell (`UNKNOWN` when unknown).
+    #[inline(always)]
+    pub fn get(&self, cell: [i64; 3]) -> i16 {
+        let (b, i) = split(cell);
+        match self.find(b) {
+            Some(s) => self.value(self.tables[s], i),
+            None => UNKNOWN,
+        }
+    }
+
+    /// The value of cell `i` of the block of entry `e`.
+    #[inline(always)]
+    fn value(&self, e: Entry, i: usize) -> i16 {
+        let tag = e.tag();
+        if tag <= UNIFORM {
+            return if tag == EMPTY {
+                UNKNOWN
+            } else {
+                (e.0 >> 16) as u16 as i16
+            };
+        }
+        let words = &self.arena.words;
+        let at = e.offset() as usize * UNIT;
+        if tag == SPARSE {
+            return sparse_get(&words[at..], i);
+        }
+        // A palette of width w, or a dense block read as a palette of width 16
+        // whose cells are their values (tags 3 to 7): no branch on the width. The
+        // value list's first line is fetched while the cell's bits are read.
+        let w = 1usize << (tag - PALETTE);
+        if let Some(x) = words.get(at + bits_words(w as u32) + 1) {
+            prefetch(x);
+        }
+        let bit = i * w;
+        let j = (words[at + (bit >> 4)] >> (bit & 15)) as usize & ((1 << w) - 1);
+        let v = if tag == DENSE {
+            at + i
+        } else {
+            at + bits_words(w as u32) + 1 + j
+        };
+        words[v] as i16
+    }
+
+    /// The values of `cells` into `out` (as many), as [`get`](Self::get) would give
+    /// them, in three passes that each prefetch what the next one reads: the table
+    /// entries, then the blocks' words in the arena. The cache misses of up to
+    /// [`BATCH`] cells overlap rather than follow one another.
+    ///
+    /// # Panics
+    /// When `cells` and `out` differ in length.
+    pub fn get_many(&self, cells: &[[i64; 3]], out: &mut [i16]) {
+        assert_eq!(cells.len(), out.len(), "as many values as cells");
+        let mut slots = [usize::MAX; BATCH];
+        let mut entries = [Entry::EMPTY; BATCH];
+        for (cells, out) in cells.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
+            for (s, &c) in slots.iter_mut().zip(cells) {
+                *s = self.find(split(c).0).unwrap_or(usize::MAX);
+                if let Some(e) = self.tables.get(*s) {
+                    prefetch(e);
+                }
+            }
+            for ((e, &s), &c) in entries.iter_mut().zip(&slots).zip(cells) {
+                *e = self.tables.get(s).copied().unwrap_or(Entry::EMPTY);
+                self.prefetch_cell(*e, local(c));
+            }
+            for ((o, &e), &c) in out.iter_mut().zip(&entries).zip(cells) {
+                *o = self.value(e, local(c));
+            }
+        }
+    }
+
+    /// Prefetches the arena words that [`value`](Self::value) reads for cell `i` of
+    /// the block of entry `e`.
+    #[inline]
+    fn prefetch_cell(&self, e: Entry, i: usize) {
+        let tag = e.tag();
+        if tag <= UNIFORM {
+            return;
+        }
+        let at = e.offset() as usize * UNIT;
+        let (a, b) = match tag {
+            // The header and the first cells; then the middle of the list, where
+            // the binary search starts, is often in the next line.
+            SPARSE => (at, at + 4 * UNIT),
+            DENSE => (at + i, at + i),
+            t => {
+                let w = 1 << (t - PALETTE);
+                (at + ((i * w) >> 4), at + bits_words(w as u32) + 1)
+            }
+        };
+        let words = &self.arena.words;
+        for k in [a, b] {
+            if let Some(x) = words.get(k) {
+                prefetch(x);
+            }
+        }
+    }
+}

@@ -1,0 +1,316 @@
+//! Lookups (`Store::get`, the batched `Store::get_many`, `OccupancyMap::log_odds_many`)
+//! through the dense superblock directory and its hash-map fallback, against a
+//! `HashMap` of cells; and the arena's limit.
+
+use std::collections::HashMap;
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+use super::sensor::{Fixed, UNKNOWN};
+use super::store::Store;
+use super::{OccupancyError, OccupancyMap, SensorModel};
+
+/// Where a map's blocks lie.
+#[derive(Debug, Clone, Copy)]
+enum Layout {
+    /// Within a few superblocks around `at` (a dense directory).
+    Near([i64; 3]),
+    /// Clusters far apart (superblocks up to 2^40 cells apart): a box far larger than
+    /// the superblocks stored, so the hash map alone.
+    Scattered,
+    /// Near the ends of the i64 range (the directory's index arithmetic at its edges).
+    Extremes,
+}
+
+fn random_block(rng: &mut Pcg64, layout: Layout, centres: &[[i64; 3]]) -> [i64; 3] {
+    let c = centres[rng.random_range(0..centres.len())];
+    let spread = match layout {
+        Layout::Near(_) => 20,
+        Layout::Scattered | Layout::Extremes => 6,
+    };
+    c.map(|x| {
+        x.saturating_add(rng.random_range(-spread..=spread))
+            .clamp(i64::MIN >> 3, i64::MAX >> 3)
+    })
+}
+
+fn centres(rng: &mut Pcg64, layout: Layout) -> Vec<[i64; 3]> {
+    match layout {
+        Layout::Near(at) => vec![at.map(|c| c >> 3)],
+        Layout::Scattered => (0..6)
+            .map(|_| [0i64; 3].map(|_| rng.random_range(-(1i64 << 37)..1 << 37)))
+            .collect(),
+        // Blocks: cells >> 3, so the ends of the block range.
+        Layout::Extremes => vec![
+            [i64::MAX >> 3; 3],
+            [i64::MIN >> 3; 3],
+            [i64::MIN >> 3, i64::MAX >> 3, 0],
+        ],
+    }
+}
+
+/// Cells to look up: the model's, their neighbours, and cells of no block.
+fn probes(rng: &mut Pcg64, model: &HashMap<[i64; 3], i16>, blocks: &[[i64; 3]]) -> Vec<[i64; 3]> {
+    let mut out: Vec<[i64; 3]> = model.keys().copied().collect();
+    for _ in 0..2000 {
+        let b = blocks[rng.random_range(0..blocks.len())];
+        // A cell of the block or of one near it (often in no superblock stored).
+        let far = [0i64; 3].map(|_| rng.random_range(-80i64..=80));
+        let near = [0i64; 3].map(|_| rng.random_range(-9i64..=16));
+        let d = if rng.random_range(0..4) == 0 {
+            far
+        } else {
+            near
+        };
+        out.push([0, 1, 2].map(|a| (b[a] << 3).saturating_add(d[a])));
+    }
+    for _ in 0..200 {
+        out.push([0i64; 3].map(|_| rng.random::<i64>()));
+    }
+    out.extend([[i64::MIN; 3], [i64::MAX; 3], [0; 3], [-1; 3]]);
+    out
+}
+
+/// Every probe through `get` and `get_many` (in slices of odd lengths) agrees with
+/// the model.
+fn check_lookups(store: &Store, model: &HashMap<[i64; 3], i16>, probes: &[[i64; 3]], what: &str) {
+    let want: Vec<i16> = probes
+        .iter()
+        .map(|c| model.get(c).copied().unwrap_or(UNKNOWN))
+        .collect();
+    for (c, &w) in probes.iter().zip(&want) {
+        assert_eq!(store.get(*c), w, "{what}: get {c:?}");
+    }
+    let mut got = vec![0i16; probes.len()];
+    for len in [1, 31, 32, 33, 1000] {
+        for (c, g) in probes.chunks(len).zip(got.chunks_mut(len)) {
+            store.get_many(c, g);
+        }
+        assert_eq!(got, want, "{what}: get_many in slices of {len}");
+    }
+}
+
+fn run(seed: u64, layout: Layout, dense: Option<bool>) {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut rng = Pcg64::seed_from_u64(seed);
+    let centres = centres(&mut rng, layout);
+    let mut store = Store::default();
+    let mut model: HashMap<[i64; 3], i16> = HashMap::new();
+    let mut blocks: Vec<[i64; 3]> = Vec::new();
+    let few = [fixed.min, fixed.max, fixed.miss, fixed.hit, 0];
+    for op in 0..1500 {
+        let b = if blocks.is_empty() || rng.random_range(0..3) == 0 {
+            let b = random_block(&mut rng, layout, &centres);
+            blocks.push(b);
+            b
+        } else {
+            blocks[rng.random_range(0..blocks.len())]
+        };
+        let cell = |i: usize| {
+            [
+                b[0] << 3 | (i & 7) as i64,
+                b[1] << 3 | (i >> 3 & 7) as i64,
+                b[2] << 3 | (i >> 6) as i64,
+            ]
+        };
+        match rng.random_range(0..4) {
+            0 => {
+                // A scan's masks: every form of block comes out of these.
+                let mut miss = [0u64; 8];
+                let mut hit = [0u64; 8];
+                let density = rng.random_range(1..5);
+                for w in 0..8 {
+                    miss[w] = (0..density).fold(u64::MAX, |m, _| m & rng.random::<u64>());
+                    hit[w] = (0..density + 1).fold(!miss[w], |m, _| m & rng.random::<u64>());
+                }
+                store.update(b, &miss, &hit, fixed);
+                for i in 0..512 {
+                    let c = cell(i);
+                    let old = model.get(&c).copied().unwrap_or(UNKNOWN);
+                    if hit[i >> 6] >> (i & 63) & 1 == 1 {
+                        model.insert(c, fixed.apply_hit(old));
+                    } else if miss[i >> 6] >> (i & 63) & 1 == 1 {
+                        model.insert(c, fixed.apply_miss(old));
+                    }
+                }
+            }
+            1 => {
+                // Many values in one block (palettes of 8 bits, dense blocks).
+                for _ in 0..rng.random_range(1..300) {
+                    let c = cell(rng.random_range(0..512));
+                    let v = rng.random_range(fixed.min..=fixed.max);
+                    store.set(c, v, fixed);
+                    model.insert(c, v);
+                }
+            }
+            _ => {
+                let c = cell(rng.random_range(0..512));
+                let v = if rng.random_range(0..4) == 0 {
+                    UNKNOWN
+                } else {
+                    few[rng.random_range(0..few.len())]
+                };
+                store.set(c, v, fixed);
+                if v == UNKNOWN {
+                    model.remove(&c);
+                } else {
+                    model.insert(c, v);
+                }
+            }
+        }
+        store.assert_valid(fixed);
+        let what = format!("seed {seed} {layout:?} op {op}");
+        // The block just changed, and now and then every probe.
+        let changed: Vec<[i64; 3]> = (0..512).map(cell).collect();
+        check_lookups(&store, &model, &changed, &what);
+        if op % 250 == 0 {
+            let p = probes(&mut rng, &model, &blocks);
+            check_lookups(&store, &model, &p, &what);
+        }
+    }
+    let p = probes(&mut rng, &model, &blocks);
+    check_lookups(&store, &model, &p, &format!("seed {seed} {layout:?}"));
+    if let Some(dense) = dense {
+        assert_eq!(store.dense_directory(), dense, "seed {seed} {layout:?}");
+    }
+}
+
+#[test]
+fn lookups_near_the_origin_agree_with_the_model() {
+    for seed in 0..3 {
+        run(seed, Layout::Near([0; 3]), Some(true));
+    }
+}
+
+#[test]
+fn lookups_far_from_the_origin_and_negative_agree_with_the_model() {
+    for (seed, at) in [
+        [-1_000_000_007, 5_000_000_000_003, -17],
+        [1 << 50, -(1 << 50), 3],
+        [-3, -5, -7],
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        run(10 + seed as u64, Layout::Near(at), Some(true));
+    }
+}
+
+#[test]
+fn lookups_over_huge_sparse_extents_use_the_hash_map_and_agree() {
+    for seed in 0..3 {
+        run(20 + seed, Layout::Scattered, Some(false));
+    }
+    for seed in 0..2 {
+        run(30 + seed, Layout::Extremes, Some(false));
+    }
+}
+
+#[test]
+fn the_directory_goes_dense_again_once_the_superblocks_fill_their_box() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut store = Store::default();
+    let mut model = HashMap::new();
+    let mut put = |store: &mut Store, c: [i64; 3], check: bool| {
+        store.set(c, fixed.hit, fixed);
+        model.insert(c, fixed.hit);
+        if check {
+            store.assert_valid(fixed);
+        }
+    };
+    // Two superblocks 2^12 superblocks apart: a box of some 55,000 slots, over
+    // budget.
+    put(&mut store, [0, 0, 0], true);
+    put(&mut store, [64 << 12, 0, 0], true);
+    assert!(!store.dense_directory());
+    // Then a line of superblocks between them, until the box's slots are few enough
+    // per superblock.
+    let mut x = 0;
+    while !store.dense_directory() {
+        x += 64;
+        put(&mut store, [x, 0, 0], x % 6400 == 0);
+        assert!(x < 64 << 12, "never dense again");
+    }
+    store.assert_valid(fixed);
+    let probes: Vec<[i64; 3]> = (-5..70_000)
+        .map(|i| [i * 7, i % 5 - 2, 0])
+        .chain(model.keys().copied())
+        .collect();
+    check_lookups(&store, &model, &probes, "dense again");
+}
+
+#[test]
+fn log_odds_many_agrees_with_log_odds() {
+    let mut rng = Pcg64::seed_from_u64(5);
+    let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    for _ in 0..4 {
+        let origin = [0.0f64; 3].map(|_| rng.random_range(-1.0..1.0));
+        let points: Vec<[f64; 3]> = (0..300)
+            .map(|_| [0.0f64; 3].map(|_| rng.random_range(-6.0..6.0)))
+            .collect();
+        map.insert_scan(origin, &points, None);
+        map.assert_valid();
+    }
+    let cells: Vec<[i64; 3]> = (0..5000)
+        .map(|_| [0i64; 3].map(|_| rng.random_range(-70..70)))
+        .collect();
+    let mut out = vec![Some(-9.0); cells.len()];
+    map.log_odds_many(&cells, &mut out);
+    let want: Vec<Option<f32>> = cells.iter().map(|&c| map.log_odds(c)).collect();
+    assert_eq!(out, want);
+    assert!(want.iter().any(Option::is_some) && want.iter().any(Option::is_none));
+}
+
+#[test]
+fn a_full_arena_refuses_blocks_with_an_error_and_stays_valid() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut rng = Pcg64::seed_from_u64(9);
+    let mut store = Store::default();
+    // 200 units of 16 bytes: a few blocks.
+    store.set_limit_units(200);
+    let mut model: HashMap<[i64; 3], i16> = HashMap::new();
+    let mut refused = 0;
+    for op in 0..400 {
+        let b = [rng.random_range(0..40), rng.random_range(-3..3), 0];
+        let c = [
+            b[0] << 3 | rng.random_range(0..8),
+            b[1] << 3 | rng.random_range(0..8),
+            rng.random_range(0..8),
+        ];
+        let v = rng.random_range(fixed.min..=fixed.max);
+        let was = store.overflowed();
+        let before = store.cells(b);
+        store.set(c, v, fixed);
+        store.assert_valid(fixed);
+        assert!(
+            store.arena_units() <= 200,
+            "op {op}: the arena passed its limit"
+        );
+        if store.get(c) == v {
+            model.insert(c, v);
+        } else {
+            // Refused: the block is as it was, and the store says so.
+            assert!(store.overflowed(), "op {op}: a dropped update unreported");
+            assert_eq!(store.cells(b), before, "op {op}: a refused block changed");
+            refused += 1;
+        }
+        assert!(!was || store.overflowed(), "op {op}: the flag is kept");
+        for (&c, &v) in &model {
+            assert_eq!(store.get(c), v, "op {op}: cell {c:?}");
+        }
+    }
+    assert!(refused > 0, "the limit was reached");
+    // Through the map: the error names the limit.
+    let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    assert_eq!(map.check_capacity(), Ok(()));
+    map.store.set_limit_units(100);
+    let points: Vec<[f64; 3]> = (0..2000)
+        .map(|_| [0.0f64; 3].map(|_| rng.random_range(-20.0..20.0)))
+        .collect();
+    map.insert_scan([0.0; 3], &points, None);
+    map.assert_valid();
+    let e = map.check_capacity().unwrap_err();
+    assert_eq!(e, OccupancyError::Capacity { limit_bytes: 1600 });
+    assert!(e.to_string().contains("1600 bytes"), "{e}");
+}

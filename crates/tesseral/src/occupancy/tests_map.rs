@@ -1,0 +1,201 @@
+//! The occupancy map's other behaviour: pruning, the fixed point against OctoMap's
+//! floats, scan counts, far keys, posed scans, models, and the scan soak (against
+//! the naive model of `tests`).
+
+use std::collections::{HashMap, HashSet};
+
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+use super::sensor::{Fixed, UNKNOWN};
+use super::tests::{check_same, Cell, Naive};
+use super::*;
+#[test]
+fn pruning_keeps_clamped_blocks_as_one_entry() {
+    let mut map = OccupancyMap::new(1.0, SensorModel::octomap()).unwrap();
+    // Rays along x through a 16-cell line of blocks, many times: free, clamped.
+    let points: Vec<[f64; 3]> = (0..8)
+        .flat_map(|y| (0..8).map(move |z| [40.5, f64::from(y) + 0.5, f64::from(z) + 0.5]))
+        .collect();
+    for _ in 0..10 {
+        for y in 0..8 {
+            for z in 0..8 {
+                map.insert_scan(
+                    [0.5, f64::from(y) + 0.5, f64::from(z) + 0.5],
+                    &points[..0],
+                    None,
+                );
+            }
+        }
+        let origins: Vec<[f64; 3]> = points.iter().map(|p| [0.5, p[1], p[2]]).collect();
+        for (o, p) in origins.iter().zip(&points) {
+            map.insert_scan(*o, &[*p], None);
+        }
+        map.assert_valid();
+    }
+    // Blocks 0..=4 along x are all free and clamped: uniform; block 5 holds the hits.
+    for bx in 0..5 {
+        assert!(
+            matches!(
+                map.store.entry([bx, 0, 0]).map(|e| e.kind()),
+                Some(store::Kind::Uniform(_))
+            ),
+            "block {bx}"
+        );
+    }
+    assert_eq!(map.state([3, 3, 3]), CellState::Free);
+    assert_eq!(
+        map.log_odds([3, 3, 3]),
+        Some(map.fixed.to_f32(map.fixed.min))
+    );
+    assert_eq!(map.state([40, 3, 3]), CellState::Occupied);
+    assert_eq!(map.occupied_count(), 64);
+    assert_eq!(map.free_count(), 40 * 64);
+    assert_eq!(map.leaf_count(), 5 + 64);
+}
+
+#[test]
+fn fixed_point_agrees_with_octomap_floats_on_occupancy() {
+    // Every state reachable in up to 40 updates from unknown, as (OctoMap's f32
+    // log-odds, our fixed point): the occupancy decision is the same in each.
+    let m = SensorModel::octomap();
+    let f = Fixed::new(&m);
+    let mut frontier: HashSet<(u32, i16)> = HashSet::from([(0f32.to_bits(), 0i16)]);
+    let mut seen = frontier.clone();
+    let mut worst = 0f32;
+    for _ in 0..40 {
+        let mut next = HashSet::new();
+        for &(b, q) in &frontier {
+            let x = f32::from_bits(b);
+            for (inc, hit) in [(m.hit(), true), (m.miss(), false)] {
+                let y = (x + inc).clamp(m.clamp_min(), m.clamp_max());
+                let r = if hit { f.apply_hit(q) } else { f.apply_miss(q) };
+                assert_eq!(
+                    y >= m.threshold(),
+                    r >= f.threshold,
+                    "{y} vs {}",
+                    f.to_f32(r)
+                );
+                worst = worst.max((y - f.to_f32(r)).abs());
+                if seen.insert((y.to_bits(), r)) {
+                    next.insert((y.to_bits(), r));
+                }
+            }
+        }
+        frontier = next;
+    }
+    assert!(worst < 2e-3, "fixed point drifts by {worst}");
+}
+
+#[test]
+fn stats_count_skipped_points_and_bad_origins() {
+    let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    let s = map.insert_scan([0.0; 3], &[[f64::NAN, 0.0, 0.0], [1.0, 0.0, 0.0]], None);
+    assert_eq!((s.points, s.rays, s.skipped, s.hits), (2, 1, 1, 1));
+    let s = map.insert_scan([f64::INFINITY, 0.0, 0.0], &[[1.0, 0.0, 0.0]], None);
+    assert_eq!((s.points, s.rays, s.skipped), (1, 0, 1));
+    assert!(OccupancyMap::new(0.0, SensorModel::octomap()).is_err());
+    assert!(SensorModel::from_probabilities(0.4, 0.4, (0.1, 0.9), 0.5).is_err());
+    assert!(SensorModel::from_probabilities(0.7, 0.4, (0.6, 0.9), 0.5).is_err());
+    map.assert_valid();
+}
+
+#[test]
+fn unbounded_keys_far_from_the_origin() {
+    let mut map = OccupancyMap::new(1.0, SensorModel::octomap()).unwrap();
+    let far = 4.0e15;
+    let s = map.insert_scan(
+        [far + 0.5, -far + 0.5, 0.5],
+        &[[far + 10.5, -far + 0.5, 0.5]],
+        None,
+    );
+    assert_eq!((s.hits, s.misses), (1, 10));
+    assert_eq!(
+        map.state([4_000_000_000_000_010, -4_000_000_000_000_000, 0]),
+        CellState::Occupied
+    );
+    map.assert_valid();
+}
+
+#[test]
+fn posed_scans_rotate_then_translate() {
+    let pose = Pose {
+        translation: [1.0, 2.0, 3.0],
+        roll: 0.0,
+        pitch: 0.0,
+        yaw: std::f64::consts::FRAC_PI_2,
+    };
+    let p = pose.apply([1.0, 0.0, 0.0]);
+    assert!((p[0] - 1.0).abs() < 1e-12 && (p[1] - 3.0).abs() < 1e-12 && (p[2] - 3.0).abs() < 1e-12);
+    let mut a = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    let mut b = a.clone();
+    let pts = [[1.0, 0.3, 0.2], [0.5, -0.4, 0.1]];
+    a.insert_scan_posed(&pose, &pts, None);
+    let world: Vec<[f64; 3]> = pts.iter().map(|q| pose.apply(*q)).collect();
+    b.insert_scan(pose.translation, &world, None);
+    assert_eq!(a.cells(), b.cells());
+}
+
+#[test]
+fn models_round_trip() {
+    let mut rng = Pcg64::seed_from_u64(3);
+    let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+    for _ in 0..5 {
+        let pts: Vec<[f64; 3]> = (0..200)
+            .map(|_| [0, 1, 2].map(|_| rng.random_range(-2.0..2.0)))
+            .collect();
+        map.insert_scan([0.0, 0.0, 0.0], &pts, Some(1.5));
+    }
+    let m = map.to_model().unwrap();
+    m.assert_valid();
+    assert_eq!(m.tree.voxel_count(), map.occupied_count());
+    assert_eq!(m.free.as_ref().unwrap().voxel_count(), map.free_count());
+    let back = OccupancyMap::from_model(&m).unwrap();
+    back.assert_valid();
+    assert_eq!(back.cells(), map.cells());
+    let _ = UNKNOWN;
+}
+
+/// The scan half of the 10^8-operation soak (issue 19 §4): scans from wandering
+/// origins until 10^8 cell updates are made, `assert_valid` after each, and every
+/// 25th scan checked against the naive model on a sample of its rays.
+#[test]
+#[ignore = "soak: minutes; run with --ignored"]
+fn soak_scan_insertion() {
+    let mut rng = Pcg64::seed_from_u64(19);
+    let res = 0.05;
+    let mut map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+    let mut updates = 0u64;
+    let mut scan = 0;
+    while updates < 100_000_000 {
+        let origin = [0, 1, 2].map(|_| rng.random_range(-20.0..20.0));
+        let points: Vec<[f64; 3]> = (0..20_000)
+            .map(|_| [0, 1, 2].map(|a| origin[a] + rng.random_range(-6.0..6.0)))
+            .collect();
+        let max_range = if scan % 2 == 0 { Some(5.0) } else { None };
+        if scan % 25 == 0 {
+            // A small scan through both: the map must change as the naive model says.
+            let few = &points[..50];
+            let mut naive = Naive {
+                cells: HashMap::new(),
+                f: map.fixed,
+                res,
+            };
+            let before: HashMap<Cell, i32> = {
+                let mut m = HashMap::new();
+                map.store.for_each(|c, v| {
+                    m.insert(c, i32::from(v));
+                });
+                m
+            };
+            naive.cells = before;
+            let got = map.insert_scan(origin, few, max_range);
+            assert_eq!(got, naive.scan(origin, few, max_range));
+            check_same(&map, &naive);
+        }
+        let s = map.insert_scan(origin, &points, max_range);
+        updates += s.hits + s.misses;
+        map.assert_valid();
+        scan += 1;
+    }
+}
