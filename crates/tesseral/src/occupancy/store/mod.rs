@@ -8,11 +8,8 @@
 mod arena;
 mod dir;
 mod forms;
-<<<<<<< HEAD
 mod fresh;
-=======
 mod lookup;
->>>>>>> s4-occlook
 mod sparse;
 mod valid;
 
