@@ -71,7 +71,9 @@ impl Store {
                     bits &= bits - 1;
                 }
             }
-            write_sparse(self.place(s, SPARSE, units), &list);
+            if let Some(words) = self.place(s, SPARSE, units) {
+                write_sparse(words, &list);
+            }
             self.scratch = list;
             return;
         }
@@ -96,7 +98,10 @@ impl Store {
                     .fold(0, |a, (_, p)| a | p.2[q])
             })
         };
-        let words = self.place(s, tag, units);
+        // A full arena refuses the block (the store remembers it: `overflowed`).
+        let Some(words) = self.place(s, tag, units) else {
+            return;
+        };
         words.fill(0);
         let lo = plane(0);
         if w == 1 {
