@@ -10,9 +10,14 @@
 
 mod cache;
 mod colours;
+mod modes;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_modes;
 mod top;
+
+pub use modes::{contact_sheet_streamed, render_streamed, section_streamed};
 
 use std::path::Path;
 use std::sync::atomic::Ordering;
@@ -25,7 +30,6 @@ use top::{ChunkRef, Top, TopKid};
 use super::index::{RayTree, Root};
 use super::nodes::{bounding_box, Kid, NodeId, Nodes, Trace};
 use super::trace::rank;
-use super::{render_cut, Image, RenderOptions, Surface};
 use crate::io::{FormatError, TessFile};
 use crate::model::Rgba;
 use crate::Voxel;
@@ -404,22 +408,4 @@ impl Trace for StreamedTree {
     fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
         self.bbox
     }
-}
-
-/// Renders a [`StreamedTree`] as [`super::render_with`] renders the whole tree (no
-/// clipping plane: `opts.clip` is ignored), reading only the chunks the rays reach.
-/// The image equals the in-memory render's.
-///
-/// # Errors
-/// The first damaged chunk or colour block met, naming the file and the chunk.
-///
-/// # Runtime
-/// As [`super::render`], plus decoding the chunks reached (again when evicted).
-pub fn render_streamed(
-    tree: &StreamedTree,
-    surface: Surface<'_>,
-    opts: &RenderOptions,
-) -> Result<Image, FormatError> {
-    let img = render_cut(tree, surface, opts, None);
-    tree.take_error().map_or(Ok(img), Err)
 }
