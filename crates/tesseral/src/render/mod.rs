@@ -302,7 +302,10 @@ fn section_of<T: Trace + ?Sized>(
                 v[axis] = at;
                 v[u_ax] += i;
                 v[v_ax] += j;
-                let (ux, vy) = ((v[u_ax] - origin[u_ax]) as usize, (v[v_ax] - origin[v_ax]) as usize);
+                let (ux, vy) = (
+                    (v[u_ax] - origin[u_ax]) as usize,
+                    (v[v_ax] - origin[v_ax]) as usize,
+                );
                 let centre = v.map(|c| c as f64 + 0.5);
                 let colour = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
                 for dy in 0..px {

@@ -112,15 +112,17 @@ fn streamed_cuts_and_sheets_equal_the_in_memory_ones() {
                 };
                 let want = render(&model.tree, surface(&shade_m), &opts);
                 let got = render_streamed(&st, surface(&shade_s), &opts).unwrap();
-                assert!(got == want, "case {case} chunk {chunk} pose {pose}: {opts:?}");
+                assert!(
+                    got == want,
+                    "case {case} chunk {chunk} pose {pose}: {opts:?}"
+                );
             }
             let opts = RenderOptions {
                 clip: (case % 3 != 0).then(|| random_clip(&mut rng, depth)),
                 ..random_options(&mut rng, case)
             };
             let want = contact_sheet(&model.tree, surface(&shade_m), &opts, &View::ALL, 2);
-            let got =
-                contact_sheet_streamed(&st, surface(&shade_s), &opts, &View::ALL, 2).unwrap();
+            let got = contact_sheet_streamed(&st, surface(&shade_s), &opts, &View::ALL, 2).unwrap();
             assert!(got == want, "case {case} chunk {chunk} sheet: {opts:?}");
         }
     }
@@ -177,7 +179,8 @@ fn a_slice_equals_the_naive_drawing() {
                 p[v] = j as i64;
                 if tree.contains(p) {
                     for (dx, dy) in [(0, 0), (0, 1), (1, 0), (1, 1)] {
-                        want.pixels[(size - 1 - (j * px + dy)) * size + i * px + dx] = DEFAULT_COLOUR;
+                        want.pixels[(size - 1 - (j * px + dy)) * size + i * px + dx] =
+                            DEFAULT_COLOUR;
                     }
                 }
             }
@@ -189,7 +192,12 @@ fn a_slice_equals_the_naive_drawing() {
             let s = b.size() as usize * px;
             let (x0, y0) = (b.min[u] as usize * px, b.min[v] as usize * px);
             for i in 0..s {
-                for (x, y) in [(x0 + i, y0), (x0 + i, y0 + s - 1), (x0, y0 + i), (x0 + s - 1, y0 + i)] {
+                for (x, y) in [
+                    (x0 + i, y0),
+                    (x0 + i, y0 + s - 1),
+                    (x0, y0 + i),
+                    (x0 + s - 1, y0 + i),
+                ] {
                     want.pixels[(size - 1 - y) * size + x] = [60, 60, 70];
                 }
             }
