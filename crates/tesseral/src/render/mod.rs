@@ -27,6 +27,8 @@ mod trace;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_images;
 
 pub use cut::crop_to_clip;
 pub use image::Image;
