@@ -275,3 +275,52 @@ fn empty_and_full_trees_cut_and_slice() {
         }
     }
 }
+
+/// A colour section damaged past its checksum (the checksum recomputed, as a file
+/// rewritten by a faulty tool would carry it) is an error naming the file, at open
+/// or while drawing, never a panic; the checksum alone catches the rest.
+#[test]
+fn a_damaged_colour_section_is_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0xc010);
+    let model = coloured(&mut rng, terrain(16));
+    let path = dir.path().join("good.tess");
+    write_v2(&path, &model, 64);
+    let good = std::fs::read(&path).unwrap();
+    let n = good.len();
+    let t = n - 48;
+    let sections = u64::from_le_bytes(good[t..t + 8].try_into().unwrap()) as usize;
+    let index = u64::from_le_bytes(good[t + 8..t + 16].try_into().unwrap()) as usize;
+    // Past the flags, the frame and the region count: the regions.
+    let first = sections + 2 + 32 + 8;
+    let bad = dir.path().join("bad.tess");
+    let mut errors = 0;
+    for (i, at) in (first..index).step_by(7).enumerate() {
+        let mut bytes = good.clone();
+        bytes[at] ^= [0x80, 0x7f, 0xff, 0x01][i % 4];
+        if i % 5 != 0 {
+            let mut crc = crc32fast::Hasher::new();
+            crc.update(&bytes[..40]);
+            crc.update(&bytes[sections..n - 12]);
+            let c = crc.finalize();
+            bytes[t + 36..t + 40].copy_from_slice(&c.to_le_bytes());
+        }
+        std::fs::write(&bad, &bytes).unwrap();
+        let drawn = StreamedTree::open(&bad, 1 << 20).and_then(|st| {
+            let shade = tree_shader(&st);
+            let opts = RenderOptions {
+                width: 32,
+                height: 24,
+                ..Default::default()
+            };
+            render_streamed(&st, surface(&shade), &opts)?;
+            section_streamed(&st, surface(&shade), 2, 1, 1)
+        });
+        if let Err(e) = drawn {
+            let e = e.to_string();
+            assert!(e.contains("bad.tess"), "byte {at}: {e}");
+            errors += 1;
+        }
+    }
+    assert!(errors > 10, "only {errors} damaged files were refused");
+}
