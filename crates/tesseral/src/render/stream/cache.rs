@@ -149,7 +149,11 @@ mod tests {
                 largest = c.largest().max(largest);
                 let keep = budget.saturating_sub(holders * largest);
                 let len = c.inner.lock().unwrap().map.len();
-                assert!(c.used() <= keep || len == 1, "step {i}: {} > {keep}", c.used());
+                assert!(
+                    c.used() <= keep || len == 1,
+                    "step {i}: {} > {keep}",
+                    c.used()
+                );
                 assert!(c.used() + holders * largest <= budget || len == 1);
             }
         }
