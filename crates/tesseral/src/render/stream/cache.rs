@@ -105,6 +105,7 @@ impl<V> Cache<V> {
     }
 
     /// The largest value seen, in bytes.
+    #[cfg(test)]
     pub(super) fn largest(&self) -> u64 {
         self.inner
             .lock()
