@@ -4,7 +4,7 @@
 //! wholly on the kept side is the tree's own, and one the plane crosses is:
 //!
 //! - white if it is white, or gray with no black voxel on the kept side (found by a
-//!   descent along the plane, remembered per node);
+//!   descent along the plane, remembered per node of side 16 or more);
 //! - gray if it is black (the crop splits it: a virtual node whose children are
 //!   classified the same way) or gray with a black voxel on the kept side.
 //!
@@ -26,6 +26,12 @@ const SPLIT: NodeId = NodeId {
     src: u32::MAX - 1,
     node: 0,
 };
+
+/// The answers of [`Clipped::any_kept`] are remembered for nodes of side at least
+/// 2^`MEMO_LOG2` only: smaller ones are cheap to ask again, and the plane crosses
+/// 4 times fewer nodes at each level up, so at most about 1/256 as many nodes are
+/// remembered as the plane crosses voxels.
+const MEMO_LOG2: u8 = 4;
 
 /// Where a node lies with respect to the plane.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -107,13 +113,16 @@ impl<'b, T: Trace + ?Sized> Clipped<'b, T> {
     /// black voxel on the kept side: a descent through the nodes the plane crosses.
     fn any_kept(&self, cur: &mut T::Cursor<'b>, id: NodeId, path: u64, k: u8) -> bool {
         let key = (id.src, id.node);
-        if let Some(&b) = self
-            .kept
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .get(&key)
-        {
-            return b;
+        let memo = k >= MEMO_LOG2;
+        if memo {
+            if let Some(&b) = self
+                .kept
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .get(&key)
+            {
+                return b;
+            }
         }
         let mut found = false;
         for label in 0..8u8 {
@@ -136,10 +145,12 @@ impl<'b, T: Trace + ?Sized> Clipped<'b, T> {
                 break;
             }
         }
-        self.kept
-            .lock()
-            .unwrap_or_else(PoisonError::into_inner)
-            .insert(key, found);
+        if memo {
+            self.kept
+                .lock()
+                .unwrap_or_else(PoisonError::into_inner)
+                .insert(key, found);
+        }
         found
     }
 }
