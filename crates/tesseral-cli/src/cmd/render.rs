@@ -86,8 +86,9 @@ pub struct Args {
     #[arg(long)]
     json: bool,
     /// Load the whole model before drawing. By default a version-2 `.tess` file or a
-    /// dataset is drawn streamed (only the chunks the rays reach are read, within
-    /// --memory); a cut, a slice or a contact sheet always loads the model.
+    /// dataset is drawn streamed (only the chunks the rays, the cut or the slice
+    /// reach are read, within --memory), views, cuts, slices and contact sheets
+    /// alike.
     #[arg(long)]
     in_memory: bool,
     #[command(flatten)]
@@ -118,6 +119,18 @@ fn parse_plane(flag: &str, s: &str) -> Result<(usize, char, f64)> {
         bail!("--{flag} {s:?}: the number must be finite");
     }
     Ok((axis, op, value))
+}
+
+/// The pixels per voxel of a slice of a tree `side` voxels across, checked
+/// against the largest image.
+fn slice_scale(args: &Args, side: usize) -> Result<usize> {
+    let scale = usize::from(args.slice_scale.unwrap_or(4));
+    if side.saturating_mul(scale) > MAX_SIDE {
+        bail!(
+            "--slice: the tree is {side} voxels across; at {scale} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)"
+        );
+    }
+    Ok(scale)
 }
 
 fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
@@ -211,17 +224,40 @@ pub fn run(args: Args) -> Result<()> {
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
-    if !is_scene && cut.is_none() && slice.is_none() && !args.sheet && !args.in_memory {
-        if let Some(tree) = streamed::open(&args.input, &args.budget)? {
-            return streamed::draw(
-                &args.input,
-                &args.output,
-                args.json,
-                &tree,
-                &opts,
-                solid_colour,
-                start,
-            );
+    if !is_scene && !args.in_memory {
+        if let Some((tree, (unit, lo))) = streamed::open(&args.input, &args.budget)? {
+            let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
+            let mode = if let Some((axis, _, c)) = slice {
+                let side = 1usize << tree.depth();
+                let scale = slice_scale(&args, side)?;
+                streamed::Mode::Slice {
+                    axis,
+                    at: to_voxel(axis, c).floor() as i64,
+                    scale,
+                }
+            } else if args.sheet {
+                streamed::Mode::Sheet
+            } else {
+                streamed::Mode::View
+            };
+            let opts = RenderOptions {
+                clip: cut.map(|(axis, op, c)| Clip {
+                    axis,
+                    at: to_voxel(axis, c),
+                    keep_above: op == '>',
+                }),
+                ..opts
+            };
+            if let Some(clip) = opts.clip {
+                let spec = args.cut.as_deref().unwrap_or_default();
+                streamed::note_cut(&tree, clip, spec);
+            }
+            let out = streamed::Out {
+                input: &args.input,
+                output: &args.output,
+                json: args.json,
+            };
+            return streamed::draw(&out, &tree, mode, &opts, solid_colour, start);
         }
     }
     let mut colors = None;
@@ -289,13 +325,7 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let image = if let Some((axis, _, c)) = slice {
         let layer = to_voxel(axis, c).floor() as i64;
-        let side = tree.side() as usize;
-        let scale = usize::from(args.slice_scale.unwrap_or(4));
-        if side.saturating_mul(scale) > MAX_SIDE {
-            bail!(
-                "--slice: the tree is {side} voxels across; at {scale} pixels per voxel the image would exceed {MAX_SIDE} pixels (lower --slice-scale)"
-            );
-        }
+        let scale = slice_scale(&args, tree.side() as usize)?;
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)

@@ -86,8 +86,8 @@ pub fn crop_to_clip(tree: &LinearOctree, clip: Clip) -> LinearOctree {
 #[derive(Clone, Copy)]
 pub(super) struct Cut<'a> {
     pub(super) clip: Clip,
-    /// The tree before cropping.
-    pub(super) original: &'a LinearOctree,
+    /// Whether the tree before cropping holds a voxel.
+    pub(super) original: &'a (dyn Fn(Voxel) -> bool + Sync),
 }
 
 impl Cut<'_> {
@@ -109,7 +109,7 @@ impl Cut<'_> {
         let step = if self.clip.keep_above { -1 } else { 1 };
         let mut beyond = inside;
         beyond[a] = inside[a].saturating_add(step);
-        self.clip.keeps(inside) && !self.clip.keeps(beyond) && self.original.contains(beyond)
+        self.clip.keeps(inside) && !self.clip.keeps(beyond) && (self.original)(beyond)
     }
 }
 

@@ -13,6 +13,7 @@
 //! - PNG output through the `png` crate ([`Image::write_png`]), written atomically.
 
 mod beam;
+mod clipped;
 mod cut;
 mod frame;
 mod image;
@@ -26,6 +27,8 @@ mod trace;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_images;
 
 pub use cut::crop_to_clip;
 pub use image::Image;
@@ -34,7 +37,9 @@ pub use options::{
     Camera, Clip, NormalFn, Normals, Projection, RenderOptions, Shader, Surface, View,
     DEFAULT_COLOUR,
 };
-pub use stream::{render_streamed, StreamStats, StreamedTree};
+pub use stream::{
+    contact_sheet_streamed, render_streamed, section_streamed, StreamStats, StreamedTree,
+};
 pub use trace::{Hit, Ray, TraversalStack};
 
 use cut::Cut;
@@ -70,9 +75,10 @@ pub fn render(tree: &LinearOctree, surface: Surface<'_>, opts: &RenderOptions) -
         None => render_with(&RayTree::new(tree), surface, opts),
         Some(clip) => {
             let kept = crop_to_clip(tree, clip);
+            let contains = |v| tree.contains(v);
             let cut = Cut {
                 clip,
-                original: tree,
+                original: &contains,
             };
             render_cut(&RayTree::new(&kept), surface, opts, Some(cut))
         }
@@ -214,10 +220,23 @@ pub fn contact_sheet(
 ) -> Image {
     let kept = opts.clip.map(|c| crop_to_clip(tree, c));
     let rt = RayTree::new(kept.as_ref().unwrap_or(tree));
+    let contains = |v| tree.contains(v);
     let cut = opts.clip.map(|clip| Cut {
         clip,
-        original: tree,
+        original: &contains,
     });
+    sheet_of(&rt, cut, surface, opts, views, columns)
+}
+
+/// [`contact_sheet`] of `rt`, already cropped when `cut` is given.
+fn sheet_of<T: Trace + ?Sized>(
+    rt: &T,
+    cut: Option<Cut<'_>>,
+    surface: Surface<'_>,
+    opts: &RenderOptions,
+    views: &[View],
+    columns: usize,
+) -> Image {
     let columns = columns.clamp(1, views.len().max(1));
     let rows = views.len().div_ceil(columns);
     let gap = 4;
@@ -231,7 +250,7 @@ pub fn contact_sheet(
         let (az, el) = v.angles();
         o.camera.azimuth_deg = az;
         o.camera.elevation_deg = el;
-        let img = render_cut(&rt, surface, &o, cut);
+        let img = render_cut(rt, surface, &o, cut);
         let (c, r) = (i % columns, i / columns);
         sheet.blit(
             &img,
@@ -259,20 +278,36 @@ pub fn section(
     at: i64,
     pixels: usize,
 ) -> Image {
-    let side = tree.side() as usize;
+    section_of(&RayTree::new(tree), surface, axis, at, pixels)
+}
+
+/// [`section`] of any tree rays can be cast through: the black blocks the layer
+/// crosses are found by a descent along it, so only they are read.
+fn section_of<T: Trace + ?Sized>(
+    t: &T,
+    surface: Surface<'_>,
+    axis: usize,
+    at: i64,
+    pixels: usize,
+) -> Image {
+    let (depth, origin) = t.space();
+    let side = 1usize << depth;
     let (u_ax, v_ax) = ((axis + 1) % 3, (axis + 2) % 3);
     let px = pixels.max(1);
     let size = side * px;
     let mut img = Image::new(size, size, [255, 255, 255]);
-    let origin = tree.origin();
-    let rt = RayTree::new(tree);
-    for vy in 0..side {
-        for ux in 0..side {
-            let mut v = origin;
-            v[axis] = at;
-            v[u_ax] += ux as i64;
-            v[v_ax] += vy as i64;
-            if rt.contains(v) {
+    // The voxels of the layer, block by block.
+    nodes::layer_blocks(t, axis, at, &mut |bmin, s| {
+        for j in 0..s {
+            for i in 0..s {
+                let mut v = bmin;
+                v[axis] = at;
+                v[u_ax] += i;
+                v[v_ax] += j;
+                let (ux, vy) = (
+                    (v[u_ax] - origin[u_ax]) as usize,
+                    (v[v_ax] - origin[v_ax]) as usize,
+                );
                 let centre = v.map(|c| c as f64 + 0.5);
                 let colour = surface.colour.map_or(DEFAULT_COLOUR, |f| f(centre));
                 for dy in 0..px {
@@ -283,15 +318,12 @@ pub fn section(
                 }
             }
         }
-    }
+    });
     // Block outlines, where the layer crosses a block.
-    for b in tree.blocks() {
-        if at < b.min[axis] || at > b.max()[axis] {
-            continue;
-        }
-        let s = b.size() as usize * px;
-        let x0 = (b.min[u_ax] - origin[u_ax]) as usize * px;
-        let y0 = (b.min[v_ax] - origin[v_ax]) as usize * px;
+    nodes::layer_blocks(t, axis, at, &mut |bmin, s| {
+        let s = s as usize * px;
+        let x0 = (bmin[u_ax] - origin[u_ax]) as usize * px;
+        let y0 = (bmin[v_ax] - origin[v_ax]) as usize * px;
         for i in 0..s {
             for (x, y) in [
                 (x0 + i, y0),
@@ -304,6 +336,6 @@ pub fn section(
                 }
             }
         }
-    }
+    });
     img
 }

@@ -191,3 +191,50 @@ fn extreme<N: Nodes>(
         }
     }
 }
+
+/// Calls `f(min, size)` for each black block of `t` that the layer of voxels with
+/// coordinate `at` on `axis` crosses, found by a descent along the layer.
+pub(crate) fn layer_blocks<T: Trace + ?Sized>(
+    t: &T,
+    axis: usize,
+    at: i64,
+    f: &mut dyn FnMut([i64; 3], i64),
+) {
+    let (depth, origin) = t.space();
+    let side = 1i64 << depth;
+    if at < origin[axis] || at - origin[axis] >= side {
+        return;
+    }
+    match t.root() {
+        (Root::White, _) => {}
+        (Root::Black, _) => f(origin, side),
+        (Root::Gray, root) => layer_rec(&mut t.cursor(), root, origin, depth, 0, axis, at, f),
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn layer_rec<N: Nodes>(
+    n: &mut N,
+    id: NodeId,
+    min: [i64; 3],
+    k: u8,
+    path: u64,
+    axis: usize,
+    at: i64,
+    f: &mut dyn FnMut([i64; 3], i64),
+) {
+    let half = 1i64 << (k - 1);
+    let side = u8::from(at >= min[axis] + half);
+    for label in 0..8u8 {
+        if (label >> axis) & 1 != side || !n.maybe(id, label) {
+            continue;
+        }
+        let cmin = child_min(min, half, label);
+        let cpath = (path << 3) | u64::from(label);
+        match n.kid(id, label, cpath, k - 1) {
+            Kid::White => {}
+            Kid::Black => f(cmin, half),
+            Kid::Gray(c) => layer_rec(n, c, cmin, k - 1, cpath, axis, at, f),
+        }
+    }
+}

@@ -1,12 +1,13 @@
 //! `tesseral render` of a version-2 `.tess` file or a dataset without loading it:
-//! the rays read only the chunks they reach (`tesseral::render::StreamedTree`).
+//! the rays (of a view, a cut or a contact sheet) or the layer (of a slice) read
+//! only the chunks they reach (`tesseral::render::StreamedTree`).
 
 use std::path::Path;
 use std::time::Instant;
 
 use anyhow::{Context, Result};
 use tesseral::io::{FormatError, TessFile};
-use tesseral::render::{self, RenderOptions, StreamedTree};
+use tesseral::render::{self, Clip, RenderOptions, StreamedTree, View};
 
 use super::super::budget::Budget;
 use super::super::output;
@@ -17,14 +18,35 @@ fn cache_bytes(budget: &Budget) -> u64 {
     (budget.memory / 4).clamp(16 << 20, 1 << 30)
 }
 
-/// The input opened for a streamed render, or `None` when it is not a version-2
-/// `.tess` file or a dataset, or carries layers other than colours (then it is
-/// loaded whole).
-pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<StreamedTree>> {
+/// What to draw.
+pub(super) enum Mode {
+    /// One view (with a cross-section when the options carry a clip).
+    View,
+    /// The four named views.
+    Sheet,
+    /// The layer `at` on `axis`, `scale` pixels per voxel.
+    Slice { axis: usize, at: i64, scale: usize },
+}
+
+/// Where the picture goes.
+pub(super) struct Out<'a> {
+    pub(super) input: &'a Path,
+    pub(super) output: &'a Path,
+    pub(super) json: bool,
+}
+
+/// The world units of the input: (the side of a voxel, the corner of voxel 0).
+type Units = (f64, [f64; 3]);
+
+/// The input opened for a streamed render, with its units, or `None` when it is
+/// not a version-2 `.tess` file or a dataset, or carries layers other than colours
+/// (then it is loaded whole).
+pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<(StreamedTree, Units)>> {
     if output::is_stdio(input) {
         return Ok(None);
     }
     let cache = cache_bytes(budget);
+    let units;
     let opened = if tesseral::partition::is_dataset(input) {
         let m = tesseral::partition::read_manifest(input).map_err(|e| anyhow::anyhow!("{e}"))?;
         let mut files = Vec::with_capacity(m.parts.len());
@@ -37,36 +59,55 @@ pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<StreamedTree>
             return Ok(None);
         }
         let ranges = m.parts.iter().map(|p| (p.lo, p.hi)).collect();
+        units = (m.frame.voxel_size, m.frame.translate);
         StreamedTree::from_parts(files, ranges, cache)
     } else if tesseral::io::extension(input) == "tess" {
-        if !TessFile::open(input)
-            .map_err(|e| anyhow::anyhow!("{e}"))?
-            .is_streamed()
-        {
+        let f = TessFile::open(input).map_err(|e| anyhow::anyhow!("{e}"))?;
+        if !f.is_streamed() {
             return Ok(None);
         }
+        units = (f.frame().voxel_size, f.frame().translate);
+        drop(f);
         StreamedTree::open(input, cache)
     } else {
         return Ok(None);
     };
     match opened {
-        Ok(t) => Ok(Some(t)),
+        Ok(t) => Ok(Some((t, units))),
         Err(e) if matches!(e.kind(), FormatError::Unsupported(_)) => Ok(None),
         Err(e) => Err(anyhow::anyhow!("{e}")),
+    }
+}
+
+/// Says on standard error when the cut `clip` keeps none or all of the solid (an
+/// empty picture alone looks like a failure), from the bounding box alone.
+pub(super) fn note_cut(tree: &StreamedTree, clip: Clip, spec: &str) {
+    let Some((lo, hi)) = tree.bbox() else { return };
+    let a = clip.axis;
+    // The bounding box is tight: voxels lie on both of its faces.
+    let (none, all) = if clip.keep_above {
+        (hi[a] < clip.boundary(), lo[a] >= clip.boundary())
+    } else {
+        (lo[a] >= clip.boundary(), hi[a] < clip.boundary())
+    };
+    if none {
+        eprintln!("note: --cut '{spec}' keeps nothing of the solid; the picture is empty");
+    } else if all {
+        eprintln!("note: --cut '{spec}' keeps all of the solid (the plane does not cross it)");
     }
 }
 
 /// Draws `tree` with its stored colours (`solid` where it has none) and writes the
 /// picture.
 pub(super) fn draw(
-    input: &Path,
-    out: &Path,
-    json: bool,
+    out: &Out<'_>,
     tree: &StreamedTree,
+    mode: Mode,
     opts: &RenderOptions,
     solid: [u8; 3],
     started: Instant,
 ) -> Result<()> {
+    let (input, out, json) = (out.input, out.output, out.json);
     let load_ms = started.elapsed().as_secs_f64() * 1e3;
     let shader = |p: [f64; 3]| {
         tree.colour(p.map(|c| c.floor() as i64))
@@ -77,7 +118,12 @@ pub(super) fn draw(
         normal: None,
     };
     let start = Instant::now();
-    let image = render::render_streamed(tree, surface, opts).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let image = match mode {
+        Mode::View => render::render_streamed(tree, surface, opts),
+        Mode::Sheet => render::contact_sheet_streamed(tree, surface, opts, &View::ALL, 2),
+        Mode::Slice { axis, at, scale } => render::section_streamed(tree, surface, axis, at, scale),
+    }
+    .map_err(|e| anyhow::anyhow!("{e}"))?;
     let render_ms = start.elapsed().as_secs_f64() * 1e3;
     if output::is_stdio(out) {
         super::super::stdio::to_stdout("png", |p| {

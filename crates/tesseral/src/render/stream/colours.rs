@@ -2,8 +2,11 @@
 //! a list of regions (a colour and its leaves, delta-coded), with no index: it is
 //! read through once when the tree is opened, keeping a resume point every
 //! [`BLOCK`] leaves; a colour is then found by binary search of those points and of
-//! one decoded block, blocks kept in a [`Cache`].
+//! one decoded block, blocks kept in a [`Cache`]. The read-through lets the mapped
+//! pages go as it goes, so resident memory stays flat (the bytes are read once,
+//! as the index checksum at open reads them anyway).
 
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 
 use super::cache::Cache;
@@ -14,6 +17,12 @@ use crate::model::Rgba;
 
 /// Leaves per decoded colour block.
 pub(super) const BLOCK: u64 = 1024;
+
+/// Leaves read through between two releases of the file's mapped pages.
+const RELEASE: u64 = 1 << 20;
+
+/// Colour blocks decoded between two releases of the file's mapped pages.
+const RELEASE_BLOCKS: u64 = 256;
 
 /// One region of one part: its colour and where each block starts.
 struct Region {
@@ -40,6 +49,7 @@ impl Colours {
         files: &[TessFile],
         depth: u8,
         budget: u64,
+        holders: u64,
     ) -> Result<Option<Colours>, FormatError> {
         let mut parts = Vec::with_capacity(files.len());
         let mut any = false;
@@ -62,6 +72,10 @@ impl Colours {
                         blocks.push((leaf.code(), point));
                     }
                     i += 1;
+                    if i % RELEASE == 0 {
+                        // The pages read so far leave resident memory.
+                        f.release(0..u64::MAX);
+                    }
                 }
                 any |= i > 0;
                 regions.push(Region { rgba, blocks });
@@ -71,7 +85,7 @@ impl Colours {
         Ok(any.then(|| Colours {
             parts,
             depth,
-            cache: Cache::new(budget),
+            cache: Cache::new(budget, holders),
         }))
     }
 
@@ -102,6 +116,11 @@ impl Colours {
                     .collect::<Result<Vec<Leaf>, FormatError>>()
                     .map_err(|e| e.with_path(f.path()))?;
                 let n = std::mem::size_of_val(leaves.as_slice()) as u64 + 64;
+                if self.cache.loads.load(Ordering::Relaxed) % RELEASE_BLOCKS == 0 {
+                    // Now and then the pages of the blocks decoded leave resident
+                    // memory: the cache holds what was decoded from them.
+                    f.release(0..u64::MAX);
+                }
                 Ok::<_, FormatError>((leaves, n))
             })?;
             let j = block.partition_point(|l| l.code() <= code);

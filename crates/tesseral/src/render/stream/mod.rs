@@ -10,9 +10,14 @@
 
 mod cache;
 mod colours;
+mod modes;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_modes;
 mod top;
+
+pub use modes::{contact_sheet_streamed, render_streamed, section_streamed};
 
 use std::path::Path;
 use std::sync::atomic::Ordering;
@@ -25,7 +30,6 @@ use top::{ChunkRef, Top, TopKid};
 use super::index::{RayTree, Root};
 use super::nodes::{bounding_box, Kid, NodeId, Nodes, Trace};
 use super::trace::rank;
-use super::{render_cut, Image, RenderOptions, Surface};
 use crate::io::{FormatError, TessFile};
 use crate::model::Rgba;
 use crate::Voxel;
@@ -81,7 +85,9 @@ pub struct StreamStats {
 
 impl StreamedTree {
     /// Opens a version-2 `.tess` file, keeping at most about `cache_bytes` of decoded
-    /// chunks and colour blocks.
+    /// chunks and colour blocks, those the rendering threads hold included (for as
+    /// many threads as rayon's current pool has; see `docs/render-stream.md` for
+    /// the exact bound).
     ///
     /// # Errors
     /// [`FormatError`] naming the file: unreadable, not version 2, layers other than
@@ -123,7 +129,8 @@ impl StreamedTree {
                 .with_path(f.path()));
             }
             let (lo, hi) = ranges[p];
-            for (i, c) in f.chunks().into_iter().enumerate() {
+            let infos = f.chunks();
+            for (i, c) in infos.iter().copied().enumerate() {
                 if chunks.last().is_some_and(|l: &ChunkRef| l.hi > c.lo) || c.lo < lo || c.hi > hi {
                     return Err(FormatError::corrupt(format!(
                         "chunk {i}: range [{}, {}) overlaps an earlier part or leaves the part's range",
@@ -137,6 +144,7 @@ impl StreamedTree {
                     lo: c.lo,
                     hi: c.hi,
                     count: c.count,
+                    bytes: (c.offset, infos.get(i + 1).map_or(u64::MAX, |n| n.offset)),
                 });
             }
             leaves += f.leaf_count();
@@ -144,7 +152,8 @@ impl StreamedTree {
         let top = Top::build(depth, &chunks, |code, k, a, b| {
             covered(&files, &chunks[a..b], code, k)
         })?;
-        let colours = Colours::index(&files, depth, cache_bytes / 4)?;
+        let threads = rayon::current_num_threads() as u64;
+        let colours = Colours::index(&files, depth, cache_bytes / 4, 2 * threads)?;
         let mut t = StreamedTree {
             files,
             ranges,
@@ -154,7 +163,9 @@ impl StreamedTree {
             origin,
             bbox: None,
             leaves,
-            cache: Cache::new(cache_bytes - cache_bytes / 4),
+            // A thread's ray reader and cut-face test each hold a chunk, and it
+            // may be decoding a third.
+            cache: Cache::new(cache_bytes - cache_bytes / 4, 3 * threads),
             colours,
             error: Mutex::new(None),
         };
@@ -267,9 +278,17 @@ impl StreamedTree {
     fn chunk_tree(&self, c: u32) -> Option<Arc<RayTree>> {
         let r = self.chunks[c as usize];
         let got = self.cache.get(u64::from(c), || {
-            let leaves = self.files[r.part as usize].chunk(r.chunk as usize)?;
+            let f = &self.files[r.part as usize];
+            let leaves = f.chunk(r.chunk as usize)?;
+            // The chunk's mapped pages leave resident memory: the cache holds
+            // what was decoded from them.
+            f.release(r.bytes.0..r.bytes.1);
             let rt = RayTree::from_leaves(self.depth, self.origin, &leaves);
-            let bytes = std::mem::size_of_val(rt.nodes.as_slice()) as u64 + 256;
+            // What decoding held at once: the leaves and the nodes (a growing
+            // vector: up to twice their length).
+            let bytes = std::mem::size_of_val(leaves.as_slice()) as u64
+                + 2 * std::mem::size_of_val(rt.nodes.as_slice()) as u64
+                + 256;
             Ok::<_, FormatError>((rt, bytes))
         });
         match got {
@@ -404,22 +423,4 @@ impl Trace for StreamedTree {
     fn bbox(&self) -> Option<([i64; 3], [i64; 3])> {
         self.bbox
     }
-}
-
-/// Renders a [`StreamedTree`] as [`super::render_with`] renders the whole tree (no
-/// clipping plane: `opts.clip` is ignored), reading only the chunks the rays reach.
-/// The image equals the in-memory render's.
-///
-/// # Errors
-/// The first damaged chunk or colour block met, naming the file and the chunk.
-///
-/// # Runtime
-/// As [`super::render`], plus decoding the chunks reached (again when evicted).
-pub fn render_streamed(
-    tree: &StreamedTree,
-    surface: Surface<'_>,
-    opts: &RenderOptions,
-) -> Result<Image, FormatError> {
-    let img = render_cut(tree, surface, opts, None);
-    tree.take_error().map_or(Ok(img), Err)
 }

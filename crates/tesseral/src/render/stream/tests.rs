@@ -15,7 +15,7 @@ use crate::render::{
 
 /// A blob of random voxels, sometimes with a big block, coloured leaf by leaf from
 /// three colours (some leaves left uncoloured).
-fn random_model(rng: &mut rand_pcg::Pcg64, depth: u8) -> Model {
+pub(super) fn random_model(rng: &mut rand_pcg::Pcg64, depth: u8) -> Model {
     let side = 1i64 << depth;
     let n = rng.random_range(1..600);
     let blob = rng.random_range(1..=side);
@@ -41,7 +41,7 @@ fn random_model(rng: &mut rand_pcg::Pcg64, depth: u8) -> Model {
 
 /// `tree` with its leaves coloured at random from three colours (some left
 /// uncoloured).
-fn coloured(rng: &mut rand_pcg::Pcg64, tree: LinearOctree) -> Model {
+pub(super) fn coloured(rng: &mut rand_pcg::Pcg64, tree: LinearOctree) -> Model {
     let depth = tree.depth();
     let palette: [Rgba; 3] = [[200, 40, 40, 255], [40, 180, 60, 255], [50, 70, 220, 255]];
     let mut regions = vec![Vec::new(); 3];
@@ -66,7 +66,7 @@ fn coloured(rng: &mut rand_pcg::Pcg64, tree: LinearOctree) -> Model {
 }
 
 /// Writes `model` as a version-2 `.tess` of `chunk` leaves per chunk.
-fn write_v2(path: &std::path::Path, model: &Model, chunk: usize) {
+pub(super) fn write_v2(path: &std::path::Path, model: &Model, chunk: usize) {
     let t = &model.tree;
     let mut w = TessWriter::new(Vec::new(), t.depth(), t.origin())
         .unwrap()
@@ -77,7 +77,7 @@ fn write_v2(path: &std::path::Path, model: &Model, chunk: usize) {
     std::fs::write(path, w.finish_extras(&Extras::of(model)).unwrap()).unwrap();
 }
 
-fn random_options(rng: &mut rand_pcg::Pcg64, pose: usize) -> RenderOptions {
+pub(super) fn random_options(rng: &mut rand_pcg::Pcg64, pose: usize) -> RenderOptions {
     let mut camera = Camera::view(View::ALL[pose % 4]);
     if pose >= 4 {
         camera.azimuth_deg = rng.random_range(-180.0..180.0);
@@ -102,7 +102,7 @@ fn random_options(rng: &mut rand_pcg::Pcg64, pose: usize) -> RenderOptions {
 }
 
 /// The in-memory render with the stored colours, as the CLI draws a file.
-fn in_memory(model: &Model, opts: &RenderOptions) -> crate::render::Image {
+pub(super) fn in_memory(model: &Model, opts: &RenderOptions) -> crate::render::Image {
     let colours = model.colors.as_ref();
     let shader = |p: [f64; 3]| {
         colours
@@ -116,7 +116,7 @@ fn in_memory(model: &Model, opts: &RenderOptions) -> crate::render::Image {
     render(&model.tree, surface, opts)
 }
 
-fn streamed(st: &StreamedTree, opts: &RenderOptions) -> crate::render::Image {
+pub(super) fn streamed(st: &StreamedTree, opts: &RenderOptions) -> crate::render::Image {
     let shader = |p: [f64; 3]| {
         st.colour(p.map(|c| c.floor() as i64))
             .map_or(DEFAULT_COLOUR, |c| [c[0], c[1], c[2]])
@@ -163,7 +163,7 @@ fn the_streamed_render_equals_the_in_memory_render() {
 }
 
 /// A bumpy slab `side` voxels across (a power of two).
-fn terrain(side: i64) -> LinearOctree {
+pub(super) fn terrain(side: i64) -> LinearOctree {
     let mut voxels = Vec::new();
     for x in 0..side {
         for y in 0..side {

@@ -15,6 +15,8 @@ pub(super) struct ChunkRef {
     pub(super) lo: u64,
     pub(super) hi: u64,
     pub(super) count: u64,
+    /// Its bytes in the file, `[start, end)` (`end` past the file for the last).
+    pub(super) bytes: (u64, u64),
 }
 
 /// A child of a top node.
