@@ -36,6 +36,8 @@ mod sniff;
 mod spool;
 pub(crate) mod tess_colours;
 mod tess_file;
+#[cfg(all(test, target_os = "linux"))]
+mod tests_release;
 pub mod vox;
 pub mod xyz;
 

@@ -24,6 +24,7 @@ mod blocks;
 pub mod dataset;
 mod merge;
 mod models;
+mod scan;
 mod shuffle;
 mod stream;
 mod translate;

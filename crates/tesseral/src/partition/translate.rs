@@ -25,7 +25,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::blocks::Blocks;
-use super::shuffle::{translated_space, union_bbox};
+use super::shuffle::translated_space;
 use super::{PartitionError, StreamSummary};
 use crate::code;
 use crate::io::{FormatError, LeafSpool, TessFile, TessWriter, DEFAULT_CHUNK_LEAVES};
@@ -314,15 +314,18 @@ pub fn stream_translate(
 /// temporary files in `spool_dir`.
 ///
 /// # Runtime
-/// One pass over the chunks for the bounding box, then O(n) in the leaves (each
-/// chunk decoded about once per output cell whose cube meets it), plus one pass
-/// over each colour region to cut it into stretches.
+/// One pass over the chunks and the colour regions for the bounding box and the
+/// colours' checks, then O(n) in the leaves (each chunk decoded about once per
+/// output cell whose cube meets it), plus one pass over each colour region to cut
+/// it into stretches.
 ///
 /// # Errors
 /// [`PartitionError::Octree`] when the grown space would be too deep or a
 /// coordinate overflows; [`PartitionError::Ranges`] when the file has layers other
 /// than colours or is version 1 with layers; [`PartitionError::Format`] for a bad
-/// chunk or a read or write error.
+/// chunk or colour region, colours on voxels that are not black or colour regions
+/// that overlap (which the in-memory reader refuses too: checked in a first pass,
+/// before anything is written), or a read or write error.
 pub fn stream_translate_in(
     f: &TessFile,
     by: [i64; 3],
@@ -332,16 +335,13 @@ pub fn stream_translate_in(
 ) -> Result<StreamTranslation, PartitionError> {
     let cap = cell_leaves.max(1) as u64;
     let colours = super::merge::only_colours(f)?;
+    // A colour layer, even one with no region, is kept (as in memory).
+    let layer = f.has_layers();
     // Finding the colour regions read the colour section: let it go.
     f.release(0..u64::MAX);
     let (depth, origin) = (f.depth(), f.origin());
     let mut blocks = Blocks::of_file(f);
-    let mut bbox = None;
-    for i in 0..blocks.len() {
-        let t = LinearOctree::from_parts(depth, origin, f.chunk(i)?);
-        bbox = union_bbox([bbox, t.bbox()]);
-        blocks.release(i);
-    }
+    let bbox = super::scan::scan(f, &blocks, &colours)?;
     let to = translated_space(depth, origin, bbox, by)?;
     let mut tw = TessWriter::new(w, to.0, to.1).map_err(io_err)?;
     let mut voxels = 0u64;
@@ -364,7 +364,12 @@ pub fn stream_translate_in(
     }
     let leaves = tw.leaf_count();
     let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
-    tw.finish_spooled(f.frame(), spools).map_err(io_err)?;
+    if layer {
+        tw.finish_spooled_layer(f.frame(), spools)
+    } else {
+        tw.finish_spooled(f.frame(), spools)
+    }
+    .map_err(io_err)?;
     Ok(StreamTranslation {
         depth: to.0,
         origin: to.1,
