@@ -174,8 +174,9 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
 /// whole tree in memory. `false` (nothing done) for other inputs, outputs and methods.
 fn streamed(args: &TranslateArgs) -> Result<bool> {
     use tesseral::io::TessFile;
-    let tess =
-        |p: &std::path::Path| !crate::cmd::output::is_stdio(p) && tesseral::io::extension(p) == "tess";
+    let tess = |p: &std::path::Path| {
+        !crate::cmd::output::is_stdio(p) && tesseral::io::extension(p) == "tess"
+    };
     let linear = matches!(args.method, Method::Linear) && !args.clip;
     let refuse = |why: &str| -> Result<bool> {
         if args.stream {
