@@ -8,7 +8,7 @@
 use std::cell::Cell;
 
 use super::blocks::Blocks;
-use super::merge::{intervals, sweep};
+use super::merge::{intervals, sweep, Stream};
 use super::shuffle::union_bbox;
 use super::PartitionError;
 use crate::io::{FormatError, RegionLeaves, TessFile};
@@ -59,24 +59,36 @@ pub(super) fn scan(
 ) -> Result<Option<(Voxel, Voxel)>, PartitionError> {
     let (depth, origin) = (f.depth(), f.origin());
     let bbox = Cell::new(None);
-    let chunk = |i: usize| -> Result<Vec<Leaf>, FormatError> {
+    // Chunk `i`'s runs of touching leaves (when `runs`), its box joined to `bbox`.
+    let chunk = |i: usize, runs: bool| -> Result<Vec<(u64, u64)>, FormatError> {
         let leaves = f.chunk(i);
         blocks.release(i);
         let t = LinearOctree::from_parts(depth, origin, leaves?);
         bbox.set(union_bbox([bbox.get(), t.bbox()]));
-        Ok(t.leaves().to_vec())
+        let mut out: Vec<(u64, u64)> = Vec::new();
+        if runs {
+            for l in t.leaves() {
+                match out.last_mut() {
+                    Some(r) if r.1 == l.code() => r.1 = l.end(),
+                    _ => out.push((l.code(), l.end())),
+                }
+            }
+        }
+        Ok(out)
     };
     if colours.is_empty() {
         for i in 0..blocks.len() {
-            chunk(i)?;
+            chunk(i, false)?;
         }
         return Ok(bbox.get());
     }
-    let shape = (0..blocks.len()).flat_map(|i| match chunk(i) {
-        Ok(leaves) => leaves.into_iter().map(Ok).collect::<Vec<_>>(),
+    // The leaves as intervals, chunk by chunk (intervals that touch across two
+    // chunks stay two: the sweep takes touching intervals).
+    let shape = (0..blocks.len()).flat_map(|i| match chunk(i, true) {
+        Ok(runs) => runs.into_iter().map(Ok).collect::<Vec<_>>(),
         Err(e) => vec![Err(e)],
     });
-    let mut streams = vec![intervals(shape)];
+    let mut streams: Vec<Stream<'_>> = vec![Box::new(shape)];
     for (_, r) in colours {
         streams.push(intervals(Releasing {
             f,
