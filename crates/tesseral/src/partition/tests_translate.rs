@@ -144,6 +144,9 @@ fn an_empty_result_keeps_the_colour_layer_as_in_memory() {
     }
 }
 
+/// Colour regions as a layer is built from.
+type Regions = Vec<([u8; 4], LinearOctree)>;
+
 /// Colours on voxels that are not black (outside the shape's bounding box, or
 /// inside it in a hole) and colour regions that overlap are refused with the
 /// in-memory reader's error, naming the file, and nothing is written; the same
@@ -155,7 +158,7 @@ fn colours_off_the_shape_are_refused_as_in_memory() {
     let t = LinearOctree::from_voxels(4, [0, 0, 0], [[1, 1, 1], [5, 1, 1], [2, 2, 2]]).unwrap();
     let region =
         |vs: &[[i64; 3]]| LinearOctree::from_voxels(4, [0, 0, 0], vs.iter().copied()).unwrap();
-    let cases: [(&str, Vec<([u8; 4], LinearOctree)>); 4] = [
+    let cases: [(&str, Regions); 4] = [
         (
             "ok",
             vec![
