@@ -37,6 +37,8 @@ mod spool;
 pub(crate) mod tess_colours;
 mod tess_file;
 mod tess_v1;
+#[cfg(all(test, target_os = "linux"))]
+mod tests_release;
 pub mod vox;
 pub mod xyz;
 

@@ -100,6 +100,30 @@ impl<W: Write> TessWriter<W> {
     /// Any error of the writer or the spools' files; [`io::ErrorKind::InvalidInput`]
     /// when a colour is given twice.
     pub fn finish_spooled(self, frame: Frame, colours: Vec<(Rgba, LeafSpool)>) -> io::Result<W> {
+        self.finish_spooled_with(frame, colours, false)
+    }
+
+    /// As [`TessWriter::finish_spooled`], but the colour section is written even
+    /// when no colour has leaves: an empty colour layer, as the in-memory writer
+    /// writes a model whose colour layer is present and empty (the translation of a
+    /// coloured file keeps its layer, as [`crate::model::Model::translate`] does).
+    ///
+    /// # Errors
+    /// As [`TessWriter::finish_spooled`].
+    pub fn finish_spooled_layer(
+        self,
+        frame: Frame,
+        colours: Vec<(Rgba, LeafSpool)>,
+    ) -> io::Result<W> {
+        self.finish_spooled_with(frame, colours, true)
+    }
+
+    fn finish_spooled_with(
+        self,
+        frame: Frame,
+        colours: Vec<(Rgba, LeafSpool)>,
+        keep_layer: bool,
+    ) -> io::Result<W> {
         let mut regions = Vec::new();
         for (c, s) in colours {
             if s.leaf_count() > 0 {
@@ -122,7 +146,7 @@ impl<W: Write> TessWriter<W> {
                     ..Extras::default()
                 },
             );
-            if !regions.is_empty() {
+            if keep_layer || !regions.is_empty() {
                 flags |= FLAG_COLOR_LAYER;
                 head.extend_from_slice(&(regions.len() as u64).to_le_bytes());
             }

@@ -62,6 +62,11 @@ impl<'a> RegionLeaves<'a> {
         }
     }
 
+    /// The byte offset (in the file) of the next leaf to decode.
+    pub(crate) fn offset(&self) -> u64 {
+        self.r.pos as u64
+    }
+
     /// The leaves from `p` (a point of a region of these same `bytes`, the whole
     /// file) on, at most `most` of them.
     pub(crate) fn resume(bytes: &'a [u8], p: RegionPoint, depth: u8, most: u64) -> Self {

@@ -75,21 +75,27 @@ pub(super) fn only_colours(
     })
 }
 
-type Stream<'a> = Box<dyn Iterator<Item = Result<(u64, u64), FormatError>> + 'a>;
+pub(super) type Stream<'a> = Box<dyn Iterator<Item = Result<(u64, u64), FormatError>> + 'a>;
 
-fn intervals<'a>(leaves: impl Iterator<Item = Result<Leaf, FormatError>> + 'a) -> Stream<'a> {
+/// The runs of touching leaves of a sorted stream, as code intervals.
+pub(super) fn intervals<'a>(
+    leaves: impl Iterator<Item = Result<Leaf, FormatError>> + 'a,
+) -> Stream<'a> {
     Box::new(Intervals {
         leaves: leaves.peekable(),
     })
 }
 
 /// What [`sweep`] calls with each stretch.
-type Segment<'a> = dyn FnMut(u64, u64, &[bool]) -> Result<(), PartitionError> + 'a;
+pub(super) type Segment<'a> = dyn FnMut(u64, u64, &[bool]) -> Result<(), PartitionError> + 'a;
 
 /// Sweeps the boundaries of `streams` (each sorted, disjoint intervals): calls
 /// `segment(lo, hi, inside)` for each stretch `[lo, hi)` over which no stream
 /// changes, `inside[i]` telling whether stream `i` covers it.
-fn sweep(mut streams: Vec<Stream<'_>>, segment: &mut Segment<'_>) -> Result<(), PartitionError> {
+pub(super) fn sweep(
+    mut streams: Vec<Stream<'_>>,
+    segment: &mut Segment<'_>,
+) -> Result<(), PartitionError> {
     let mut cur = Vec::with_capacity(streams.len());
     for s in &mut streams {
         cur.push(s.next().transpose()?);

@@ -25,6 +25,7 @@ pub mod dataset;
 mod merge;
 mod models;
 mod recut;
+mod scan;
 mod shuffle;
 mod stream;
 mod translate;

@@ -10,24 +10,36 @@ use super::*;
 use crate::io::{native, TessFile};
 use crate::model::{Frame, Model};
 
-/// Displacements of every kind for a depth-`depth` space: none, aligned to the
-/// space, aligned to small blocks, unaligned, negative, and far enough to grow it.
-fn offsets(rng: &mut rand_pcg::Pcg64, depth: u8) -> Vec<[i64; 3]> {
-    let side = 1i64 << depth;
+/// Displacements of every kind for `t`: none, aligned to the space, aligned to
+/// small blocks, unaligned, negative, far enough to grow the space, and moving the
+/// leaves up to each edge of the space (kept) and one voxel past it (grown).
+fn offsets(rng: &mut rand_pcg::Pcg64, t: &LinearOctree) -> Vec<[i64; 3]> {
+    let side = 1i64 << t.depth();
     let mut r = |lo: i64, hi: i64| rng.random_range(lo..=hi);
-    vec![
+    let mut out = vec![
         [0, 0, 0],
         [side, 0, -side],
         [4 * r(-2, 2), 2 * r(-3, 3), 0],
         [r(-3, 3), r(-3, 3), r(-3, 3)],
         [-1, -2, -3],
         [r(side, 3 * side), -r(side, 3 * side), r(0, 1)],
-    ]
+    ];
+    if let Some((lo, hi)) = t.bbox() {
+        let o = t.origin();
+        let to_low: [i64; 3] = std::array::from_fn(|a| o[a] - lo[a]);
+        let to_high: [i64; 3] = std::array::from_fn(|a| o[a] + side - 1 - hi[a]);
+        out.push(to_low);
+        out.push(to_high);
+        out.push([to_low[0] - 1, to_low[1], to_low[2]]);
+        out.push([to_high[0], to_high[1], to_high[2] + 1]);
+    }
+    out
 }
 
-/// The streamed translation equals `Model::translate` (space, tree and colour
-/// layer) and moves exactly the voxels of a hash-set model, with windows of a
-/// few leaves so that the output is cut into many cells, down to single voxels.
+/// The streamed translation writes the bytes the in-memory path writes for
+/// `Model::translate` (space, tree and colour layer, an empty layer included) and
+/// moves exactly the voxels of a hash-set model, with windows of a few leaves so
+/// that the output is cut into many cells, down to single voxels.
 #[test]
 fn streamed_translation_equals_the_in_memory_one() {
     let dir = tempfile::tempdir().unwrap();
@@ -53,7 +65,7 @@ fn streamed_translation_equals_the_in_memory_one() {
         let path = dir.path().join(format!("m{i}.tess"));
         std::fs::write(&path, native::tests::encode_chunked(&model, 1 + i % 5)).unwrap();
         let f = TessFile::open(&path).unwrap();
-        for by in offsets(&mut rng, depth) {
+        for by in offsets(&mut rng, &t) {
             for run in [1, 3, 64, CELL_LEAVES] {
                 let mut out = Vec::new();
                 let s = stream_translate_in(&f, by, &mut out, dir.path(), run).unwrap();
@@ -74,8 +86,11 @@ fn streamed_translation_equals_the_in_memory_one() {
                     .map(|v| [v[0] + by[0], v[1] + by[1], v[2] + by[2]])
                     .collect();
                 assert_eq!(voxels(&got.tree), moved);
-                let want_colors = want.colors.filter(|l| !l.is_empty());
-                assert_eq!(got.colors, want_colors, "{i} by {by:?} run {run}");
+                assert_eq!(got.colors, want.colors, "{i} by {by:?} run {run}");
+                assert!(
+                    out == native::encode(&want),
+                    "bytes, {i} by {by:?} run {run}"
+                );
                 assert_eq!(got.frame, frame);
                 assert_eq!(s.summary.voxels, t.voxel_count());
                 assert_eq!(s.summary.leaves, got.tree.leaf_count() as u64);
@@ -95,4 +110,100 @@ fn streamed_translation_past_the_deepest_space_is_an_error() {
     let mut out = Vec::new();
     assert!(stream_translate(&f, [i64::MAX, 0, 0], &mut out, dir.path()).is_err());
     assert!(stream_translate(&f, [1 << 40, 0, 0], &mut out, dir.path()).is_err());
+}
+
+/// An empty model, with an empty colour layer or none, translates to the bytes
+/// the in-memory path writes: the layer is kept (empty) or stays absent.
+#[test]
+fn an_empty_result_keeps_the_colour_layer_as_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let frame = Frame::new(0.5, [1.0, 2.0, 3.0]);
+    for (i, origin) in [[0, 0, 0], [-5, 3, 9]].into_iter().enumerate() {
+        let t = LinearOctree::empty(4, origin).unwrap();
+        let layer = crate::model::Layer::from_regions(4, origin, []).unwrap();
+        for (j, colors) in [None, Some(layer)].into_iter().enumerate() {
+            let model = Model {
+                colors,
+                ..Model::new(t.clone()).with_frame(frame)
+            };
+            let path = dir.path().join(format!("e{i}{j}.tess"));
+            std::fs::write(&path, native::encode(&model)).unwrap();
+            let f = TessFile::open(&path).unwrap();
+            for by in [[0, 0, 0], [3, -7, 16], [1 << 20, 0, 0]] {
+                let mut out = Vec::new();
+                let s = stream_translate(&f, by, &mut out, dir.path()).unwrap();
+                let want = model.translate(by).unwrap();
+                let got = native::decode(&out).unwrap();
+                got.assert_valid();
+                assert_eq!(got, want, "{i} {j} by {by:?}");
+                assert_eq!(got.colors.is_some(), j == 1);
+                assert!(out == native::encode(&want), "bytes, {i} {j} by {by:?}");
+                assert_eq!((s.bbox, s.summary.leaves, s.summary.colours), (None, 0, 0));
+            }
+        }
+    }
+}
+
+/// Colour regions as a layer is built from.
+type Regions = Vec<([u8; 4], LinearOctree)>;
+
+/// Colours on voxels that are not black (outside the shape's bounding box, or
+/// inside it in a hole) and colour regions that overlap are refused with the
+/// in-memory reader's error, naming the file, and nothing is written; the same
+/// colours on black voxels translate.
+#[test]
+fn colours_off_the_shape_are_refused_as_in_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let (red, blue) = ([255, 0, 0, 255], [0, 0, 255, 255]);
+    let t = LinearOctree::from_voxels(4, [0, 0, 0], [[1, 1, 1], [5, 1, 1], [2, 2, 2]]).unwrap();
+    let region =
+        |vs: &[[i64; 3]]| LinearOctree::from_voxels(4, [0, 0, 0], vs.iter().copied()).unwrap();
+    let cases: [(&str, Regions); 4] = [
+        (
+            "ok",
+            vec![
+                (red, region(&[[1, 1, 1], [2, 2, 2]])),
+                (blue, region(&[[5, 1, 1]])),
+            ],
+        ),
+        // Outside the bounding box [1, 5] × [1, 2] × [1, 2].
+        ("not black", vec![(red, region(&[[1, 1, 1], [14, 0, 9]]))]),
+        // Inside it, on a hole.
+        ("not black", vec![(red, region(&[[3, 1, 1]]))]),
+        (
+            "overlap",
+            vec![
+                (red, region(&[[1, 1, 1]])),
+                (blue, region(&[[1, 1, 1], [5, 1, 1]])),
+            ],
+        ),
+    ];
+    for (i, (want, regions)) in cases.into_iter().enumerate() {
+        let layer = crate::model::Layer::from_regions(4, [0, 0, 0], regions).unwrap();
+        // Written as is: `Model::with_colors` would restrict the layer to the shape.
+        let model = Model {
+            colors: Some(layer),
+            ..Model::new(t.clone())
+        };
+        let path = dir.path().join(format!("c{i}.tess"));
+        std::fs::write(&path, native::encode(&model)).unwrap();
+        let f = TessFile::open(&path).unwrap();
+        for by in [[0, 0, 0], [3, -1, 2], [16, 0, 0]] {
+            let mut out = Vec::new();
+            let got = stream_translate(&f, by, &mut out, dir.path());
+            if want == "ok" {
+                let got = native::decode(&out).unwrap();
+                assert_eq!(got, model.translate(by).unwrap());
+                continue;
+            }
+            let e = got.unwrap_err().to_string();
+            assert!(e.contains(want) && e.contains(&format!("c{i}.tess")), "{e}");
+            assert!(
+                out.is_empty(),
+                "case {i}: nothing is written before the check"
+            );
+            let in_memory = f.to_model().unwrap_err().to_string();
+            assert!(in_memory.contains(want), "{in_memory}");
+        }
+    }
 }

@@ -15,9 +15,10 @@
 //! colour region is translated the same way (cut into stretches of leaves that
 //! play the chunks' part) into a [`LeafSpool`].
 //!
-//! Memory: one cell's leaves (at most about `cell_leaves`), its moved copy and the
-//! resampler's index of it, a few decoded chunks, the writer's chunk, one spool
-//! buffer, and the cell list (16 bytes a cell). Time: each chunk is decoded once
+//! Memory: one cell's leaves (at most about `cell_leaves`), a quarter of them at a
+//! time moved (their copy, the resampler's index of them and its output), a few
+//! decoded chunks, the writer's chunk, one spool buffer, and the cell list (16
+//! bytes a cell). Time: each chunk is decoded once
 //! per output cell whose cube meets it (about once, more along the cells'
 //! boundaries), and the leaves are moved once.
 
@@ -25,7 +26,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::blocks::Blocks;
-use super::shuffle::{translated_space, union_bbox};
+use super::shuffle::translated_space;
 use super::{PartitionError, StreamSummary};
 use crate::code;
 use crate::io::{FormatError, LeafSpool, TessFile, TessWriter, DEFAULT_CHUNK_LEAVES};
@@ -35,6 +36,10 @@ use crate::Voxel;
 /// The most leaves a cell's window may hold (by the chunk index) before the cell
 /// is split, unless [`stream_translate_in`] is told otherwise.
 pub const CELL_LEAVES: usize = 1 << 22;
+
+/// A cell's window may hold `cell_leaves` leaves; they are moved at most
+/// `cell_leaves / MOVE_SHARE` at a time (see [`Mover::move_into`]).
+const MOVE_SHARE: u64 = 4;
 
 /// What [`stream_translate_in`] wrote: the result's space and its counts.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,6 +149,8 @@ struct Mover {
     /// The input leaves' bounding box.
     bbox: Box3,
     cap: u64,
+    /// The most leaves moved at once (see [`Mover::move_into`]).
+    move_cap: u64,
 }
 
 impl Mover {
@@ -173,6 +180,7 @@ impl Mover {
             shift,
             bbox,
             cap,
+            move_cap: (cap / MOVE_SHARE).max(1),
         })
     }
 
@@ -273,7 +281,43 @@ impl Mover {
                 &mut |leaves| select(leaves, c, k, &b, &mut sel),
             )?;
         }
+        self.move_into(sel, code, k, push)
+    }
+
+    /// Moves `sel`, the input leaves that meet the cube under the output cell
+    /// `(code, k)` (sorted), into that cell. More than `move_cap` of them are first
+    /// cut by the cell's eight children (each child's leaves selected from `sel`,
+    /// which is then dropped), so that the resampler (its index and its output,
+    /// several times the leaves' own size) never holds more than `move_cap` leaves
+    /// whatever a window holds; nothing is decoded again.
+    fn move_into(
+        &self,
+        sel: Vec<Leaf>,
+        code: u64,
+        k: u8,
+        push: &mut dyn FnMut(Leaf) -> io::Result<()>,
+    ) -> Result<(), PartitionError> {
         if sel.is_empty() {
+            return Ok(());
+        }
+        if sel.len() as u64 > self.move_cap && k > 0 {
+            let size = 1u64 << (3 * u32::from(k - 1));
+            let mut parts = Vec::with_capacity(8);
+            for d in 0..8 {
+                let c = code + d * size;
+                let (b, window) = self.window(c, k - 1);
+                let mut part = Vec::new();
+                for &w in &window {
+                    let first = sel.partition_point(|l| l.end() <= w);
+                    let last = sel.partition_point(|l| l.code() < w + size);
+                    select(&sel[first..last.max(first)], w, k - 1, &b, &mut part);
+                }
+                parts.push((c, part));
+            }
+            drop(sel);
+            for (c, part) in parts {
+                self.move_into(part, c, k - 1, push)?;
+            }
             return Ok(());
         }
         let tree = LinearOctree::from_parts(self.depth, self.origin, sel);
@@ -310,19 +354,23 @@ pub fn stream_translate(
 /// [`crate::model::Model::translate`] of the file's model, in the same space (the
 /// input's space when the moved leaves fit, else grown by root expansion), byte for
 /// byte as the in-memory path writes it. An output cell is split while its window
-/// holds more than `cell_leaves` leaves (at least one); the colour spools are
-/// temporary files in `spool_dir`.
+/// holds more than `cell_leaves` leaves (at least one), and its leaves are moved a
+/// quarter of that at a time at most; the colour spools are temporary files in
+/// `spool_dir`.
 ///
 /// # Runtime
-/// One pass over the chunks for the bounding box, then O(n) in the leaves (each
-/// chunk decoded about once per output cell whose cube meets it), plus one pass
-/// over each colour region to cut it into stretches.
+/// One pass over the chunks and the colour regions for the bounding box and the
+/// colours' checks, then O(n) in the leaves (each chunk decoded about once per
+/// output cell whose cube meets it), plus one pass over each colour region to cut
+/// it into stretches.
 ///
 /// # Errors
 /// [`PartitionError::Octree`] when the grown space would be too deep or a
 /// coordinate overflows; [`PartitionError::Ranges`] when the file has layers other
 /// than colours or is version 1 with layers; [`PartitionError::Format`] for a bad
-/// chunk or a read or write error.
+/// chunk or colour region, colours on voxels that are not black or colour regions
+/// that overlap (which the in-memory reader refuses too: checked in a first pass,
+/// before anything is written), or a read or write error.
 pub fn stream_translate_in(
     f: &TessFile,
     by: [i64; 3],
@@ -332,16 +380,13 @@ pub fn stream_translate_in(
 ) -> Result<StreamTranslation, PartitionError> {
     let cap = cell_leaves.max(1) as u64;
     let colours = super::merge::only_colours(f)?;
+    // A colour layer, even one with no region, is kept (as in memory).
+    let layer = f.has_layers();
     // Finding the colour regions read the colour section: let it go.
     f.release(0..u64::MAX);
     let (depth, origin) = (f.depth(), f.origin());
     let mut blocks = Blocks::of_file(f);
-    let mut bbox = None;
-    for i in 0..blocks.len() {
-        let t = LinearOctree::from_parts(depth, origin, f.chunk(i)?);
-        bbox = union_bbox([bbox, t.bbox()]);
-        blocks.release(i);
-    }
+    let bbox = super::scan::scan(f, &blocks, &colours)?;
     let to = translated_space(depth, origin, bbox, by)?;
     let mut tw = TessWriter::new(w, to.0, to.1).map_err(io_err)?;
     let mut voxels = 0u64;
@@ -364,7 +409,12 @@ pub fn stream_translate_in(
     }
     let leaves = tw.leaf_count();
     let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
-    tw.finish_spooled(f.frame(), spools).map_err(io_err)?;
+    if layer {
+        tw.finish_spooled_layer(f.frame(), spools)
+    } else {
+        tw.finish_spooled(f.frame(), spools)
+    }
+    .map_err(io_err)?;
     Ok(StreamTranslation {
         depth: to.0,
         origin: to.1,
