@@ -229,9 +229,18 @@ pub fn same_file(a: &Path, b: &Path) -> bool {
 /// An error naming the output, the estimate, the limit and the flag.
 pub fn check_size(output: &Path, estimate: u64, limit: u64) -> Result<()> {
     if estimate > limit {
+        // `.tess` is the most compact format: suggest it only for another one.
+        let tess = output
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("tess"));
+        let compact = if tess {
+            ""
+        } else {
+            ", or choose a more compact format such as .tess"
+        };
         bail!(
             "{}: the output would be about {} ({estimate} bytes), more than the limit of {}; \
-             raise it with --max-output (e.g. --max-output {}), or choose a more compact format such as .tess",
+             raise it with --max-output (e.g. --max-output {}){compact}",
             output.display(),
             human_bytes(estimate),
             human_bytes(limit),
@@ -312,6 +321,19 @@ pub fn install_signal_handler() {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_refused_size_suggests_tess_only_for_other_formats() {
+        let err = |name: &str| check_size(Path::new(name), 10, 5).unwrap_err().to_string();
+        assert!(err("big.xyz")
+            .contains("--max-output 1G), or choose a more compact format such as .tess"));
+        assert!(
+            err("big.tess").ends_with("--max-output 1G)"),
+            "{}",
+            err("big.tess")
+        );
+        assert!(check_size(Path::new("big.tess"), 5, 5).is_ok());
+    }
 
     #[test]
     fn byte_sizes() {
