@@ -200,16 +200,18 @@ impl StreamedTree {
     }
 
     /// The number of black voxels: every chunk read once, one at a time (not
-    /// cached; a render does not need it).
+    /// cached; a render does not need it), its mapped pages let go after it.
     ///
     /// # Errors
     /// A damaged chunk, naming the file and the chunk.
     pub fn voxel_count(&self) -> Result<u64, FormatError> {
         let mut n = 0u64;
         for c in &self.chunks {
-            for l in self.files[c.part as usize].chunk(c.chunk as usize)? {
+            let f = &self.files[c.part as usize];
+            for l in f.chunk(c.chunk as usize)? {
                 n += l.end() - l.code();
             }
+            f.release(c.bytes.0..c.bytes.1);
         }
         Ok(n)
     }
