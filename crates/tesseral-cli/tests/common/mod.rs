@@ -115,3 +115,22 @@ pub fn build_scene(dir: &Path, scene: &str, out: &str, depth: u8) -> String {
         ],
     )
 }
+
+/// `render INPUT` with `extra` flags twice, streamed to `s.png` and `--in-memory` to
+/// `m.png`, in `dir`: checks that each took its path and that the PNGs are the same
+/// bytes; returns the streamed and the in-memory runs' JSON.
+pub fn render_both(dir: &Path, input: &str, extra: &[&str]) -> (Value, Value) {
+    let mut a = vec!["render", input, "-o", "s.png", "--json"];
+    a.extend_from_slice(extra);
+    let v = json(dir, &a);
+    assert_eq!(v["streamed"], true, "{v}");
+    let mut b = vec!["render", input, "-o", "m.png", "--json", "--in-memory"];
+    b.extend_from_slice(extra);
+    let w = json(dir, &b);
+    assert_eq!(w["streamed"], false, "{w}");
+    assert!(
+        fs::read(dir.join("s.png")).unwrap() == fs::read(dir.join("m.png")).unwrap(),
+        "{input} {extra:?}: the streamed PNG differs from the in-memory one"
+    );
+    (v, w)
+}
