@@ -152,8 +152,13 @@ impl<T: LayerValue> Layer<T> {
     }
 
     /// A layer from regions already in the space and disjoint; regions with the same
-    /// value are merged and empty ones dropped, and the order made canonical.
-    fn from_regions_unchecked(depth: u8, origin: Voxel, regions: Vec<(T, LinearOctree)>) -> Self {
+    /// value are merged and empty ones dropped, and the order made canonical. Tests
+    /// use it to write the files that readers must refuse.
+    pub(crate) fn from_regions_unchecked(
+        depth: u8,
+        origin: Voxel,
+        regions: Vec<(T, LinearOctree)>,
+    ) -> Self {
         let mut by_key: HashMap<u64, (T, LinearOctree)> = HashMap::new();
         for (x, t) in regions {
             if t.is_empty() {
@@ -180,10 +185,16 @@ impl<T: LayerValue> Layer<T> {
     }
 
     /// A layer from regions of equal value in any spaces; they are re-expressed in
-    /// the space `(depth, origin)`, which must hold them, and must be disjoint.
+    /// the space `(depth, origin)`, which must hold them, and must be disjoint
+    /// (regions of the same value may overlap: they are merged).
+    ///
+    /// # Runtime
+    /// O(n log n) in the regions' leaves, for the disjointness check.
     ///
     /// # Errors
-    /// As [`LinearOctree::resample`].
+    /// As [`LinearOctree::resample`]; [`OctreeError::InvalidArgument`] when two
+    /// regions of different values share a voxel (a layer holds one value per
+    /// voxel, and a file written from such a layer could not be read back).
     pub fn from_regions(
         depth: u8,
         origin: Voxel,
@@ -193,7 +204,13 @@ impl<T: LayerValue> Layer<T> {
         for (x, t) in regions {
             out.push((x, in_space(t, depth, origin)?));
         }
-        Ok(Self::from_regions_unchecked(depth, origin, out))
+        let layer = Self::from_regions_unchecked(depth, origin, out);
+        if !disjoint(&layer.regions) {
+            return Err(OctreeError::InvalidArgument(
+                "the regions overlap: a voxel would hold two values".into(),
+            ));
+        }
+        Ok(layer)
     }
 
     /// The layer's space: depth.
@@ -354,5 +371,18 @@ impl<T: LayerValue> Layer<T> {
             total += t.voxel_count();
         }
         assert_eq!(self.domain().voxel_count(), total, "regions overlap");
+        assert!(disjoint(&self.regions), "regions overlap");
     }
+}
+
+/// Whether no two regions share a voxel: every leaf's code range, sorted, ends
+/// before the next one begins. O(n log n) in the leaves, where unions of the
+/// regions would cost O(r·n) for r regions.
+fn disjoint<T>(regions: &[(T, LinearOctree)]) -> bool {
+    let mut spans: Vec<(u64, u64)> = regions
+        .iter()
+        .flat_map(|(_, t)| t.leaves().iter().map(|l| (l.code(), l.end())))
+        .collect();
+    spans.sort_unstable();
+    spans.windows(2).all(|w| w[0].1 <= w[1].0)
 }

@@ -323,3 +323,46 @@ fn layers_with_many_distinct_values_stay_exact() {
     }
     assert_eq!(layer.voxel_count(), last.len() as u64);
 }
+
+#[test]
+fn layers_from_overlapping_regions_are_refused_unless_the_values_agree() {
+    // Random voxel sets, two values: the layer must be refused exactly when a voxel
+    // holds both (a HashSet says which), and otherwise hold every voxel's value.
+    let mut rng = Pcg64Mcg::seed_from_u64(11);
+    for round in 0..200 {
+        let set = |rng: &mut Pcg64Mcg| -> Vec<Voxel> {
+            let n = rng.random_range(0..40);
+            (0..n)
+                .map(|_| std::array::from_fn(|_| rng.random_range(0..8)))
+                .collect()
+        };
+        let (a, b) = (set(&mut rng), set(&mut rng));
+        let tree = |v: &[Voxel]| LinearOctree::from_voxels(3, [0; 3], v.iter().copied()).unwrap();
+        let (red, blue) = ([255, 0, 0, 255], [0, 0, 255, 255]);
+        let sa: std::collections::HashSet<Voxel> = a.iter().copied().collect();
+        let shared = b.iter().any(|v| sa.contains(v));
+        match Layer::from_regions(3, [0; 3], [(red, tree(&a)), (blue, tree(&b))]) {
+            Ok(layer) => {
+                assert!(!shared, "round {round}: overlapping regions accepted");
+                layer.assert_valid();
+                for v in &a {
+                    assert_eq!(layer.get(*v), Some(red));
+                }
+                for v in &b {
+                    assert_eq!(layer.get(*v), Some(blue));
+                }
+            }
+            Err(e) => {
+                assert!(shared, "round {round}: disjoint regions refused: {e}");
+                assert!(e.to_string().contains("overlap"), "{e}");
+            }
+        }
+        // The same value twice is one region, whatever the overlap.
+        let same = Layer::from_regions(3, [0; 3], [(red, tree(&a)), (red, tree(&b))]).unwrap();
+        same.assert_valid();
+        assert_eq!(
+            same.region_count(),
+            usize::from(!(a.is_empty() && b.is_empty()))
+        );
+    }
+}

@@ -179,8 +179,10 @@ fn colours_off_the_shape_are_refused_as_in_memory() {
         ),
     ];
     for (i, (want, regions)) in cases.into_iter().enumerate() {
-        let layer = crate::model::Layer::from_regions(4, [0, 0, 0], regions).unwrap();
-        // Written as is: `Model::with_colors` would restrict the layer to the shape.
+        // Unchecked, so that the overlapping case reaches the file (`from_regions`
+        // refuses it); written as is: `Model::with_colors` would restrict the layer
+        // to the shape.
+        let layer = crate::model::Layer::from_regions_unchecked(4, [0, 0, 0], regions);
         let model = Model {
             colors: Some(layer),
             ..Model::new(t.clone())
