@@ -6,9 +6,10 @@
 //! holds up the lookups after it until the block's words have come from memory.
 //! [`sparse_value`] instead compares the cell with the first [`LANES`] listed cells
 //! at once (eight SSE2 compares whose loads overlap) and picks the match with bit
-//! arithmetic. Longer lists, blocks within [`LANES`] cells of the arena's end, and
-//! CPUs other than x86_64 use the binary search ([`sparse_get`]), which gives the
-//! same answers (tested against each other and against a model of cells).
+//! arithmetic. Longer lists, blocks fewer than `UNIT + LANES` words (the compares'
+//! reach) from the arena's end, and CPUs other than x86_64 use the binary search
+//! ([`sparse_get`]), which gives the same answers (tested against each other and
+//! against a model of cells).
 
 use super::arena::UNIT;
 use super::forms::sparse_get;
@@ -53,6 +54,7 @@ fn sparse_value_short(words: &[u16], at: usize, i: usize) -> Option<i16> {
 }
 
 /// A mask of the lanes below `len` (`len` ≤ 64), without a branch.
+#[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn below(len: usize) -> u64 {
     (1u64 << (len & 63)).wrapping_sub(1) | ((len >> 6) as u64).wrapping_neg()
