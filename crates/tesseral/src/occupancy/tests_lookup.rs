@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
 use super::sensor::{Fixed, UNKNOWN};
-use super::store::Store;
+use super::store::{Kind, Store};
 use super::{OccupancyError, OccupancyMap, SensorModel};
 
 /// Where a map's blocks lie.
@@ -238,6 +238,87 @@ fn the_directory_goes_dense_again_once_the_superblocks_fill_their_box() {
         .chain(model.keys().copied())
         .collect();
     check_lookups(&store, &model, &probes, "dense again");
+}
+
+/// Sparse blocks grown one cell at a time to every length a sparse block takes
+/// (1 to 136 cells of up to six values: past the 64 that `get` compares at once),
+/// two at a time so that one lies inside the arena and the other often at its end;
+/// near the origin, far and negative, and with the hash-map directory. After every
+/// cell set: `assert_valid`, and every cell of both blocks and of their neighbours
+/// against the model.
+#[test]
+fn sparse_blocks_of_every_length_agree_with_the_model() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let far = [-(1i64 << 40) - 5, 7, -(1 << 33) + 3];
+    for (seed, at, scattered) in [(40, [0i64; 3], false), (41, far, false), (42, far, true)] {
+        let mut rng = Pcg64::seed_from_u64(seed);
+        let mut store = Store::default();
+        let mut model: HashMap<[i64; 3], i16> = HashMap::new();
+        if scattered {
+            // A cell 2^45 cells away: the directory's box is over budget.
+            let c = [1i64 << 45, -(1 << 45), 0];
+            store.set(c, fixed.hit, fixed);
+            model.insert(c, fixed.hit);
+        }
+        let blocks = [at, [at[0] + 1, at[1] - 1, at[2]]];
+        // Six distinct values inside the clamps.
+        let step = (i32::from(fixed.max) - i32::from(fixed.min)) / 7;
+        let values: Vec<i16> = (1..=6)
+            .map(|k| (i32::from(fixed.min) + k * step) as i16)
+            .collect();
+        let mut order: Vec<Vec<usize>> = Vec::new();
+        for _ in blocks {
+            let mut o: Vec<usize> = (0..512).collect();
+            for k in 0..511 {
+                o.swap(k, rng.random_range(k..512));
+            }
+            order.push(o);
+        }
+        let mut sparse_lengths = Vec::new();
+        for len in 1..=140 {
+            for (b, o) in blocks.iter().zip(&order) {
+                let i = o[len - 1];
+                let c = [
+                    b[0] << 3 | (i & 7) as i64,
+                    b[1] << 3 | (i >> 3 & 7) as i64,
+                    b[2] << 3 | (i >> 6) as i64,
+                ];
+                let v = values[rng.random_range(0..values.len())];
+                store.set(c, v, fixed);
+                model.insert(c, v);
+                store.assert_valid(fixed);
+                if store.entry(*b).map(|e| e.kind()) == Some(Kind::Sparse) {
+                    sparse_lengths.push(len);
+                }
+            }
+            let probes: Vec<[i64; 3]> = blocks
+                .iter()
+                .flat_map(|b| {
+                    (-8..16).flat_map(move |x| {
+                        (0..8).flat_map(move |y| {
+                            (0..8).map(move |z| [b[0] * 8 + x, b[1] * 8 + y, b[2] * 8 + z])
+                        })
+                    })
+                })
+                .collect();
+            check_lookups(
+                &store,
+                &model,
+                &probes,
+                &format!("seed {seed} length {len}"),
+            );
+        }
+        assert_eq!(store.dense_directory(), !scattered, "seed {seed}");
+        // Both the compares (up to 64 cells) and the search beyond were exercised.
+        assert!(
+            sparse_lengths.contains(&1) && sparse_lengths.contains(&64),
+            "seed {seed}"
+        );
+        assert!(
+            sparse_lengths.contains(&65) && sparse_lengths.contains(&136),
+            "seed {seed}"
+        );
+    }
 }
 
 #[test]

@@ -2,7 +2,8 @@
 //! accesses are prefetched in passes ([`Store::get_many`]).
 
 use super::arena::UNIT;
-use super::forms::{bits_words, sparse_get, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
+use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
+use super::probe::{sparse_value, LANES};
 use super::{local, split, Entry, Store};
 use crate::occupancy::sensor::UNKNOWN;
 
@@ -49,7 +50,8 @@ impl Store {
         let words = &self.arena.words;
         let at = e.offset() as usize * UNIT;
         if tag == SPARSE {
-            return sparse_get(&words[at..], i);
+            // Compares, not a binary search (see `probe`).
+            return sparse_value(words, at, i);
         }
         // A palette of width w, or a dense block read as a palette of width 16
         // whose cells are their values (tags 3 to 7): no branch on the width. The
@@ -106,9 +108,10 @@ impl Store {
         }
         let at = e.offset() as usize * UNIT;
         let (a, b) = match tag {
-            // The header and the first cells; then the middle of the list, where
-            // the binary search starts, is often in the next line.
-            SPARSE => (at, at + 4 * UNIT),
+            // The header and the cells that `sparse_value` compares at once: the
+            // first and last of its lines (the middle one is most often fetched
+            // with its neighbours by the hardware prefetcher).
+            SPARSE => (at, at + UNIT + LANES - 1),
             DENSE => (at + i, at + i),
             t => {
                 let w = 1 << (t - PALETTE);

@@ -10,6 +10,7 @@ mod dir;
 mod forms;
 mod fresh;
 mod lookup;
+mod probe;
 mod sparse;
 mod valid;
 

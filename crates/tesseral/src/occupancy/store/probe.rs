@@ -1,0 +1,146 @@
+//! Finding a cell in a sparse block's sorted list without branching on the data.
+//!
+//! A binary search over a sparse block's cells (up to 136 of them) takes as many
+//! steps as the list's length has bits: its loop exit is mispredicted on most
+//! lookups of a map whose sparse blocks vary in length, and each misprediction
+//! holds up the lookups after it until the block's words have come from memory.
+//! [`sparse_value`] instead compares the cell with the first [`LANES`] listed cells
+//! at once (eight SSE2 compares whose loads overlap) and picks the match with bit
+//! arithmetic. Longer lists, blocks fewer than `UNIT + LANES` words (the compares'
+//! reach) from the arena's end, and CPUs other than x86_64 use the binary search
+//! ([`sparse_get`]), which gives the same answers (tested against each other and
+//! against a model of cells).
+
+use super::arena::UNIT;
+use super::forms::sparse_get;
+use crate::occupancy::sensor::UNKNOWN;
+
+/// Listed cells compared at once.
+pub(crate) const LANES: usize = 64;
+
+/// The value of cell `i` of the sparse block whose words start at `at`
+/// (`UNKNOWN` when it is not listed). O(1) for lists of up to [`LANES`] cells,
+/// O(log len) beyond.
+#[inline(always)]
+pub(crate) fn sparse_value(words: &[u16], at: usize, i: usize) -> i16 {
+    sparse_value_short(words, at, i).unwrap_or_else(|| sparse_get(&words[at..], i))
+}
+
+/// [`sparse_value`] by compares alone: `None` when the list is longer than
+/// [`LANES`], when fewer than `UNIT + LANES` words are left from `at`, or off
+/// x86_64. The words past a short list (another block's, or free) are read and
+/// their lanes masked off.
+#[inline(always)]
+fn sparse_value_short(words: &[u16], at: usize, i: usize) -> Option<i16> {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let w = words.get(at..at + UNIT + LANES)?;
+        let len = usize::from(w[0]);
+        if len > LANES {
+            return None;
+        }
+        let cells = w[UNIT..].try_into().expect("LANES words");
+        let hits = matches(cells, i) & below(len);
+        // With no hit, the first cell is read and its value dropped.
+        let c = w[UNIT + (hits.trailing_zeros() as usize & (LANES - 1))];
+        let v = w[2 + usize::from(c & 7)] as i16;
+        Some(if hits != 0 { v } else { UNKNOWN })
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let _ = (words, at, i);
+        None
+    }
+}
+
+/// A mask of the lanes below `len` (`len` ≤ 64), without a branch.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn below(len: usize) -> u64 {
+    (1u64 << (len & 63)).wrapping_sub(1) | ((len >> 6) as u64).wrapping_neg()
+}
+
+/// Bit `k` set where listed cell `k` is cell `i` (a listed cell is
+/// `index << 3 | value number`).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn matches(cells: &[u16; LANES], i: usize) -> u64 {
+    use std::arch::x86_64::{
+        __m128i, _mm_and_si128, _mm_cmpeq_epi16, _mm_loadu_si128, _mm_movemask_epi8,
+        _mm_packs_epi16, _mm_set1_epi16,
+    };
+    let p = cells.as_ptr().cast::<__m128i>();
+    // SAFETY: SSE2 is part of every x86_64 CPU. Load `k` (k < LANES / 8) reads the
+    // eight words `cells[8k..8k + 8]`, inside the array; `loadu` needs no alignment.
+    unsafe {
+        let key = _mm_set1_epi16((i << 3) as i16);
+        let index = _mm_set1_epi16(!7);
+        let eq = |k: usize| _mm_cmpeq_epi16(_mm_and_si128(_mm_loadu_si128(p.add(k)), index), key);
+        let mut bits = 0u64;
+        for q in 0..LANES / 16 {
+            // Two compares' 16 lanes of 0 or −1 packed to bytes: one bit a lane.
+            let m = _mm_movemask_epi8(_mm_packs_epi16(eq(2 * q), eq(2 * q + 1)));
+            bits |= u64::from(m as u16) << (16 * q);
+        }
+        bits
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::occupancy::store::forms::{sparse_units, write_sparse};
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
+
+    /// Every list length from 0 to past [`LANES`], blocks in the middle and at the
+    /// very end of the words, every cell: the same as the binary search and as the
+    /// cells written.
+    #[test]
+    fn the_compares_agree_with_the_binary_search_and_the_cells() {
+        let mut rng = Pcg64::seed_from_u64(3);
+        for len in 0..=140usize {
+            for round in 0..6 {
+                let mut idx: Vec<usize> = (0..512).collect();
+                for k in 0..len {
+                    let j = rng.random_range(k..512);
+                    idx.swap(k, j);
+                }
+                let mut idx = idx[..len].to_vec();
+                idx.sort_unstable();
+                let values: Vec<i16> = (0..6).map(|_| rng.random_range(-2000..2000)).collect();
+                let cells: Vec<u32> = idx
+                    .iter()
+                    .map(|&i| (i as u32) << 16 | u32::from(values[rng.random_range(0..6)] as u16))
+                    .collect();
+                let units = sparse_units(len);
+                // Garbage before and, in odd rounds, after the block.
+                let before = rng.random_range(0..3) * UNIT;
+                let after = if round % 2 == 0 {
+                    0
+                } else {
+                    rng.random_range(1..100)
+                };
+                let mut words: Vec<u16> = (0..before + units * UNIT + after)
+                    .map(|_| rng.random())
+                    .collect();
+                write_sparse(&mut words[before..before + units * UNIT], &cells);
+                let mut want = [UNKNOWN; 512];
+                for &c in &cells {
+                    want[(c >> 16) as usize] = c as u16 as i16;
+                }
+                let short = words.len() >= before + UNIT + LANES && len <= LANES;
+                for (i, &w) in want.iter().enumerate() {
+                    assert_eq!(sparse_value(&words, before, i), w, "len {len} cell {i}");
+                    assert_eq!(sparse_get(&words[before..], i), w, "len {len} cell {i}");
+                    let s = sparse_value_short(&words, before, i);
+                    if cfg!(target_arch = "x86_64") && short {
+                        assert_eq!(s, Some(w), "len {len} cell {i}: the compares");
+                    } else {
+                        assert_eq!(s, None, "len {len}: not short");
+                    }
+                }
+            }
+        }
+    }
+}
