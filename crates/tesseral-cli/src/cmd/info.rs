@@ -105,9 +105,11 @@ struct Info {
 /// An inclusive box of voxels.
 type BBox = ([i64; 3], [i64; 3]);
 
-/// The info of a version-2 `.tess` file with no layers but colours, or of a dataset
-/// of them, read chunk by chunk from the maps (the leaves never all held), part
-/// after part, the colour regions as streams. `None` for other files.
+/// The info of a `.tess` file (either version: a version-1 payload is indexed in
+/// one pass, `TessFile::open_streaming`) with no layers but colours, or of a
+/// dataset of them, read chunk by chunk from the maps (the leaves never all held),
+/// part after part, the colour regions as streams. `None` for other files (a
+/// legacy colour list, free space or log-odds: read whole).
 fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
     use tesseral::io::TessFile;
     use tesseral::partition::{is_dataset, open_part, read_manifest};
@@ -124,7 +126,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
         let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
         (files, frame)
     } else if path.is_file() && tesseral::io::extension(path) == "tess" {
-        let f = TessFile::open(path)?;
+        let f = TessFile::open_streaming(path)?;
         let frame = f.frame();
         (vec![f], frame)
     } else {
@@ -205,6 +207,7 @@ pub fn run(args: Args) -> Result<()> {
             return print(&args, &info, bbox);
         }
     }
+    super::streamed::check_version_1_in_memory(&args.file, &args.budget)?;
     let model = octree::read_model(&args.file, &args.budget, &Default::default())?;
     let tree = &model.tree;
     if args.tree || args.codes {

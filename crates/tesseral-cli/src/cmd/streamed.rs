@@ -52,7 +52,7 @@ fn file_len(path: &Path) -> Result<u64> {
         .len())
 }
 
-/// Whether `path` is a `.tess` file of version 1 (one payload, decoded whole).
+/// Whether `path` is a `.tess` file of version 1 (one payload, no chunks).
 pub fn is_version_1(path: &Path) -> Result<bool> {
     use std::io::Read;
     let mut head = [0u8; 10];
@@ -64,11 +64,29 @@ pub fn is_version_1(path: &Path) -> Result<bool> {
     Ok(u16::from_le_bytes([head[8], head[9]]) == 1)
 }
 
+/// Before a version-1 `.tess` file is read whole (the in-memory paths, taken
+/// when it has layers that do not stream or the command cannot stream): its
+/// memory, at most 24 bytes a byte of the file, against `--memory`. Nothing for
+/// other inputs.
+pub fn check_version_1_in_memory(path: &Path, budget: &Budget) -> Result<()> {
+    if super::output::is_stdio(path)
+        || !(path.is_file() && tesseral::io::extension(path) == "tess")
+        || !is_version_1(path)?
+    {
+        return Ok(());
+    }
+    budget.check_memory(
+        &format!("{} (a version-1 .tess file, read whole)", path.display()),
+        file_len(path)?.saturating_mul(V1_BYTES_PER_FILE_BYTE),
+        "",
+    )
+}
+
 /// Opens `path` for streaming: a dataset directory (its parts, checked against
-/// the manifest) or a `.tess` file. A version-1 file is one payload, decoded whole
-/// when it is opened: its memory (at most 24 bytes a byte of the file) is checked
-/// against `--memory` first. `None` for anything else (read it in memory).
-pub fn open_operand(path: &Path, budget: &Budget) -> Result<Option<Operand>> {
+/// the manifest) or a `.tess` file of either version (a version-1 file's payload
+/// is indexed in one pass, `TessFile::open_streaming`, and then streams as a
+/// version-2 file does). `None` for anything else (read it in memory).
+pub fn open_operand(path: &Path) -> Result<Option<Operand>> {
     use tesseral::partition::{is_dataset, open_part, read_manifest};
     if super::output::is_stdio(path) {
         return Ok(None);
@@ -92,17 +110,7 @@ pub fn open_operand(path: &Path, budget: &Budget) -> Result<Option<Operand>> {
         return Ok(None);
     }
     let bytes = file_len(path)?;
-    if is_version_1(path)? {
-        budget.check_memory(
-            &format!(
-                "{} (a version-1 .tess file, read whole; `convert` it to .tess to stream it)",
-                path.display()
-            ),
-            bytes.saturating_mul(V1_BYTES_PER_FILE_BYTE),
-            "",
-        )?;
-    }
-    let f = TessFile::open(path)?;
+    let f = TessFile::open_streaming(path)?;
     let frame = f.frame();
     Ok(Some(Operand {
         files: vec![f],
