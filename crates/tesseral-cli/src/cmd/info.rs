@@ -17,7 +17,7 @@ pub struct Args {
     file: PathBuf,
     /// Print JSON (keys: voxels, leaves, depth, origin, bbox_min, bbox_max,
     /// leaves_by_depth, bytes, voxel_size, translate, world_min, world_max, colors,
-    /// colored_voxels, free_voxels, free_leaves, log_odds).
+    /// colored_voxels, free_voxels, free_leaves, log_odds, streamed).
     #[arg(long)]
     json: bool,
     /// Print the octree as the indented node list of Ahuja & Nash Fig. 4 instead:
@@ -100,6 +100,9 @@ struct Info {
     free_leaves: Option<usize>,
     /// Whether per-voxel occupancy log-odds are stored.
     log_odds: bool,
+    /// Whether the file was read chunk by chunk (a `.tess` file of either version
+    /// or a dataset, with no layers but colours) rather than loaded whole.
+    streamed: bool,
 }
 
 /// An inclusive box of voxels.
@@ -197,6 +200,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
         free_voxels: None,
         free_leaves: None,
         log_odds: false,
+        streamed: true,
     };
     Ok(Some((info, bbox)))
 }
@@ -233,6 +237,7 @@ pub fn run(args: Args) -> Result<()> {
         free_voxels: model.free.as_ref().map(|f| f.voxel_count()),
         free_leaves: model.free.as_ref().map(|f| f.leaf_count()),
         log_odds: model.log_odds.is_some(),
+        streamed: false,
     };
     print(&args, &info, bbox)
 }
