@@ -119,6 +119,21 @@ pub fn open_operand(path: &Path) -> Result<Option<Operand>> {
     }))
 }
 
+/// Makes the staged directory a dataset is written into beside `dir`, after
+/// removing the staged directories of writers of `dir` that were killed
+/// (`io::sweep_stale_staged`: only those whose marker names a process that is
+/// provably gone), each named in a note on standard error.
+pub fn stage_dataset(dir: &Path) -> Result<tesseral::io::StagedDir> {
+    for gone in tesseral::io::sweep_stale_staged(dir) {
+        eprintln!(
+            "note: removed {}, left by a writer of {} that was killed",
+            gone.display(),
+            dir.display()
+        );
+    }
+    Ok(tesseral::io::StagedDir::beside(dir)?)
+}
+
 /// The folder for temporary files beside `out`.
 pub fn spool_dir(out: &Path) -> PathBuf {
     match out.parent() {

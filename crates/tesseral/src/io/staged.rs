@@ -416,7 +416,11 @@ mod tests {
         let bare = root.path().join(".ds.bare01.tmp");
         fs::create_dir(&bare).unwrap();
         let bad = planted(&target, &with(dead_pid, None));
-        fs::write(bad.join(MARKER), "tesseral staged dataset directory\npid x\n").unwrap();
+        fs::write(
+            bad.join(MARKER),
+            "tesseral staged dataset directory\npid x\n",
+        )
+        .unwrap();
         let old = root.path().join(".ds.aside1.tmp.old");
         fs::create_dir(&old).unwrap();
         fs::write(old.join(MARKER), marker_text(&with(dead_pid, None))).unwrap();

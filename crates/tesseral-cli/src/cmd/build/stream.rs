@@ -171,8 +171,9 @@ pub fn build_parts(
     )?;
     drop(plan);
     // Written into a hidden directory beside DIR and renamed into place at the end
-    // (an old dataset there moved aside, then removed); Ctrl-C removes it.
-    let staged = tesseral::io::StagedDir::beside(dir)?;
+    // (an old dataset there moved aside, then removed); Ctrl-C removes it, and the
+    // next writer removes it after a SIGKILL.
+    let staged = super::super::streamed::stage_dataset(dir)?;
     let parts =
         tesseral::partition::build_scene_dataset(scene, staged.path(), k, window, &mut |_, _| {})?;
     staged.commit(dir)?;
