@@ -119,11 +119,14 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     )?;
     let mut summary = tesseral::partition::StreamSummary::default();
     let spool = spool_dir(&args.output);
-    tesseral::io::write_atomic(&args.output, |w| {
-        summary =
-            tesseral::partition::stream_set_op_files(&a.files, &b.files, op, a.frame, w, &spool)
-                .map_err(std::io::Error::other)?;
-        Ok(())
+    super::streamed::with_leaf_progress("combining", &[&a.files, &b.files], || {
+        tesseral::io::write_atomic(&args.output, |w| {
+            summary = tesseral::partition::stream_set_op_files(
+                &a.files, &b.files, op, a.frame, w, &spool,
+            )
+            .map_err(std::io::Error::other)?;
+            Ok(())
+        })
     })
     .with_context(|| format!("writing {}", args.output.display()))?;
     let (depth, origin) = a.space();

@@ -146,3 +146,76 @@ pub fn spool_dir(out: &Path) -> PathBuf {
 pub fn is_tess_output(out: &Path) -> bool {
     !super::output::is_stdio(out) && tesseral::io::extension(out) == "tess"
 }
+
+/// Streamed writes of fewer input leaves than this show no progress bar.
+const PROGRESS_MIN_LEAVES: u64 = 1 << 20;
+
+/// The bytes the chunks of `f` take: the leaves' share of the file, which a
+/// streamed copy, cut, merge or translation writes as it goes (the colour
+/// regions are spooled and copied at the end).
+fn chunk_bytes(f: &TessFile) -> u64 {
+    let c = f.chunks();
+    match (c.first(), c.last()) {
+        (Some(a), Some(b)) if c.len() > 1 => {
+            let span = b.offset - a.offset;
+            span + span / (c.len() as u64 - 1)
+        }
+        _ => f.leaf_count() + f.leaf_count() / 10,
+    }
+}
+
+/// Bytes written so far by the writes in progress: each temporary file's size,
+/// and the files in each staged dataset directory.
+fn written_bytes() -> u64 {
+    let len = |p: &Path| std::fs::symlink_metadata(p).map_or(0, |m| m.len());
+    tesseral::io::pending_temporaries()
+        .iter()
+        .map(|p| {
+            if p.is_dir() {
+                std::fs::read_dir(p).map_or(0, |d| d.flatten().map(|e| len(&e.path())).sum())
+            } else {
+                len(p)
+            }
+        })
+        .sum()
+}
+
+/// Runs `write`, a streamed write of the leaves of the files `inputs` (`what`: "cutting",
+/// "translating"...), and while it runs shows on standard error, on a terminal
+/// only and for inputs of at least 2^20 leaves, a bar of the input's leaves with
+/// the time left. The library prints nothing and reports no progress here, so
+/// the bar watches the output grow from a second thread (the temporary file, or
+/// a staged dataset's files) against the bytes of the input's chunks: the leaves
+/// shown are that share of the input's leaves, an estimate (an operation that
+/// drops most leaves, such as an intersection, ends early).
+pub fn with_leaf_progress<T>(what: &str, inputs: &[&[TessFile]], write: impl FnOnce() -> T) -> T {
+    use std::io::IsTerminal;
+    let files = || inputs.iter().flat_map(|f| f.iter());
+    let leaves: u64 = files().map(TessFile::leaf_count).sum();
+    if leaves < PROGRESS_MIN_LEAVES || !std::io::stderr().is_terminal() {
+        return write();
+    }
+    let bytes = files().map(chunk_bytes).sum::<u64>().max(1);
+    let bar = indicatif::ProgressBar::new(leaves);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!(
+            "{what} {{bar:40}} ~{{pos}}/{{len}} leaves, eta {{eta}}"
+        ))
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                let share = written_bytes().min(bytes) as f64 / bytes as f64;
+                bar.set_position((share * leaves as f64) as u64);
+                std::thread::sleep(std::time::Duration::from_millis(200));
+            }
+        });
+        let result = write();
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        result
+    });
+    bar.finish_and_clear();
+    result
+}

@@ -71,7 +71,10 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             output::check_size(dir, estimate, args.limits.limits.max_output)?;
             let ranges = partition::leaf_ranges(&op.files, k)?;
             let staged = super::super::streamed::stage_dataset(dir)?;
-            let parts = partition::stream_dataset(&op.files, op.frame, &ranges, staged.path())
+            let parts =
+                super::super::streamed::with_leaf_progress("cutting", &[&op.files[..]], || {
+                    partition::stream_dataset(&op.files, op.frame, &ranges, staged.path())
+                })
                 .with_context(|| format!("writing {}", dir.display()))?;
             staged.commit(dir)?;
             (parts, op.space(), op.frame)

@@ -81,10 +81,12 @@ pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
     output::check_size(out, op.bytes, args.limits.limits.max_output)?;
     let spool_dir = streamed::spool_dir(out);
     let mut summary = tesseral::partition::StreamSummary::default();
-    io::write_atomic(out, |w| {
-        summary = tesseral::partition::stream_concat(&op.files, op.frame, w, &spool_dir)
-            .map_err(std::io::Error::other)?;
-        Ok(())
+    streamed::with_leaf_progress("converting", &[&op.files[..]], || {
+        io::write_atomic(out, |w| {
+            summary = tesseral::partition::stream_concat(&op.files, op.frame, w, &spool_dir)
+                .map_err(std::io::Error::other)?;
+            Ok(())
+        })
     })
     .map_err(|e| anyhow::anyhow!("writing {}: {e}", out.display()))?;
     if args.json {

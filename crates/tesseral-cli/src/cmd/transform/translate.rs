@@ -219,12 +219,15 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
     // The colour spools' temporary files go next to the output.
     let spool_dir = crate::cmd::streamed::spool_dir(&args.output);
     let mut done = None;
-    tesseral::io::write_atomic(&args.output, |w| {
-        done = Some(
-            tesseral::partition::stream_translate(&f, by, w, &spool_dir)
-                .map_err(std::io::Error::other)?,
-        );
-        Ok(())
+    let inputs = [std::slice::from_ref(&f)];
+    crate::cmd::streamed::with_leaf_progress("translating", &inputs, || {
+        tesseral::io::write_atomic(&args.output, |w| {
+            done = Some(
+                tesseral::partition::stream_translate(&f, by, w, &spool_dir)
+                    .map_err(std::io::Error::other)?,
+            );
+            Ok(())
+        })
     })
     .with_context(|| {
         format!(
