@@ -399,6 +399,29 @@ impl From<Entry> for ManifestPart {
     }
 }
 
+/// Makes a staged dataset directory beside `target` (`.NAME.XXXXXX.tmp`, with
+/// the marker naming this process, as `tesseral build --parts` makes it) and
+/// returns its path; nothing removes it but [`staged_commit`] or the caller.
+#[pyfunction]
+pub fn staged_create(target: PathBuf) -> PyResult<PathBuf> {
+    tesseral::io::stage_dir(&target).map_err(errors::format)
+}
+
+/// Renames the staged directory `staged` to `target` (its marker removed; an old
+/// directory at `target` renamed aside first, then removed), as the CLI does.
+#[pyfunction]
+pub fn staged_commit(py: Python<'_>, staged: PathBuf, target: PathBuf) -> PyResult<()> {
+    py.allow_threads(|| tesseral::io::commit_staged(&staged, &target))
+        .map_err(errors::format)
+}
+
+/// Removes the staged directories beside `target` whose writers are provably
+/// gone (killed), as the CLI's `--parts` writers do; returns their paths.
+#[pyfunction]
+pub fn staged_sweep(py: Python<'_>, target: PathBuf) -> Vec<PathBuf> {
+    py.allow_threads(|| tesseral::io::sweep_stale_staged(&target))
+}
+
 /// Registers the functions above.
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(partition_scene_ranges, m)?)?;
@@ -416,5 +439,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(partition_write_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(partition_read_manifest, m)?)?;
     m.add_function(wrap_pyfunction!(partition_read_part, m)?)?;
+    m.add_function(wrap_pyfunction!(staged_create, m)?)?;
+    m.add_function(wrap_pyfunction!(staged_commit, m)?)?;
+    m.add_function(wrap_pyfunction!(staged_sweep, m)?)?;
     Ok(())
 }

@@ -398,3 +398,38 @@ def test_overwriting_replaces_the_whole_dataset(client, tmp_path):
     (manifest,) = dask.compute(task)
     assert len(manifest["parts"]) == 3
     same(tesseral.Octree.read(tmp_path / "later"), a.build())
+
+
+KILLED_CLIENT = """
+import os, signal, sys
+import dask
+import tesseral, tesseral.dask as tdask
+scene = tesseral.Scene.parse(sys.argv[2])
+parts = tdask.build(scene, parts=3)
+def die(tree):
+    os.kill(os.getpid(), signal.SIGKILL)
+parts = tdask.Parts(parts.ranges, parts.octrees[:2] + [dask.delayed(die)(parts.octrees[2])], parts.space)
+tdask.write(parts, sys.argv[1], scheduler="sync")
+"""
+
+
+def test_a_killed_clients_staged_directory_is_swept_by_the_next_write(client, tmp_path):
+    ds = tmp_path / "ds"
+    # A client killed (SIGKILL) in the middle of its write: the write's tasks run
+    # in the client (the synchronous scheduler), and the last one kills it.
+    out = subprocess.run(
+        [sys.executable, "-c", KILLED_CLIENT, str(ds), SCENE_A], capture_output=True, text=True
+    )
+    assert out.returncode == -signal.SIGKILL, out.stderr
+    (left,) = [n for n in os.listdir(tmp_path) if n.startswith(".ds.") and n.endswith(".tmp")]
+    assert ".tesseral-staged" in os.listdir(tmp_path / left)
+    assert not ds.exists()
+    # A staged directory of a live writer (this process) is kept.
+    live = os.fspath(tesseral._tesseral.staged_create(ds))
+    b = tesseral.Scene.parse(SCENE_B)
+    tdask.write(tdask.build(b, parts=2), ds)
+    staged = sorted(n for n in os.listdir(tmp_path) if n != "ds")
+    assert staged == [os.path.basename(live)]
+    assert sorted(os.listdir(ds)) == ["manifest.json", "part-00000.tess", "part-00001.tess"]
+    same(tdask.read(ds).compute(), b.build())
+    shutil.rmtree(live)

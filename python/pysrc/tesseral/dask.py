@@ -30,7 +30,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import uuid
 from typing import Any, Iterable, List, Optional, Sequence, Tuple, Union
 
 try:
@@ -260,7 +259,8 @@ def _check_target(path: str, overwrite: bool) -> None:
 
 def _commit(tmp: str, path: str, overwrite: bool, manifest: dict) -> dict:
     """Moves the dataset written in ``tmp`` to ``path``: renamed into place, an old
-    dataset there renamed aside first and removed after, so no part of it stays."""
+    dataset there renamed aside first and removed after, so no part of it stays
+    (the library's ``io::commit_staged``, which ``tesseral build --parts`` uses)."""
     if not os.path.exists(tmp) and os.path.exists(os.path.join(path, "manifest.json")):
         # A rerun of this task after its first run committed.
         if _ext.partition_read_manifest(path) == manifest:
@@ -268,18 +268,7 @@ def _commit(tmp: str, path: str, overwrite: bool, manifest: dict) -> dict:
     _check_target(path, overwrite)
     if os.path.isdir(path) and not os.listdir(path):
         os.rmdir(path)
-    if not os.path.lexists(path):
-        os.rename(tmp, path)
-        return manifest
-    parent, name = os.path.split(path)
-    old = os.path.join(parent, f".{name}.old-{uuid.uuid4().hex}")
-    os.rename(path, old)
-    try:
-        os.rename(tmp, path)
-    except BaseException:
-        os.rename(old, path)
-        raise
-    shutil.rmtree(old, ignore_errors=True)
+    _ext.staged_commit(tmp, path)
     return manifest
 
 
@@ -435,17 +424,26 @@ def write(parts: Parts, path: Union[str, "os.PathLike[str]"], overwrite: bool = 
     """Writes the parts as a dataset in the directory ``path``: one ``.tess`` per
     part (with its colours), written by the worker that holds it, then
     ``manifest.json`` (space, frame, ranges, counts, CRC-32s), all in a new
-    directory beside ``path`` that is then renamed into place. So a reader sees the
+    directory beside ``path`` (``.NAME.XXXXXX.tmp``, with a marker naming this
+    client, made and renamed by the same library code as ``tesseral build
+    --parts``) that is then renamed into place. So a reader sees the
     old dataset or the new one, never a mixture, and no part of an old dataset
     stays. Refuses an existing ``path`` (other than an empty directory) unless
     ``overwrite``, and even then anything but a dataset directory. The workers
-    write, so on a cluster ``path`` must be on a file system that they all see.
+    write, so on a cluster ``path`` must be on a file system that they all see. A
+    client killed mid-write leaves its directory; the next ``write`` to ``path``
+    from the same host removes it (a writer on another host, or still running, is
+    left alone).
     Returns the manifest as a dict, or with ``compute=False`` the task that writes
     it (keyword arguments go to ``dask.compute``)."""
     path = os.path.abspath(os.fspath(path))
     _check_target(path, overwrite)
-    parent, name = os.path.split(path)
-    tmp = os.path.join(parent, f".{name}.tmp-{uuid.uuid4().hex}")
+    # Staged as the CLI stages: first the staged directories of clients of this
+    # path that were killed mid-write are removed (only those whose marker names
+    # a process that is provably gone), then a new one is made, whose marker
+    # names this client.
+    _ext.staged_sweep(path)
+    tmp = os.fspath(_ext.staged_create(path))
     entries = [
         dask.delayed(_write_part)(tmp, i, parts.ranges, t)
         for i, t in enumerate(parts.octrees)

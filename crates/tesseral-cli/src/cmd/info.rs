@@ -17,7 +17,7 @@ pub struct Args {
     file: PathBuf,
     /// Print JSON (keys: voxels, leaves, depth, origin, bbox_min, bbox_max,
     /// leaves_by_depth, bytes, voxel_size, translate, world_min, world_max, colors,
-    /// colored_voxels, free_voxels, free_leaves, log_odds).
+    /// colored_voxels, free_voxels, free_leaves, log_odds, streamed).
     #[arg(long)]
     json: bool,
     /// Print the octree as the indented node list of Ahuja & Nash Fig. 4 instead:
@@ -100,14 +100,19 @@ struct Info {
     free_leaves: Option<usize>,
     /// Whether per-voxel occupancy log-odds are stored.
     log_odds: bool,
+    /// Whether the file was read chunk by chunk (a `.tess` file of either version
+    /// or a dataset, with no layers but colours) rather than loaded whole.
+    streamed: bool,
 }
 
 /// An inclusive box of voxels.
 type BBox = ([i64; 3], [i64; 3]);
 
-/// The info of a version-2 `.tess` file with no layers but colours, or of a dataset
-/// of them, read chunk by chunk from the maps (the leaves never all held), part
-/// after part, the colour regions as streams. `None` for other files.
+/// The info of a `.tess` file (either version: a version-1 payload is indexed in
+/// one pass, `TessFile::open_streaming`) with no layers but colours, or of a
+/// dataset of them, read chunk by chunk from the maps (the leaves never all held),
+/// part after part, the colour regions as streams. `None` for other files (a
+/// legacy colour list, free space or log-odds: read whole).
 fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
     use tesseral::io::TessFile;
     use tesseral::partition::{is_dataset, open_part, read_manifest};
@@ -124,7 +129,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
         let frame = tesseral::model::Frame::new(m.frame.voxel_size, m.frame.translate);
         (files, frame)
     } else if path.is_file() && tesseral::io::extension(path) == "tess" {
-        let f = TessFile::open(path)?;
+        let f = TessFile::open_streaming(path)?;
         let frame = f.frame();
         (vec![f], frame)
     } else {
@@ -195,6 +200,7 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
         free_voxels: None,
         free_leaves: None,
         log_odds: false,
+        streamed: true,
     };
     Ok(Some((info, bbox)))
 }
@@ -205,6 +211,7 @@ pub fn run(args: Args) -> Result<()> {
             return print(&args, &info, bbox);
         }
     }
+    super::streamed::check_version_1_in_memory(&args.file, &args.budget)?;
     let model = octree::read_model(&args.file, &args.budget, &Default::default())?;
     let tree = &model.tree;
     if args.tree || args.codes {
@@ -230,6 +237,7 @@ pub fn run(args: Args) -> Result<()> {
         free_voxels: model.free.as_ref().map(|f| f.voxel_count()),
         free_leaves: model.free.as_ref().map(|f| f.leaf_count()),
         log_odds: model.log_odds.is_some(),
+        streamed: false,
     };
     print(&args, &info, bbox)
 }

@@ -39,8 +39,10 @@ pub struct Args {
     #[command(flatten)]
     limits: octree::OutArgs,
     /// The working memory a version-1 `.tess` operand may take when it is decoded
-    /// whole (at most 24 bytes a byte of the file), checked before it is read:
-    /// bytes, or a number with K, M, G or T (powers of 1024).
+    /// whole (at most 24 bytes a byte of the file; only when it cannot stream: a
+    /// legacy colour list, free space or log-odds, operands in different spaces,
+    /// or an output that is not .tess), checked before it is read: bytes, or a
+    /// number with K, M, G or T (powers of 1024).
     #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = super::output::parse_bytes)]
     memory: u64,
 }
@@ -55,6 +57,13 @@ pub fn run(args: Args) -> Result<()> {
     };
     if let Some(done) = streamed(&args, op)? {
         return done;
+    }
+    let budget = super::budget::Budget {
+        max_leaves: None,
+        memory: args.memory,
+    };
+    for input in [&args.a, &args.b] {
+        super::streamed::check_version_1_in_memory(input, &budget)?;
     }
     let a = octree::read(&args.a)?;
     let b = octree::read(&args.b)?;
@@ -83,8 +92,8 @@ pub fn run(args: Args) -> Result<()> {
 /// Two operands of one space and frame, each a `.tess` file or a dataset
 /// directory, with no layers but colours, into a `.tess` file: a merge of the two
 /// sorted streams (a dataset's parts read in order as one stream, colour regions
-/// included), one chunk of each held at a time. A version-1 file is one payload,
-/// decoded whole under the `--memory` check, then streamed from memory. The output
+/// included), one chunk of each held at a time. A version-1 file streams too, its
+/// payload indexed in one pass (`TessFile::open_streaming`). The output
 /// size (estimated as the inputs' sizes together) is checked against
 /// `--max-output` before the work. `None` when the inputs need the in-memory
 /// path.
@@ -93,14 +102,10 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     if !is_tess_output(&args.output) {
         return Ok(None);
     }
-    let budget = super::budget::Budget {
-        max_leaves: None,
-        memory: args.memory,
-    };
-    let Some(a) = open_operand(&args.a, &budget)? else {
+    let Some(a) = open_operand(&args.a)? else {
         return Ok(None);
     };
-    let Some(b) = open_operand(&args.b, &budget)? else {
+    let Some(b) = open_operand(&args.b)? else {
         return Ok(None);
     };
     let same_space = (a.space(), a.frame) == (b.space(), b.frame);
@@ -114,11 +119,14 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
     )?;
     let mut summary = tesseral::partition::StreamSummary::default();
     let spool = spool_dir(&args.output);
-    tesseral::io::write_atomic(&args.output, |w| {
-        summary =
-            tesseral::partition::stream_set_op_files(&a.files, &b.files, op, a.frame, w, &spool)
-                .map_err(std::io::Error::other)?;
-        Ok(())
+    super::streamed::with_leaf_progress("combining", &[&a.files, &b.files], || {
+        tesseral::io::write_atomic(&args.output, |w| {
+            summary = tesseral::partition::stream_set_op_files(
+                &a.files, &b.files, op, a.frame, w, &spool,
+            )
+            .map_err(std::io::Error::other)?;
+            Ok(())
+        })
     })
     .with_context(|| format!("writing {}", args.output.display()))?;
     let (depth, origin) = a.space();

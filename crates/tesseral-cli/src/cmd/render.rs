@@ -85,10 +85,10 @@ pub struct Args {
     /// Print sizes and timings as JSON on stdout.
     #[arg(long)]
     json: bool,
-    /// Load the whole model before drawing. By default a version-2 `.tess` file or a
-    /// dataset is drawn streamed (only the chunks the rays, the cut or the slice
-    /// reach are read, within --memory), views, cuts, slices and contact sheets
-    /// alike.
+    /// Load the whole model before drawing. By default a `.tess` file (either
+    /// version) or a dataset is drawn streamed (only the chunks the rays, the cut
+    /// or the slice reach are read, within --memory), views, cuts, slices and
+    /// contact sheets alike.
     #[arg(long)]
     in_memory: bool,
     #[command(flatten)]
@@ -268,6 +268,11 @@ pub fn run(args: Args) -> Result<()> {
         let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
+        if !args.in_memory {
+            // A version-1 file that cannot stream (a legacy colour list, free space
+            // or log-odds) is decoded whole: its memory is checked first.
+            super::streamed::check_version_1_in_memory(&args.input, &args.budget)?;
+        }
         let model = octree::read(&args.input)?;
         let frame = model.frame;
         colors = model.colors;

@@ -52,7 +52,7 @@ fn file_len(path: &Path) -> Result<u64> {
         .len())
 }
 
-/// Whether `path` is a `.tess` file of version 1 (one payload, decoded whole).
+/// Whether `path` is a `.tess` file of version 1 (one payload, no chunks).
 pub fn is_version_1(path: &Path) -> Result<bool> {
     use std::io::Read;
     let mut head = [0u8; 10];
@@ -64,11 +64,29 @@ pub fn is_version_1(path: &Path) -> Result<bool> {
     Ok(u16::from_le_bytes([head[8], head[9]]) == 1)
 }
 
+/// Before a version-1 `.tess` file is read whole (the in-memory paths, taken
+/// when it has layers that do not stream or the command cannot stream): its
+/// memory, at most 24 bytes a byte of the file, against `--memory`. Nothing for
+/// other inputs.
+pub fn check_version_1_in_memory(path: &Path, budget: &Budget) -> Result<()> {
+    if super::output::is_stdio(path)
+        || !(path.is_file() && tesseral::io::extension(path) == "tess")
+        || !is_version_1(path)?
+    {
+        return Ok(());
+    }
+    budget.check_memory(
+        &format!("{} (a version-1 .tess file, read whole)", path.display()),
+        file_len(path)?.saturating_mul(V1_BYTES_PER_FILE_BYTE),
+        "",
+    )
+}
+
 /// Opens `path` for streaming: a dataset directory (its parts, checked against
-/// the manifest) or a `.tess` file. A version-1 file is one payload, decoded whole
-/// when it is opened: its memory (at most 24 bytes a byte of the file) is checked
-/// against `--memory` first. `None` for anything else (read it in memory).
-pub fn open_operand(path: &Path, budget: &Budget) -> Result<Option<Operand>> {
+/// the manifest) or a `.tess` file of either version (a version-1 file's payload
+/// is indexed in one pass, `TessFile::open_streaming`, and then streams as a
+/// version-2 file does). `None` for anything else (read it in memory).
+pub fn open_operand(path: &Path) -> Result<Option<Operand>> {
     use tesseral::partition::{is_dataset, open_part, read_manifest};
     if super::output::is_stdio(path) {
         return Ok(None);
@@ -92,23 +110,28 @@ pub fn open_operand(path: &Path, budget: &Budget) -> Result<Option<Operand>> {
         return Ok(None);
     }
     let bytes = file_len(path)?;
-    if is_version_1(path)? {
-        budget.check_memory(
-            &format!(
-                "{} (a version-1 .tess file, read whole; `convert` it to .tess to stream it)",
-                path.display()
-            ),
-            bytes.saturating_mul(V1_BYTES_PER_FILE_BYTE),
-            "",
-        )?;
-    }
-    let f = TessFile::open(path)?;
+    let f = TessFile::open_streaming(path)?;
     let frame = f.frame();
     Ok(Some(Operand {
         files: vec![f],
         frame,
         bytes,
     }))
+}
+
+/// Makes the staged directory a dataset is written into beside `dir`, after
+/// removing the staged directories of writers of `dir` that were killed
+/// (`io::sweep_stale_staged`: only those whose marker names a process that is
+/// provably gone), each named in a note on standard error.
+pub fn stage_dataset(dir: &Path) -> Result<tesseral::io::StagedDir> {
+    for gone in tesseral::io::sweep_stale_staged(dir) {
+        eprintln!(
+            "note: removed {}, left by a writer of {} that was killed",
+            gone.display(),
+            dir.display()
+        );
+    }
+    Ok(tesseral::io::StagedDir::beside(dir)?)
 }
 
 /// The folder for temporary files beside `out`.
@@ -122,4 +145,77 @@ pub fn spool_dir(out: &Path) -> PathBuf {
 /// Whether `out` is a `.tess` file (not standard output).
 pub fn is_tess_output(out: &Path) -> bool {
     !super::output::is_stdio(out) && tesseral::io::extension(out) == "tess"
+}
+
+/// Streamed writes of fewer input leaves than this show no progress bar.
+const PROGRESS_MIN_LEAVES: u64 = 1 << 20;
+
+/// The bytes the chunks of `f` take: the leaves' share of the file, which a
+/// streamed copy, cut, merge or translation writes as it goes (the colour
+/// regions are spooled and copied at the end).
+fn chunk_bytes(f: &TessFile) -> u64 {
+    let c = f.chunks();
+    match (c.first(), c.last()) {
+        (Some(a), Some(b)) if c.len() > 1 => {
+            let span = b.offset - a.offset;
+            span + span / (c.len() as u64 - 1)
+        }
+        _ => f.leaf_count() + f.leaf_count() / 10,
+    }
+}
+
+/// Bytes written so far by the writes in progress: each temporary file's size,
+/// and the files in each staged dataset directory.
+fn written_bytes() -> u64 {
+    let len = |p: &Path| std::fs::symlink_metadata(p).map_or(0, |m| m.len());
+    tesseral::io::pending_temporaries()
+        .iter()
+        .map(|p| {
+            if p.is_dir() {
+                std::fs::read_dir(p).map_or(0, |d| d.flatten().map(|e| len(&e.path())).sum())
+            } else {
+                len(p)
+            }
+        })
+        .sum()
+}
+
+/// Runs `write`, a streamed write of the leaves of the files `inputs` (`what`: "cutting",
+/// "translating"...), and while it runs shows on standard error, on a terminal
+/// only and for inputs of at least 2^20 leaves, a bar of the input's leaves with
+/// the time left. The library prints nothing and reports no progress here, so
+/// the bar watches the output grow from a second thread (the temporary file, or
+/// a staged dataset's files) against the bytes of the input's chunks: the leaves
+/// shown are that share of the input's leaves, an estimate (an operation that
+/// drops most leaves, such as an intersection, ends early).
+pub fn with_leaf_progress<T>(what: &str, inputs: &[&[TessFile]], write: impl FnOnce() -> T) -> T {
+    use std::io::IsTerminal;
+    let files = || inputs.iter().flat_map(|f| f.iter());
+    let leaves: u64 = files().map(TessFile::leaf_count).sum();
+    if leaves < PROGRESS_MIN_LEAVES || !std::io::stderr().is_terminal() {
+        return write();
+    }
+    let bytes = files().map(chunk_bytes).sum::<u64>().max(1);
+    let bar = indicatif::ProgressBar::new(leaves);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(&format!(
+            "{what} {{bar:40}} ~{{pos}}/{{len}} leaves, eta {{eta}}"
+        ))
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let done = std::sync::atomic::AtomicBool::new(false);
+    let result = std::thread::scope(|scope| {
+        scope.spawn(|| {
+            while !done.load(std::sync::atomic::Ordering::Relaxed) {
+                let share = written_bytes().min(bytes) as f64 / bytes as f64;
+                bar.set_position((share * leaves as f64) as u64);
+                std::thread::sleep(std::time::Duration::from_millis(200));
+            }
+        });
+        let result = write();
+        done.store(true, std::sync::atomic::Ordering::Relaxed);
+        result
+    });
+    bar.finish_and_clear();
+    result
 }

@@ -51,7 +51,7 @@ pub use estimate::{estimate_image_bytes, estimate_output_bytes, estimate_xyz_byt
 pub use reframe::reframe;
 pub use sniff::sniff_format;
 pub use spool::LeafSpool;
-pub use staged::StagedDir;
+pub use staged::{commit_staged, stage_dir, sweep_stale_staged, StagedDir, MARKER};
 pub use tess_colours::RegionLeaves;
 pub use tess_file::{LeafIter, TessFile};
 

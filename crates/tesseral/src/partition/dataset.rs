@@ -275,7 +275,9 @@ pub fn read_manifest(dir: &Path) -> Result<Manifest, PartitionError> {
 }
 
 /// Opens part `i` of a dataset and checks it against the manifest (CRC, space,
-/// range, leaf count).
+/// range, leaf count). A part of version 1 (our writers write version 2, but a
+/// manifest may name older files) is opened by [`TessFile::open_streaming`], so
+/// that it streams as a version-2 part does.
 ///
 /// # Errors
 /// [`PartitionError`] naming the part file.
@@ -293,7 +295,7 @@ pub fn open_part(dir: &Path, m: &Manifest, i: usize) -> Result<TessFile, Partiti
             p.crc32
         )));
     }
-    let f = TessFile::open(&path)?;
+    let f = TessFile::open_streaming(&path)?;
     if (f.depth(), f.origin()) != (m.depth, m.origin) {
         return Err(bad(
             "the part is in another space than the manifest's".into()

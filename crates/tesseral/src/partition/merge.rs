@@ -216,9 +216,12 @@ fn chained(files: &[TessFile]) -> crate::io::LeafIter<'_> {
 /// `w` with `frame` (see the module docs). Colours follow the in-memory rule
 /// (`Model::set_op`): a voxel of the result keeps the first operand's colour where
 /// it has one, else the second's; each colour region is spooled to a temporary
-/// file in `spool_dir` and read from the inputs as a stream. A version-1 file
-/// (one payload) was decoded whole when it was opened; its leaves and colours are
-/// streamed from memory.
+/// file in `spool_dir` and read from the inputs as a stream. A version-1 file is
+/// read as a stream too when it was opened by [`TessFile::open_streaming`] (else
+/// it was decoded whole and is streamed from memory). The result keeps a colour
+/// layer, even an empty one, when an operand has one, as `Model::set_op` does: a
+/// single file's layer even when empty, a dataset's (several files) when a part
+/// has a colour region (as the joined model has).
 ///
 /// # Runtime
 /// O((leaves of both + colour leaves) × streams), reading each chunk once.
@@ -254,6 +257,10 @@ pub fn stream_set_op_files(
         )));
     }
     let (ca, cb) = (operand_colours(a)?, operand_colours(b)?);
+    let has_layer = |fs: &[TessFile], regions: &[_]| {
+        !regions.is_empty() || (fs.len() == 1 && fs[0].has_layers())
+    };
+    let keep_layer = has_layer(a, &ca) || has_layer(b, &cb);
     let io = |e: std::io::Error| PartitionError::Format(FormatError::io(e));
     // One spool per distinct colour; stream i+2 is a's region i, then b's.
     let mut colours: Vec<Rgba> = Vec::new();
@@ -299,7 +306,11 @@ pub fn stream_set_op_files(
     })?;
     let leaves = tw.leaf_count();
     let colours = spools.iter().filter(|(_, s)| s.leaf_count() > 0).count() as u64;
-    tw.finish_spooled(frame, spools).map_err(io)?;
+    if keep_layer {
+        tw.finish_spooled_layer(frame, spools).map_err(io)?;
+    } else {
+        tw.finish_spooled(frame, spools).map_err(io)?;
+    }
     Ok(StreamSummary {
         leaves,
         voxels,

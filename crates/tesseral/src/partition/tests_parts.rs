@@ -77,6 +77,10 @@ fn streamed_set_operations_of_parts_and_version_1_files_equal_the_in_memory_ones
         let fb = [TessFile::open(&pb).unwrap()];
         assert_eq!(fb[0].is_streamed(), !v1);
         let (va, vb) = (voxels(&a), voxels(&b));
+        // The dataset as the in-memory reader joins it: a colour layer only when
+        // a part has a colour region.
+        let mut ma = ma;
+        ma.colors = ma.colors.filter(|l| !l.is_empty());
         for op in [
             SetOp::Union,
             SetOp::Intersection,
@@ -95,8 +99,7 @@ fn streamed_set_operations_of_parts_and_version_1_files_equal_the_in_memory_ones
                 got.tree.assert_valid();
                 let want = mx.set_op(my, op).unwrap();
                 assert_eq!(got.tree, want.tree, "{i} {op:?}");
-                let want_colors = want.colors.filter(|l| !l.is_empty());
-                assert_eq!(got.colors, want_colors, "{i} {op:?}");
+                assert_eq!(got.colors, want.colors, "{i} {op:?}");
                 let set: HashSet<[i64; 3]> = match op {
                     SetOp::Union => vx | vy,
                     SetOp::Intersection => vx & vy,

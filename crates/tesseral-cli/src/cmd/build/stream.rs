@@ -137,6 +137,23 @@ fn progress_bar(cells: u64, estimate: u64) -> Option<indicatif::ProgressBar> {
     Some(bar)
 }
 
+/// A bar of leaves against the estimate, with the part in progress and the time
+/// left, on a terminal only.
+fn leaves_bar(estimate: u64) -> Option<indicatif::ProgressBar> {
+    use std::io::IsTerminal;
+    if !std::io::stderr().is_terminal() {
+        return None;
+    }
+    let bar = indicatif::ProgressBar::new(estimate.max(1));
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "building {bar:40} {pos}/~{len} leaves, {msg}, eta {eta}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    Some(bar)
+}
+
 /// Builds `scene` into the dataset directory `dir` as `k` parts (each streamed),
 /// after the same memory check as a streamed build; a reader of `dir` sees the old
 /// dataset or the new one, never a mixture.
@@ -171,10 +188,33 @@ pub fn build_parts(
     )?;
     drop(plan);
     // Written into a hidden directory beside DIR and renamed into place at the end
-    // (an old dataset there moved aside, then removed); Ctrl-C removes it.
-    let staged = tesseral::io::StagedDir::beside(dir)?;
-    let parts =
-        tesseral::partition::build_scene_dataset(scene, staged.path(), k, window, &mut |_, _| {})?;
+    // (an old dataset there moved aside, then removed); Ctrl-C removes it, and the
+    // next writer removes it after a SIGKILL.
+    let staged = super::super::streamed::stage_dataset(dir)?;
+    // The bar counts the leaves of the parts written so far and of the part in
+    // progress, against the scene's estimate.
+    let bar = leaves_bar(estimate);
+    let (mut before, mut current, mut part) = (0u64, 0u64, 0usize);
+    let built = tesseral::partition::build_scene_dataset(
+        scene,
+        staged.path(),
+        k,
+        window,
+        &mut |i, p: StreamProgress| {
+            if i != part {
+                (before, part) = (before + current, i);
+            }
+            current = p.leaves;
+            if let Some(b) = &bar {
+                b.set_position(before + current);
+                b.set_message(format!("part {} of {k}", i + 1));
+            }
+        },
+    );
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let parts = built?;
     staged.commit(dir)?;
     Ok(parts)
 }

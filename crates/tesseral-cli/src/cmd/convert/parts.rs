@@ -8,6 +8,8 @@
 //! dataset is written into a new hidden directory beside DIR (`.DIR.…tmp`) and
 //! renamed into place at the end; an old dataset at DIR is renamed aside first and
 //! removed after, so a reader sees the old dataset or the new one, never a mix.
+//! Staged directories of killed writers of DIR are removed first
+//! (`streamed::stage_dataset`).
 
 use std::path::Path;
 
@@ -68,8 +70,11 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             let estimate = op.bytes.saturating_add(k as u64 * 256);
             output::check_size(dir, estimate, args.limits.limits.max_output)?;
             let ranges = partition::leaf_ranges(&op.files, k)?;
-            let staged = tesseral::io::StagedDir::beside(dir)?;
-            let parts = partition::stream_dataset(&op.files, op.frame, &ranges, staged.path())
+            let staged = super::super::streamed::stage_dataset(dir)?;
+            let parts =
+                super::super::streamed::with_leaf_progress("cutting", &[&op.files[..]], || {
+                    partition::stream_dataset(&op.files, op.frame, &ranges, staged.path())
+                })
                 .with_context(|| format!("writing {}", dir.display()))?;
             staged.commit(dir)?;
             (parts, op.space(), op.frame)
@@ -83,7 +88,7 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             let ranges = partition::balanced_ranges_of(tree, k);
             let cut = partition::split_model(&model, &ranges)
                 .with_context(|| format!("cutting {} into parts", args.input.display()))?;
-            let staged = tesseral::io::StagedDir::beside(dir)?;
+            let staged = super::super::streamed::stage_dataset(dir)?;
             let mut parts = Vec::with_capacity(ranges.len());
             for (i, (p, m)) in ranges.iter().zip(&cut).enumerate() {
                 parts.push(partition::write_model_part(staged.path(), i, *p, m)?);

@@ -42,19 +42,9 @@ fn colour_count(op: &Operand) -> Result<usize> {
 /// `None` (read it in memory) otherwise.
 pub fn open(args: &Args) -> Result<Option<(Operand, usize)>> {
     let input = &args.input;
-    let op = if input.is_file() && io::extension(input) == "tess" {
-        // A version-1 file streams too: its payload is indexed in one pass.
-        let f = io::TessFile::open_streaming(input)?;
-        Operand {
-            frame: f.frame(),
-            bytes: std::fs::metadata(input).map_or(0, |m| m.len()),
-            files: vec![f],
-        }
-    } else {
-        match streamed::open_operand(input, &args.budget)? {
-            Some(op) => op,
-            None => return Ok(None),
-        }
+    // A version-1 file streams too: its payload is indexed in one pass.
+    let Some(op) = streamed::open_operand(input)? else {
+        return Ok(None);
     };
     if !op.colours_only()? {
         return Ok(None);
@@ -91,10 +81,12 @@ pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
     output::check_size(out, op.bytes, args.limits.limits.max_output)?;
     let spool_dir = streamed::spool_dir(out);
     let mut summary = tesseral::partition::StreamSummary::default();
-    io::write_atomic(out, |w| {
-        summary = tesseral::partition::stream_concat(&op.files, op.frame, w, &spool_dir)
-            .map_err(std::io::Error::other)?;
-        Ok(())
+    streamed::with_leaf_progress("converting", &[&op.files[..]], || {
+        io::write_atomic(out, |w| {
+            summary = tesseral::partition::stream_concat(&op.files, op.frame, w, &spool_dir)
+                .map_err(std::io::Error::other)?;
+            Ok(())
+        })
     })
     .map_err(|e| anyhow::anyhow!("writing {}: {e}", out.display()))?;
     if args.json {

@@ -1,4 +1,4 @@
-//! `tesseral render` of a version-2 `.tess` file or a dataset without loading it:
+//! `tesseral render` of a `.tess` file (either version) or a dataset without loading it:
 //! the rays (of a view, a cut or a contact sheet) or the layer (of a slice) read
 //! only the chunks they reach (`tesseral::render::StreamedTree`).
 
@@ -39,8 +39,9 @@ pub(super) struct Out<'a> {
 type Units = (f64, [f64; 3]);
 
 /// The input opened for a streamed render, with its units, or `None` when it is
-/// not a version-2 `.tess` file or a dataset, or carries layers other than colours
-/// (then it is loaded whole).
+/// not a `.tess` file (either version) or a dataset, or carries layers other than
+/// colours (a version-1 legacy colour list, free space, log-odds: then it is
+/// loaded whole).
 pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<(StreamedTree, Units)>> {
     if output::is_stdio(input) {
         return Ok(None);
@@ -62,13 +63,15 @@ pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<(StreamedTree
         units = (m.frame.voxel_size, m.frame.translate);
         StreamedTree::from_parts(files, ranges, cache)
     } else if tesseral::io::extension(input) == "tess" {
-        let f = TessFile::open(input).map_err(|e| anyhow::anyhow!("{e}"))?;
+        // Either version: a version-1 payload is indexed in one pass and then read
+        // stretch by stretch as a version-2 file's chunks are.
+        let f = TessFile::open_streaming(input).map_err(|e| anyhow::anyhow!("{e}"))?;
         if !f.is_streamed() {
             return Ok(None);
         }
         units = (f.frame().voxel_size, f.frame().translate);
-        drop(f);
-        StreamedTree::open(input, cache)
+        let end = 1u64 << (3 * u32::from(f.depth()));
+        StreamedTree::from_parts(vec![f], vec![(0, end)], cache)
     } else {
         return Ok(None);
     };

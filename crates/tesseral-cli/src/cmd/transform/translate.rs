@@ -1,6 +1,6 @@
 //! `tesseral translate`: in memory (any input and output, `--clip`, `--method
-//! labels`), or streamed output cell by output cell for a version-2 `.tess` file
-//! into a `.tess` file (docs/stream-translate.md).
+//! labels`), or streamed output cell by output cell for a `.tess` file of either
+//! version into a `.tess` file (docs/stream-translate.md).
 
 use std::path::PathBuf;
 
@@ -49,15 +49,15 @@ pub struct TranslateArgs {
     /// of growing the space. Only with `--method linear`.
     #[arg(long)]
     clip: bool,
-    /// Require the streamed translation (a version-2 `.tess` file whose only layer
-    /// is colours, into a `.tess` file, with `--method linear` and without
+    /// Require the streamed translation (a `.tess` file whose only layer is
+    /// colours, into a `.tess` file, with `--method linear` and without
     /// `--clip`): an error when the input or output cannot stream. Without it, such
     /// a translation streams anyway (flat memory, about the in-memory time), and
     /// anything else is translated in memory.
     #[arg(long)]
     stream: bool,
     /// The working memory of a translation that does not stream, estimated before
-    /// the work for a version-2 `.tess` input (about 48 bytes a leaf, colours
+    /// the work for a `.tess` input (about 48 bytes a leaf, colours
     /// included): bytes, or a number with K, M, G or T (powers of 1024).
     #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = crate::cmd::output::parse_bytes)]
     memory: u64,
@@ -74,7 +74,8 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
         return Ok(());
     }
     if tesseral::io::extension(&args.input) == "tess" && args.input.is_file() {
-        let f = tesseral::io::TessFile::open(&args.input)?;
+        // Either version: a version-1 file's leaves are counted by indexing it.
+        let f = tesseral::io::TessFile::open_streaming(&args.input)?;
         if f.is_streamed() {
             crate::cmd::budget::Budget {
                 max_leaves: None,
@@ -169,9 +170,10 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
     octree::write(&args.output, &moved, &args.limits, report)
 }
 
-/// A version-2 `.tess` file with no layers but colours, translated into a `.tess`
-/// file output cell by output cell (`partition::stream_translate`): never the
-/// whole tree in memory. `false` (nothing done) for other inputs, outputs and methods.
+/// A `.tess` file of either version (a version-1 payload indexed in one pass,
+/// `TessFile::open_streaming`) with no layers but colours, translated into a
+/// `.tess` file output cell by output cell (`partition::stream_translate`): never
+/// the whole tree in memory. `false` (nothing done) for other inputs, outputs and methods.
 fn streamed(args: &TranslateArgs) -> Result<bool> {
     use tesseral::io::TessFile;
     let tess = |p: &std::path::Path| {
@@ -189,10 +191,10 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
             "only a .tess file into a .tess file streams, with --method linear and without --clip",
         );
     }
-    let f = TessFile::open(&args.input)?;
+    let f = TessFile::open_streaming(&args.input)?;
     if !f.is_streamed() || (f.has_layers() && f.colour_streams()?.is_none()) {
         return refuse(&format!(
-            "{} is not a version-2 .tess file with only colours beside its shape (convert it to .tess first)",
+            "{} has layers that do not stream (a version-1 legacy colour list, free space or log-odds; only colours stream)",
             args.input.display()
         ));
     }
@@ -217,12 +219,15 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
     // The colour spools' temporary files go next to the output.
     let spool_dir = crate::cmd::streamed::spool_dir(&args.output);
     let mut done = None;
-    tesseral::io::write_atomic(&args.output, |w| {
-        done = Some(
-            tesseral::partition::stream_translate(&f, by, w, &spool_dir)
-                .map_err(std::io::Error::other)?,
-        );
-        Ok(())
+    let inputs = [std::slice::from_ref(&f)];
+    crate::cmd::streamed::with_leaf_progress("translating", &inputs, || {
+        tesseral::io::write_atomic(&args.output, |w| {
+            done = Some(
+                tesseral::partition::stream_translate(&f, by, w, &spool_dir)
+                    .map_err(std::io::Error::other)?,
+            );
+            Ok(())
+        })
     })
     .with_context(|| {
         format!(
