@@ -179,50 +179,107 @@ pub(crate) fn exit_block(
 #[cfg(test)]
 pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
-/// Hit and miss bits of one block: bit `x + 8y` of word `z`. The miss bits fill one
-/// cache line, which is all that a ray crossing the block touches.
-#[derive(Debug, Clone, Copy)]
+/// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray
+/// crossing a block touches only its line of miss bits.
+#[derive(Debug, Clone, Copy, Default)]
 #[repr(C, align(64))]
-pub(crate) struct Masks {
-    pub miss: [u64; 8],
-    pub hit: [u64; 8],
-    pub key: BlockKey,
-}
+pub(crate) struct Bits(pub [u64; 8]);
 
 /// Blocks per side of the dense index around the origin (a power of two).
 const NEAR_SIDE_LOG2: u32 = 6;
 const NEAR_SIDE: i64 = 1 << NEAR_SIDE_LOG2;
 const NO_SLOT: u32 = u32::MAX;
 
+/// Lines of miss bits per chunk (64 KiB): the chunks never move as a scratch grows
+/// (a `Vec` of 64-byte-aligned lines would be copied at each doubling).
+const CHUNK_LOG2: u32 = 10;
+const CHUNK: usize = 1 << CHUNK_LOG2;
+
+/// Blocks of the hash index packed in one `u64` when each axis lies within this
+/// many blocks of the origin's (2^20 blocks: thousands of kilometres at any
+/// resolution of interest); farther ones are keyed by their whole key.
+const PACK: i64 = 1 << 20;
+
 /// One thread's updates of a scan: blocks, each with its masks, found through a
 /// dense index of the 64³ blocks around the origin (rays from one origin cross
-/// these most often) and a hash map beyond. Each cell is a bit, so updates are
+/// these most often) and hash maps beyond. Each cell is a bit, so updates are
 /// deduplicated as they are made, and the cells near the origin that every ray
 /// crosses cost a bit set, not an update.
+///
+/// A block is a slot: its key, its line of miss bits (in chunks that never move),
+/// and its hit bits only when a ray ends in it (few blocks do), so that a scan
+/// crossing millions of blocks writes 92 bytes for each, not the 192 of a block
+/// with both masks and its key in one aligned record.
 #[derive(Debug)]
 pub(crate) struct Scratch {
+    /// The origin's block.
+    centre: BlockKey,
     /// The lowest block of the dense index.
     near_lo: BlockKey,
     near: Vec<u32>,
-    far: FxHashMap<BlockKey, u32>,
-    pub blocks: Vec<Masks>,
+    /// Blocks beyond the dense index, by their offset from `centre` packed in 21
+    /// bits per axis.
+    far: FxHashMap<u64, u32>,
+    /// Blocks too far from `centre` to pack.
+    wide: FxHashMap<BlockKey, u32>,
+    /// The key of each slot.
+    keys: Vec<BlockKey>,
+    /// The miss bits of slot `s`: `miss[s >> CHUNK_LOG2][s % CHUNK]`.
+    miss: Vec<Box<[Bits]>>,
+    /// Per slot, 1 + its index in `hits`, or 0 when no ray ends in it.
+    hit_at: Vec<u32>,
+    hits: Vec<Bits>,
 }
+
+/// No hits.
+const NO_HITS: Bits = Bits([0; 8]);
 
 impl Scratch {
     /// An empty scratch whose dense index is centred on block `centre`.
     pub fn new(centre: BlockKey) -> Self {
         Self {
+            centre,
             near_lo: centre.map(|c| c - NEAR_SIDE / 2),
             near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
             far: FxHashMap::default(),
-            blocks: Vec::new(),
+            wide: FxHashMap::default(),
+            keys: Vec::new(),
+            miss: Vec::new(),
+            hit_at: Vec::new(),
+            hits: Vec::new(),
         }
     }
 
+    /// The keys of the slots (`0..keys().len()`).
+    pub fn keys(&self) -> &[BlockKey] {
+        &self.keys
+    }
+
+    /// The miss bits of slot `s`.
+    #[inline(always)]
+    pub fn miss(&self, s: usize) -> &[u64; 8] {
+        &self.miss[s >> CHUNK_LOG2][s & (CHUNK - 1)].0
+    }
+
+    #[inline(always)]
+    fn miss_mut(&mut self, s: usize) -> &mut [u64; 8] {
+        &mut self.miss[s >> CHUNK_LOG2][s & (CHUNK - 1)].0
+    }
+
+    /// The hit bits of slot `s`.
+    #[inline]
+    pub fn hits(&self, s: usize) -> &[u64; 8] {
+        match self.hit_at[s] {
+            0 => &NO_HITS.0,
+            h => &self.hits[h as usize - 1].0,
+        }
+    }
+
+    /// The slot of block `b`, made (empty) when the scratch has none.
     #[inline]
     fn slot(&mut self, b: BlockKey) -> usize {
         let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
-        let n = self.blocks.len() as u32;
+        let n = self.keys.len() as u32;
         let i = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
             let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
             let i = &mut self.near[at];
@@ -231,16 +288,35 @@ impl Scratch {
             }
             *i
         } else {
-            *self.far.entry(b).or_insert(n)
+            self.far_slot(b, n)
         };
         if i == n {
-            self.blocks.push(Masks {
-                key: b,
-                miss: [0; 8],
-                hit: [0; 8],
-            });
+            self.push(b);
         }
         i as usize
+    }
+
+    /// The slot of block `b` outside the dense index, or `n` (entered as `b`'s).
+    #[inline]
+    fn far_slot(&mut self, b: BlockKey, n: u32) -> u32 {
+        let d = [0, 1, 2].map(|i| b[i].checked_sub(self.centre[i]));
+        if let [Some(x), Some(y), Some(z)] = d {
+            if [x, y, z].iter().all(|c| (-PACK..PACK).contains(c)) {
+                let p = |c: i64| (c + PACK) as u64;
+                return *self.far.entry(p(x) | p(y) << 21 | p(z) << 42).or_insert(n);
+            }
+        }
+        *self.wide.entry(b).or_insert(n)
+    }
+
+    /// Appends an empty slot for block `b`.
+    fn push(&mut self, b: BlockKey) {
+        if self.keys.len() & (CHUNK - 1) == 0 {
+            self.miss
+                .push(vec![Bits::default(); CHUNK].into_boxed_slice());
+        }
+        self.keys.push(b);
+        self.hit_at.push(0);
     }
 
     /// Marks missed the cells of a ray, as [`walk`] visits them: the walk is kept in
@@ -271,7 +347,7 @@ impl Scratch {
         let mut s = self.slot(block);
         loop {
             // (x, y, z) is the walk's cell, in block `s`, not marked yet.
-            let m = &mut self.blocks[s].miss;
+            let m = self.miss_mut(s);
             m[z as usize] |= 1 << (x | y << 3);
             if m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX {
                 // Every cell of the block is missed: only the exit matters.
@@ -337,13 +413,18 @@ impl Scratch {
     #[cfg(test)]
     pub fn fill(&mut self, b: BlockKey) {
         let s = self.slot(b);
-        self.blocks[s].miss = [u64::MAX; 8];
+        *self.miss_mut(s) = [u64::MAX; 8];
     }
 
     /// Marks a cell hit.
     #[inline]
     pub fn hit(&mut self, c: [i64; 3]) {
         let s = self.slot(c.map(|x| x >> BLOCK_LOG2));
-        self.blocks[s].hit[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
+        if self.hit_at[s] == 0 {
+            self.hits.push(NO_HITS);
+            self.hit_at[s] = self.hits.len() as u32;
+        }
+        let h = &mut self.hits[self.hit_at[s] as usize - 1].0;
+        h[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
     }
 }

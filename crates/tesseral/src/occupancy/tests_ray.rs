@@ -16,14 +16,14 @@ fn key(p: [f64; 3], res: f64) -> [i64; 3] {
 /// Every missed cell of a scratch.
 fn missed(s: &Scratch) -> HashSet<[i64; 3]> {
     let mut out = HashSet::new();
-    for m in &s.blocks {
-        for (z, &w) in m.miss.iter().enumerate() {
+    for (i, key) in s.keys().iter().enumerate() {
+        for (z, &w) in s.miss(i).iter().enumerate() {
             for bit in 0..64 {
                 if w >> bit & 1 == 1 {
                     out.insert([
-                        m.key[0] * 8 + (bit & 7),
-                        m.key[1] * 8 + (bit >> 3),
-                        m.key[2] * 8 + z as i64,
+                        key[0] * 8 + (bit & 7),
+                        key[1] * 8 + (bit >> 3),
+                        key[2] * 8 + z as i64,
                     ]);
                 }
             }
