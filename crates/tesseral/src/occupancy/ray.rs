@@ -188,7 +188,12 @@ pub(crate) struct Bits(pub [u64; 8]);
 /// Blocks per side of the dense index around the origin (a power of two).
 const NEAR_SIDE_LOG2: u32 = 6;
 const NEAR_SIDE: i64 = 1 << NEAR_SIDE_LOG2;
-const NO_SLOT: u32 = u32::MAX;
+/// An entry of the dense index with no slot (the index is zeroed memory, of which
+/// only the pages a scan reaches are ever mapped); others hold the slot plus one.
+const NO_SLOT: u32 = 0;
+/// The flag of a slot in the dense index whose block is all missed (so that a ray
+/// crossing it jumps to its exit without reading its bits).
+const FULL: u32 = 1 << 31;
 
 /// Lines of miss bits per chunk (64 KiB): the chunks never move as a scratch grows
 /// (a `Vec` of 64-byte-aligned lines would be copied at each doubling).
@@ -278,22 +283,31 @@ impl Scratch {
     /// The slot of block `b`, made (empty) when the scratch has none.
     #[inline]
     fn slot(&mut self, b: BlockKey) -> usize {
+        (self.enter(b).0 & !FULL) as usize
+    }
+
+    /// The slot of block `b` (made when the scratch has none), with [`FULL`] set when
+    /// the block is known to be all missed, and its place in the dense index
+    /// (`usize::MAX` when beyond).
+    #[inline(always)]
+    fn enter(&mut self, b: BlockKey) -> (u32, usize) {
         let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
         let n = self.keys.len() as u32;
-        let i = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
+        debug_assert!(n < FULL - 1, "a scratch holds fewer than 2^31 - 1 blocks");
+        let (i, at) = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
             let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
             let i = &mut self.near[at];
             if *i == NO_SLOT {
-                *i = n;
+                *i = n + 1;
             }
-            *i
+            (*i - 1, at)
         } else {
-            self.far_slot(b, n)
+            (self.far_slot(b, n), usize::MAX)
         };
         if i == n {
             self.push(b);
         }
-        i as usize
+        (i, at)
     }
 
     /// The slot of block `b` outside the dense index, or `n` (entered as `b`'s).
@@ -344,12 +358,19 @@ impl Scratch {
         let [dx, dy, dz] = w.t_delta;
         let [mut lx, mut ly, mut lz] = w.left_axis;
         let mut left = w.left;
-        let mut s = self.slot(block);
+        let all = |m: &[u64; 8]| m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX;
         loop {
-            // (x, y, z) is the walk's cell, in block `s`, not marked yet.
-            let m = self.miss_mut(s);
-            m[z as usize] |= 1 << (x | y << 3);
-            if m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX {
+            // (x, y, z) is the walk's cell, in `block`, not marked yet. A block of the
+            // dense index is known full by its flag, set as a ray leaves it full (its
+            // line is in cache then); one beyond is checked as it is entered.
+            let (v, at) = self.enter(block);
+            let s = (v & !FULL) as usize;
+            let full = v & FULL != 0 || {
+                let m = self.miss_mut(s);
+                m[z as usize] |= 1 << (x | y << 3);
+                at == usize::MAX && all(m)
+            };
+            if full {
                 // Every cell of the block is missed: only the exit matters.
                 #[cfg(test)]
                 JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -366,19 +387,30 @@ impl Scratch {
                 y = (y + sy * n[1]) & mask;
                 z = (z + sz * n[2]) & mask;
                 block[axis] += w.step[axis];
-                s = self.slot(block);
                 continue;
+            }
+            let m = self.miss_mut(s);
+            // The bits of the cells walked in word `z` since it was last written: kept
+            // in a register and written when the walk leaves the word, so that steps
+            // along x and y do not wait on their own store to the same word.
+            let mut acc = 0u64;
+            macro_rules! flush {
+                () => {
+                    m[z as usize] |= acc;
+                };
             }
             // One step along an axis: stop before passing the end cell's plane or on
             // reaching the end cell; leave the loop when the local coordinate wraps.
             macro_rules! step {
                 ($l:ident, $t:ident, $d:ident, $c:ident, $s:ident, $axis:expr) => {{
                     if $l == 0 {
+                        flush!();
                         return;
                     }
                     $l -= 1;
                     left -= 1;
                     if left == 0 {
+                        flush!();
                         return;
                     }
                     $t += $d;
@@ -396,24 +428,37 @@ impl Scratch {
                     if tx < tz {
                         step!(lx, tx, dx, x, sx, 0);
                     } else {
+                        flush!();
+                        acc = 0;
                         step!(lz, tz, dz, z, sz, 2);
                     }
                 } else if ty < tz {
                     step!(ly, ty, dy, y, sy, 1);
                 } else {
+                    flush!();
+                    acc = 0;
                     step!(lz, tz, dz, z, sz, 2);
                 }
-                m[z as usize] |= 1 << (x | y << 3);
+                acc |= 1 << (x | y << 3);
             }
-            s = self.slot(block);
+            // After a step out along z, `acc` is empty (written before the step).
+            flush!();
+            // (One word first: stores to the line are still in flight, and a wider
+            // load of them would wait for them all.)
+            if at != usize::MAX && m[0] == u64::MAX && all(m) {
+                self.near[at] |= FULL;
+            }
         }
     }
 
     /// Marks every cell of block `b` missed.
     #[cfg(test)]
     pub fn fill(&mut self, b: BlockKey) {
-        let s = self.slot(b);
-        *self.miss_mut(s) = [u64::MAX; 8];
+        let (v, at) = self.enter(b);
+        *self.miss_mut((v & !FULL) as usize) = [u64::MAX; 8];
+        if at != usize::MAX {
+            self.near[at] |= FULL;
+        }
     }
 
     /// Marks a cell hit.
