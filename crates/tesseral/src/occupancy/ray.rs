@@ -179,68 +179,158 @@ pub(crate) fn exit_block(
 #[cfg(test)]
 pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
-/// Hit and miss bits of one block: bit `x + 8y` of word `z`. The miss bits fill one
-/// cache line, which is all that a ray crossing the block touches.
-#[derive(Debug, Clone, Copy)]
+/// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray
+/// crossing a block touches only its line of miss bits.
+#[derive(Debug, Clone, Copy, Default)]
 #[repr(C, align(64))]
-pub(crate) struct Masks {
-    pub miss: [u64; 8],
-    pub hit: [u64; 8],
-    pub key: BlockKey,
-}
+pub(crate) struct Bits(pub [u64; 8]);
 
 /// Blocks per side of the dense index around the origin (a power of two).
 const NEAR_SIDE_LOG2: u32 = 6;
 const NEAR_SIDE: i64 = 1 << NEAR_SIDE_LOG2;
-const NO_SLOT: u32 = u32::MAX;
+/// An entry of the dense index with no slot (the index is zeroed memory, of which
+/// only the pages a scan reaches are ever mapped); others hold the slot plus one.
+const NO_SLOT: u32 = 0;
+/// The flag of a slot in the dense index whose block is all missed (so that a ray
+/// crossing it jumps to its exit without reading its bits).
+const FULL: u32 = 1 << 31;
+
+/// Lines of miss bits per chunk (64 KiB): the chunks never move as a scratch grows
+/// (a `Vec` of 64-byte-aligned lines would be copied at each doubling).
+const CHUNK_LOG2: u32 = 10;
+const CHUNK: usize = 1 << CHUNK_LOG2;
+
+/// Blocks of the hash index packed in one `u64` when each axis lies within this
+/// many blocks of the origin's (2^20 blocks: thousands of kilometres at any
+/// resolution of interest); farther ones are keyed by their whole key.
+const PACK: i64 = 1 << 20;
 
 /// One thread's updates of a scan: blocks, each with its masks, found through a
 /// dense index of the 64³ blocks around the origin (rays from one origin cross
-/// these most often) and a hash map beyond. Each cell is a bit, so updates are
+/// these most often) and hash maps beyond. Each cell is a bit, so updates are
 /// deduplicated as they are made, and the cells near the origin that every ray
 /// crosses cost a bit set, not an update.
+///
+/// A block is a slot: its key, its line of miss bits (in chunks that never move),
+/// and its hit bits only when a ray ends in it (few blocks do), so that a scan
+/// crossing millions of blocks writes 92 bytes for each, not the 192 of a block
+/// with both masks and its key in one aligned record.
 #[derive(Debug)]
 pub(crate) struct Scratch {
+    /// The origin's block.
+    centre: BlockKey,
     /// The lowest block of the dense index.
     near_lo: BlockKey,
     near: Vec<u32>,
-    far: FxHashMap<BlockKey, u32>,
-    pub blocks: Vec<Masks>,
+    /// Blocks beyond the dense index, by their offset from `centre` packed in 21
+    /// bits per axis.
+    far: FxHashMap<u64, u32>,
+    /// Blocks too far from `centre` to pack.
+    wide: FxHashMap<BlockKey, u32>,
+    /// The key of each slot.
+    keys: Vec<BlockKey>,
+    /// The miss bits of slot `s`: `miss[s >> CHUNK_LOG2][s % CHUNK]`.
+    miss: Vec<Box<[Bits]>>,
+    /// Per slot, 1 + its index in `hits`, or 0 when no ray ends in it.
+    hit_at: Vec<u32>,
+    hits: Vec<Bits>,
 }
+
+/// No hits.
+const NO_HITS: Bits = Bits([0; 8]);
 
 impl Scratch {
     /// An empty scratch whose dense index is centred on block `centre`.
     pub fn new(centre: BlockKey) -> Self {
         Self {
+            centre,
             near_lo: centre.map(|c| c - NEAR_SIDE / 2),
             near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
             far: FxHashMap::default(),
-            blocks: Vec::new(),
+            wide: FxHashMap::default(),
+            keys: Vec::new(),
+            miss: Vec::new(),
+            hit_at: Vec::new(),
+            hits: Vec::new(),
         }
     }
 
+    /// The keys of the slots (`0..keys().len()`).
+    pub fn keys(&self) -> &[BlockKey] {
+        &self.keys
+    }
+
+    /// The miss bits of slot `s`.
+    #[inline(always)]
+    pub fn miss(&self, s: usize) -> &[u64; 8] {
+        &self.miss[s >> CHUNK_LOG2][s & (CHUNK - 1)].0
+    }
+
+    #[inline(always)]
+    fn miss_mut(&mut self, s: usize) -> &mut [u64; 8] {
+        &mut self.miss[s >> CHUNK_LOG2][s & (CHUNK - 1)].0
+    }
+
+    /// The hit bits of slot `s`.
+    #[inline]
+    pub fn hits(&self, s: usize) -> &[u64; 8] {
+        match self.hit_at[s] {
+            0 => &NO_HITS.0,
+            h => &self.hits[h as usize - 1].0,
+        }
+    }
+
+    /// The slot of block `b`, made (empty) when the scratch has none.
     #[inline]
     fn slot(&mut self, b: BlockKey) -> usize {
+        (self.enter(b).0 & !FULL) as usize
+    }
+
+    /// The slot of block `b` (made when the scratch has none), with [`FULL`] set when
+    /// the block is known to be all missed, and its place in the dense index
+    /// (`usize::MAX` when beyond).
+    #[inline(always)]
+    fn enter(&mut self, b: BlockKey) -> (u32, usize) {
         let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
-        let n = self.blocks.len() as u32;
-        let i = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
+        let n = self.keys.len() as u32;
+        debug_assert!(n < FULL - 1, "a scratch holds fewer than 2^31 - 1 blocks");
+        let (i, at) = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
             let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
             let i = &mut self.near[at];
             if *i == NO_SLOT {
-                *i = n;
+                *i = n + 1;
             }
-            *i
+            (*i - 1, at)
         } else {
-            *self.far.entry(b).or_insert(n)
+            (self.far_slot(b, n), usize::MAX)
         };
         if i == n {
-            self.blocks.push(Masks {
-                key: b,
-                miss: [0; 8],
-                hit: [0; 8],
-            });
+            self.push(b);
         }
-        i as usize
+        (i, at)
+    }
+
+    /// The slot of block `b` outside the dense index, or `n` (entered as `b`'s).
+    #[inline]
+    fn far_slot(&mut self, b: BlockKey, n: u32) -> u32 {
+        let d = [0, 1, 2].map(|i| b[i].checked_sub(self.centre[i]));
+        if let [Some(x), Some(y), Some(z)] = d {
+            if [x, y, z].iter().all(|c| (-PACK..PACK).contains(c)) {
+                let p = |c: i64| (c + PACK) as u64;
+                return *self.far.entry(p(x) | p(y) << 21 | p(z) << 42).or_insert(n);
+            }
+        }
+        *self.wide.entry(b).or_insert(n)
+    }
+
+    /// Appends an empty slot for block `b`.
+    fn push(&mut self, b: BlockKey) {
+        if self.keys.len() & (CHUNK - 1) == 0 {
+            self.miss
+                .push(vec![Bits::default(); CHUNK].into_boxed_slice());
+        }
+        self.keys.push(b);
+        self.hit_at.push(0);
     }
 
     /// Marks missed the cells of a ray, as [`walk`] visits them: the walk is kept in
@@ -268,12 +358,19 @@ impl Scratch {
         let [dx, dy, dz] = w.t_delta;
         let [mut lx, mut ly, mut lz] = w.left_axis;
         let mut left = w.left;
-        let mut s = self.slot(block);
+        let all = |m: &[u64; 8]| m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX;
         loop {
-            // (x, y, z) is the walk's cell, in block `s`, not marked yet.
-            let m = &mut self.blocks[s].miss;
-            m[z as usize] |= 1 << (x | y << 3);
-            if m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX {
+            // (x, y, z) is the walk's cell, in `block`, not marked yet. A block of the
+            // dense index is known full by its flag, set as a ray leaves it full (its
+            // line is in cache then); one beyond is checked as it is entered.
+            let (v, at) = self.enter(block);
+            let s = (v & !FULL) as usize;
+            let full = v & FULL != 0 || {
+                let m = self.miss_mut(s);
+                m[z as usize] |= 1 << (x | y << 3);
+                at == usize::MAX && all(m)
+            };
+            if full {
                 // Every cell of the block is missed: only the exit matters.
                 #[cfg(test)]
                 JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
@@ -290,19 +387,30 @@ impl Scratch {
                 y = (y + sy * n[1]) & mask;
                 z = (z + sz * n[2]) & mask;
                 block[axis] += w.step[axis];
-                s = self.slot(block);
                 continue;
+            }
+            let m = self.miss_mut(s);
+            // The bits of the cells walked in word `z` since it was last written: kept
+            // in a register and written when the walk leaves the word, so that steps
+            // along x and y do not wait on their own store to the same word.
+            let mut acc = 0u64;
+            macro_rules! flush {
+                () => {
+                    m[z as usize] |= acc;
+                };
             }
             // One step along an axis: stop before passing the end cell's plane or on
             // reaching the end cell; leave the loop when the local coordinate wraps.
             macro_rules! step {
                 ($l:ident, $t:ident, $d:ident, $c:ident, $s:ident, $axis:expr) => {{
                     if $l == 0 {
+                        flush!();
                         return;
                     }
                     $l -= 1;
                     left -= 1;
                     if left == 0 {
+                        flush!();
                         return;
                     }
                     $t += $d;
@@ -320,30 +428,48 @@ impl Scratch {
                     if tx < tz {
                         step!(lx, tx, dx, x, sx, 0);
                     } else {
+                        flush!();
+                        acc = 0;
                         step!(lz, tz, dz, z, sz, 2);
                     }
                 } else if ty < tz {
                     step!(ly, ty, dy, y, sy, 1);
                 } else {
+                    flush!();
+                    acc = 0;
                     step!(lz, tz, dz, z, sz, 2);
                 }
-                m[z as usize] |= 1 << (x | y << 3);
+                acc |= 1 << (x | y << 3);
             }
-            s = self.slot(block);
+            // After a step out along z, `acc` is empty (written before the step).
+            flush!();
+            // (One word first: stores to the line are still in flight, and a wider
+            // load of them would wait for them all.)
+            if at != usize::MAX && m[0] == u64::MAX && all(m) {
+                self.near[at] |= FULL;
+            }
         }
     }
 
     /// Marks every cell of block `b` missed.
     #[cfg(test)]
     pub fn fill(&mut self, b: BlockKey) {
-        let s = self.slot(b);
-        self.blocks[s].miss = [u64::MAX; 8];
+        let (v, at) = self.enter(b);
+        *self.miss_mut((v & !FULL) as usize) = [u64::MAX; 8];
+        if at != usize::MAX {
+            self.near[at] |= FULL;
+        }
     }
 
     /// Marks a cell hit.
     #[inline]
     pub fn hit(&mut self, c: [i64; 3]) {
         let s = self.slot(c.map(|x| x >> BLOCK_LOG2));
-        self.blocks[s].hit[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
+        if self.hit_at[s] == 0 {
+            self.hits.push(NO_HITS);
+            self.hit_at[s] = self.hits.len() as u32;
+        }
+        let h = &mut self.hits[self.hit_at[s] as usize - 1].0;
+        h[(c[2] & 7) as usize] |= 1 << ((c[0] & 7) | (c[1] & 7) << 3);
     }
 }

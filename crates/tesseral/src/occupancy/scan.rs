@@ -4,9 +4,9 @@
 
 use rayon::prelude::*;
 
-use super::ray::{Masks, Scratch};
+use super::ray::Scratch;
 use super::sensor::Pose;
-use super::store::BLOCK_LOG2;
+use super::store::{BlockKey, BLOCK_LOG2};
 use super::{OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
@@ -112,17 +112,17 @@ struct Place {
 /// are put in buckets by those bits and each bucket sorted on the low 64 bits, which
 /// moves half the bytes of sorting the whole codes. Many high values (a scan over
 /// thousands of kilometres): one sort of whole codes.
-fn tesseral_order(blocks: &[&[Masks]]) -> Vec<Place> {
+fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
     let codes: Vec<(u128, Place)> = blocks
         .par_iter()
         .enumerate()
         .flat_map_iter(|(s, b)| {
-            b.iter().enumerate().map(move |(i, m)| {
+            b.iter().enumerate().map(move |(i, k)| {
                 let p = Place {
                     scratch: s as u32,
                     index: i as u32,
                 };
-                (block_code(m.key), p)
+                (block_code(*k), p)
             })
         })
         .collect();
@@ -228,9 +228,9 @@ impl OccupancyMap {
         stats.rays = stats.points - skipped;
         // The blocks of all scratches in tesseral order (a block in several scratches
         // comes once per scratch, side by side: merged as it is applied).
-        let blocks: Vec<&[Masks]> = scratches.iter().map(|s| &s.blocks[..]).collect();
-        let order = tesseral_order(&blocks);
-        let (hits, misses) = self.apply(&blocks, &order);
+        let keys: Vec<&[BlockKey]> = scratches.iter().map(Scratch::keys).collect();
+        let order = tesseral_order(&keys);
+        let (hits, misses) = self.apply(&scratches, &order);
         stats.hits = hits;
         stats.misses = misses;
         stats
@@ -253,22 +253,35 @@ impl OccupancyMap {
 
     /// Applies the masks of a scan, block by block in the order given (the masks of
     /// one block, in several scratches, side by side); returns the numbers of cells
-    /// hit and missed.
-    fn apply(&mut self, blocks: &[&[Masks]], order: &[Place]) -> (u64, u64) {
+    /// hit and missed. The scratches are read out of order: the block `AHEAD` places
+    /// on is prefetched, so that its cache misses overlap this block's writing.
+    fn apply(&mut self, scratches: &[Scratch], order: &[Place]) -> (u64, u64) {
+        const AHEAD: usize = 8;
         let fixed = self.fixed;
         let (mut hits, mut misses) = (0u64, 0u64);
         self.store.reserve(order.len() / 4);
+        let key = |p: &Place| scratches[p.scratch as usize].keys()[p.index as usize];
         let mut i = 0;
         while i < order.len() {
-            let at = |p: &Place| &blocks[p.scratch as usize][p.index as usize];
-            let m = at(&order[i]);
-            let (mut miss, mut hit) = (m.miss, m.hit);
+            if let Some(p) = order.get(i + AHEAD) {
+                let s = &scratches[p.scratch as usize];
+                prefetch(s.miss(p.index as usize));
+                prefetch(&s.keys()[p.index as usize]);
+            }
+            let p = order[i];
+            let s = &scratches[p.scratch as usize];
+            let k = key(&p);
+            let (mut miss, mut hit) = (*s.miss(p.index as usize), *s.hits(p.index as usize));
             i += 1;
-            while i < order.len() && at(&order[i]).key == m.key {
-                let o = at(&order[i]);
+            while i < order.len() && key(&order[i]) == k {
+                let o = &scratches[order[i].scratch as usize];
+                let (om, oh) = (
+                    o.miss(order[i].index as usize),
+                    o.hits(order[i].index as usize),
+                );
                 for w in 0..8 {
-                    miss[w] |= o.miss[w];
-                    hit[w] |= o.hit[w];
+                    miss[w] |= om[w];
+                    hit[w] |= oh[w];
                 }
                 i += 1;
             }
@@ -277,10 +290,25 @@ impl OccupancyMap {
             }
             hits += u64::from(hit.iter().map(|w| w.count_ones()).sum::<u32>());
             misses += u64::from(miss.iter().map(|w| w.count_ones()).sum::<u32>());
-            self.store.update(m.key, &miss, &hit, fixed);
+            self.store.update(k, &miss, &hit, fixed);
         }
         (hits, misses)
     }
+}
+
+/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
+    // address is that of a live reference anyway).
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 #[cfg(test)]
@@ -296,32 +324,27 @@ mod tests {
     fn blocks_come_in_tesseral_order_duplicates_side_by_side() {
         let mut rng = Pcg64::seed_from_u64(5);
         for (round, span) in [40i64, 1 << 20, 1 << 41, 3].into_iter().enumerate() {
-            let scratches: Vec<Vec<Masks>> = (0..3)
+            let scratches: Vec<Vec<BlockKey>> = (0..3)
                 .map(|_| {
                     let mut seen = std::collections::HashSet::new();
                     (0..2000)
                         .map(|_| [0, 1, 2].map(|_| rng.random_range(-span..span)))
                         .filter(|k| seen.insert(*k))
-                        .map(|key| Masks {
-                            miss: [0; 8],
-                            hit: [0; 8],
-                            key,
-                        })
                         .collect()
                 })
                 .collect();
-            let blocks: Vec<&[Masks]> = scratches.iter().map(|s| &s[..]).collect();
+            let blocks: Vec<&[BlockKey]> = scratches.iter().map(|s| &s[..]).collect();
             let got = tesseral_order(&blocks);
             let mut want: Vec<(u128, Place)> = blocks
                 .iter()
                 .enumerate()
                 .flat_map(|(s, b)| {
-                    b.iter().enumerate().map(move |(i, m)| {
+                    b.iter().enumerate().map(move |(i, k)| {
                         let p = Place {
                             scratch: s as u32,
                             index: i as u32,
                         };
-                        (block_code(m.key), p)
+                        (block_code(*k), p)
                     })
                 })
                 .collect();

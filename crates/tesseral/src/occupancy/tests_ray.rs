@@ -16,14 +16,14 @@ fn key(p: [f64; 3], res: f64) -> [i64; 3] {
 /// Every missed cell of a scratch.
 fn missed(s: &Scratch) -> HashSet<[i64; 3]> {
     let mut out = HashSet::new();
-    for m in &s.blocks {
-        for (z, &w) in m.miss.iter().enumerate() {
+    for (i, key) in s.keys().iter().enumerate() {
+        for (z, &w) in s.miss(i).iter().enumerate() {
             for bit in 0..64 {
                 if w >> bit & 1 == 1 {
                     out.insert([
-                        m.key[0] * 8 + (bit & 7),
-                        m.key[1] * 8 + (bit >> 3),
-                        m.key[2] * 8 + z as i64,
+                        key[0] * 8 + (bit & 7),
+                        key[1] * 8 + (bit >> 3),
+                        key[2] * 8 + z as i64,
                     ]);
                 }
             }
@@ -215,4 +215,46 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
         JUMPS.load(Ordering::Relaxed) > before + 4000,
         "the jumps were taken"
     );
+}
+
+/// A scratch's slots against a map from block to hit cells: one slot per block, in
+/// the dense index, in the hash index of packed offsets (up to and past its 2^20
+/// blocks either way, where keys would collide if an offset were cut short), and
+/// beyond it, to blocks near both ends of the key range.
+#[test]
+fn a_scratch_holds_one_slot_per_block_near_far_and_beyond_packing() {
+    let mut rng = Pcg64::seed_from_u64(21);
+    for round in 0..20 {
+        let centre = [0, 1, 2].map(|_| rng.random_range(-1000i64..1000));
+        let mut s = Scratch::new(centre);
+        let mut want: std::collections::HashMap<[i64; 3], HashSet<i64>> =
+            std::collections::HashMap::new();
+        for _ in 0..3000 {
+            let b: [i64; 3] = [0, 1, 2].map(|i| {
+                let p = 1i64 << 20;
+                let off = match rng.random_range(0..5) {
+                    0 => rng.random_range(-40..40),
+                    1 => rng.random_range(-3000..3000),
+                    2 => [-p - 1, -p, -p + 1, p - 1, p, p + 1][rng.random_range(0..6)],
+                    3 => rng.random_range(-4..4) * p + rng.random_range(-2..2),
+                    _ => return [-(1i64 << 60), (1 << 60) - 1][rng.random_range(0..2)],
+                };
+                centre[i] + off
+            });
+            let l = [0, 1, 2].map(|_| rng.random_range(0..8i64));
+            s.hit([0, 1, 2].map(|i| b[i] * 8 + l[i]));
+            want.entry(b)
+                .or_default()
+                .insert(l[0] | l[1] << 3 | l[2] << 6);
+        }
+        let keys = s.keys();
+        assert_eq!(keys.len(), want.len(), "round {round}: one slot per block");
+        for (i, k) in keys.iter().enumerate() {
+            let h = s.hits(i);
+            let got: HashSet<i64> = (0..512)
+                .filter(|c| h[*c as usize >> 6] >> (c & 63) & 1 == 1)
+                .collect();
+            assert_eq!(Some(&got), want.get(k), "round {round}: block {k:?}");
+        }
+    }
 }
