@@ -64,6 +64,9 @@ pub struct TessFile {
     /// Version 2: whether sections past the frame (colours, free space, log-odds)
     /// are present.
     layers: bool,
+    /// Whether the colour regions' CRCs were checked (see
+    /// [`TessFile::open_lazy_colours`]).
+    colours_checked: std::sync::OnceLock<Result<(), String>>,
 }
 
 impl TessFile {
@@ -129,6 +132,7 @@ impl TessFile {
                 ..Extras::default()
             },
             layers,
+            colours_checked: std::sync::OnceLock::new(),
         })
     }
 
@@ -141,6 +145,38 @@ impl TessFile {
     }
 
     fn from_body(bytes: Bytes, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body_with(bytes, path, false)
+    }
+
+    /// As [`TessFile::open`], but a version-2 file whose only layer is colours and
+    /// which has a colour index (every file this version writes with colours) is
+    /// opened without reading its colour section: its checksum takes the colour
+    /// regions' CRCs from the index, and each block of colours is checked when it
+    /// is read ([`TessFile::colour_block`]). Reading the regions as streams
+    /// ([`TessFile::colour_streams`]) checks their CRCs first, in one pass.
+    /// Other files open as with [`TessFile::open`].
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn open_lazy_colours(path: &Path) -> Result<Self, FormatError> {
+        let file = std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
+        // SAFETY: as in `open`.
+        let bytes = match unsafe { memmap2::Mmap::map(&file) } {
+            Ok(m) => Bytes::Map(m),
+            Err(_) => Bytes::Owned(super::read_limited(path, super::MAX_FILE_BYTES)?),
+        };
+        Self::from_body_with(bytes, path, true)
+    }
+
+    /// As [`TessFile::open_lazy_colours`], for bytes held in memory.
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn from_bytes_lazy_colours(bytes: Vec<u8>, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body_with(Bytes::Owned(bytes), path, true)
+    }
+
+    fn from_body_with(bytes: Bytes, path: &Path, lazy: bool) -> Result<Self, FormatError> {
         let err = |e: FormatError| e.with_path(path);
         if bytes.len() < 10 || bytes[..8] != super::native::MAGIC {
             return Err(err(FormatError::corrupt(
@@ -158,12 +194,14 @@ impl TessFile {
                 body: Body::Decoded(model.tree),
                 extras,
                 layers,
+                colours_checked: std::sync::OnceLock::new(),
             });
         }
         // The checksum reads the sections (the colours: about half a big file):
         // let their mapped pages go as it goes, so opening keeps memory flat.
-        let layout = super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b))
-            .map_err(|m| err(FormatError::corrupt(m)))?;
+        let layout =
+            super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b), lazy)
+                .map_err(|m| err(FormatError::corrupt(m)))?;
         let space =
             LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
         // The sections are under the index's checksum, checked above; the layers
@@ -171,6 +209,7 @@ impl TessFile {
         // never holds its colours.
         let (flags, frame) = super::native::decode_frame(&bytes, &layout, &space)
             .map_err(|m| err(FormatError::corrupt(m)))?;
+        let checked = layout.colours_checked;
         Ok(Self {
             path: path.to_owned(),
             body: Body::Chunked(bytes, layout),
@@ -179,6 +218,11 @@ impl TessFile {
                 ..Extras::default()
             },
             layers: flags & !super::sections::FLAG_FRAME != 0,
+            colours_checked: if checked {
+                Ok(()).into()
+            } else {
+                std::sync::OnceLock::new()
+            },
         })
     }
 
@@ -258,6 +302,30 @@ impl TessFile {
         }
     }
 
+    /// The colour index of a version-2 file whose only layer is colours.
+    pub(crate) fn colour_only_index(&self) -> Option<&super::colour_index::ColourIndex> {
+        match &self.body {
+            Body::Chunked(b, l) => {
+                let flags = u16::from_le_bytes([b[l.sections.0], b[l.sections.0 + 1]]);
+                let only = flags & (super::sections::FLAG_FREE | super::sections::FLAG_LOG_ODDS) == 0;
+                l.colour_index.as_ref().filter(|_| only)
+            }
+            _ => None,
+        }
+    }
+
+    /// Block `k` of the colour index's blocks (of region `i`), decoded and
+    /// checked ([`super::colour_index::decode_block`]).
+    pub(crate) fn colour_block(&self, i: usize, k: usize) -> Result<Vec<Leaf>, FormatError> {
+        match (&self.body, self.colour_only_index()) {
+            (Body::Chunked(b, l), Some(ix)) => {
+                super::colour_index::decode_block(b, ix, i, k, l.depth)
+                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))
+            }
+            _ => Err(FormatError::corrupt("no colour index").with_path(&self.path)),
+        }
+    }
+
     /// The file's path.
     #[must_use]
     pub fn path(&self) -> &Path {
@@ -326,6 +394,31 @@ impl TessFile {
         &self,
     ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
         match &self.body {
+            Body::Chunked(bytes, layout) if self.colour_only_index().is_some() => {
+                let ix = layout.colour_index.as_ref().expect("an index");
+                self.colours_checked
+                    .get_or_init(|| {
+                        let r = super::colour_index::verify_crcs(bytes, ix);
+                        if let Some(first) = ix.regions.first() {
+                            release_map(bytes, first.start, ix.start);
+                        }
+                        r
+                    })
+                    .clone()
+                    .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
+                Ok(Some(
+                    ix.regions
+                        .iter()
+                        .map(|r| {
+                            let span = (r.start, r.end);
+                            (
+                                r.rgba,
+                                super::RegionLeaves::region(bytes, span, r.count, layout.depth),
+                            )
+                        })
+                        .collect(),
+                ))
+            }
             Body::Chunked(bytes, layout) => super::tess_colours::colour_regions(
                 bytes,
                 layout.sections,
