@@ -65,6 +65,8 @@ pub struct TessWriter<W: Write> {
     header: Vec<u8>,
     leaf_count: u64,
     payload: Vec<u8>,
+    /// Leaves per block of the colour index; `None`: no index (as older writers).
+    pub(crate) colour_block: Option<u64>,
 }
 
 impl<W: Write> TessWriter<W> {
@@ -96,6 +98,7 @@ impl<W: Write> TessWriter<W> {
             header,
             leaf_count: 0,
             payload: Vec::new(),
+            colour_block: Some(super::colour_index::INDEX_BLOCK),
         })
     }
 
@@ -103,6 +106,14 @@ impl<W: Write> TessWriter<W> {
     #[must_use]
     pub fn with_chunk_leaves(mut self, n: usize) -> Self {
         self.chunk_leaves = n.max(1);
+        self
+    }
+
+    /// Sets the leaves per block of the colour index (`None`: no index, a file as
+    /// older versions wrote it, which builds before the index read).
+    #[must_use]
+    pub fn with_colour_index(mut self, block: Option<u64>) -> Self {
+        self.colour_block = block;
         self
     }
 
@@ -189,10 +200,12 @@ impl<W: Write> TessWriter<W> {
     }
 
     pub(crate) fn finish_extras(self, extras: &Extras) -> io::Result<W> {
+        let block = self.colour_block;
         self.finish_with(|emit| {
             let mut meta = vec![0, 0];
             let mut flags = put_sections(&mut meta, extras);
-            if let Some(ix) = super::colour_index::index_of_sections(&meta, flags) {
+            let ix = block.and_then(|b| super::colour_index::index_of_sections(&meta, flags, b));
+            if let Some(ix) = ix {
                 meta.extend_from_slice(&ix);
                 flags |= super::colour_index::FLAG_COLOUR_INDEX;
             }

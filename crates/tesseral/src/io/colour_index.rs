@@ -492,10 +492,10 @@ impl IndexBuilder {
     }
 }
 
-/// The colour index of sections already written whole (`sections`, flags first,
+/// The colour index (blocks of `block` leaves) of sections already written whole (`sections`, flags first,
 /// as [`super::sections::put_sections`] writes them): walks the colour layer's
 /// regions. `None` when there is no colour layer or it has no region.
-pub(crate) fn index_of_sections(sections: &[u8], flags: u16) -> Option<Vec<u8>> {
+pub(crate) fn index_of_sections(sections: &[u8], flags: u16, block: u64) -> Option<Vec<u8>> {
     if flags & FLAG_COLOR_LAYER == 0 || flags & FLAG_COLORS != 0 {
         return None;
     }
@@ -507,7 +507,7 @@ pub(crate) fn index_of_sections(sections: &[u8], flags: u16) -> Option<Vec<u8>> 
     if count == 0 {
         return None;
     }
-    let mut b = IndexBuilder::new(INDEX_BLOCK);
+    let mut b = IndexBuilder::new(block);
     for _ in 0..count {
         let v = r.take(4).ok()?;
         let n = r.u64().ok()?;
@@ -520,3 +520,7 @@ pub(crate) fn index_of_sections(sections: &[u8], flags: u16) -> Option<Vec<u8>> 
     }
     Some(b.finish())
 }
+
+#[cfg(test)]
+#[path = "colour_index_tests.rs"]
+mod tests;

@@ -132,6 +132,7 @@ impl<W: Write> TessWriter<W> {
             }
         }
         regions.sort_unstable_by_key(|(c, _)| c.key());
+        let block = self.colour_block;
         if regions.windows(2).any(|w| w[0].0 == w[1].0) {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -151,14 +152,15 @@ impl<W: Write> TessWriter<W> {
                 flags |= FLAG_COLOR_LAYER;
                 head.extend_from_slice(&(regions.len() as u64).to_le_bytes());
             }
-            if !regions.is_empty() {
+            let indexed = block.is_some() && !regions.is_empty();
+            if indexed {
                 flags |= FLAG_COLOUR_INDEX;
             }
             head[..2].copy_from_slice(&flags.to_le_bytes());
             emit(&head)?;
             // The colour index is made as the regions' bytes go by.
             let mut at = head.len() as u64;
-            let mut index = IndexBuilder::new(INDEX_BLOCK);
+            let mut index = IndexBuilder::new(block.unwrap_or(INDEX_BLOCK));
             let mut buf = vec![0u8; 1 << 20];
             for (c, (count, file)) in &mut regions {
                 let (c, count) = (*c, *count);
@@ -177,7 +179,7 @@ impl<W: Write> TessWriter<W> {
                     emit(&buf[..n])?;
                 }
             }
-            if !regions.is_empty() {
+            if indexed {
                 emit(&index.finish())?;
             }
             Ok(())

@@ -326,6 +326,20 @@ impl TessFile {
         }
     }
 
+    /// Every block of the colour index, decoded and checked one at a time as a
+    /// streamed render reads them, with the colour of its region; `None` when the
+    /// file has no colour index (or layers other than colours). O(colour bytes).
+    #[must_use]
+    pub fn indexed_colour_blocks(
+        &self,
+    ) -> Option<impl Iterator<Item = (crate::model::Rgba, Result<Vec<Leaf>, FormatError>)> + '_>
+    {
+        let ix = self.colour_only_index()?;
+        Some(ix.regions.iter().enumerate().flat_map(move |(i, r)| {
+            (r.blocks.0..r.blocks.1).map(move |k| (r.rgba, self.colour_block(i, k)))
+        }))
+    }
+
     /// The file's path.
     #[must_use]
     pub fn path(&self) -> &Path {
