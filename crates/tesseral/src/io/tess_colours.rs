@@ -82,6 +82,20 @@ impl<'a> RegionLeaves<'a> {
         self.r.pos as u64
     }
 
+    /// The leaves left to decode.
+    pub(crate) fn left(&self) -> u64 {
+        self.left
+    }
+
+    /// The next `n` leaves (or those left, if fewer) as a stream of their own,
+    /// with the same checks; `self` does not move.
+    pub(crate) fn limited(&self, n: u64) -> Self {
+        let mut part = self.clone();
+        part.whole = part.whole && part.left <= n;
+        part.left = part.left.min(n);
+        part
+    }
+
     /// The leaves from `p` (a point of a region of these same `bytes`, the whole
     /// file) on, at most `most` of them.
     pub(crate) fn resume(bytes: &'a [u8], p: RegionPoint, depth: u8, most: u64) -> Self {
@@ -184,9 +198,7 @@ impl<'a> RegionLeaves<'a> {
         let n = n.max(1) as u64;
         let mut out = Vec::new();
         while self.left > 0 && !self.failed {
-            let mut part = self.clone();
-            part.left = part.left.min(n);
-            part.whole = part.whole && part.left == self.left;
+            let part = self.limited(n);
             let count = part.left;
             let mut lo = None;
             let mut hi = 0;
