@@ -362,9 +362,10 @@ pub(crate) fn parse_layout_with(
     let skips = match &colour_index {
         Some(ix)
             if lazy_colours
-                && flags & !(super::sections::FLAG_FRAME
-                    | super::sections::FLAG_COLOR_LAYER
-                    | super::colour_index::FLAG_COLOUR_INDEX)
+                && flags
+                    & !(super::sections::FLAG_FRAME
+                        | super::sections::FLAG_COLOR_LAYER
+                        | super::colour_index::FLAG_COLOUR_INDEX)
                     == 0 =>
         {
             super::colour_index::skips(ix)

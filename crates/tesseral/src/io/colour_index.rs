@@ -166,7 +166,10 @@ pub(crate) fn parse(
         }
         let s = p + 12;
         if off != (s - start) as u64 {
-            return Err(at(&format!("offset {off} where {} was expected", s - start)));
+            return Err(at(&format!(
+                "offset {off} where {} was expected",
+                s - start
+            )));
         }
         let e_abs = usize::try_from(slen)
             .ok()
@@ -244,7 +247,8 @@ pub(crate) fn parse(
         if expect != reg.end {
             return Err(bad(format!("region {i}: its blocks do not end with it")));
         }
-        if !valid(reg.last, depth) || prev_first.is_some_and(|f| Leaf::from_packed(reg.last).code() < f)
+        if !valid(reg.last, depth)
+            || prev_first.is_some_and(|f| Leaf::from_packed(reg.last).code() < f)
         {
             return Err(bad(format!("region {i}: its last leaf is invalid")));
         }
@@ -307,7 +311,8 @@ pub(crate) fn decode_block(
     if it.offset() != end as u64 {
         return Err(at("its leaves do not fill its bytes".into()));
     }
-    if out.first().map(|l| l.code()) != Some(b.first) || out.last().map(|l| l.packed()) != Some(next)
+    if out.first().map(|l| l.code()) != Some(b.first)
+        || out.last().map(|l| l.packed()) != Some(next)
     {
         return Err(at("its leaves disagree with the index".into()));
     }

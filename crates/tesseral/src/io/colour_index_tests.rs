@@ -101,7 +101,11 @@ fn the_index_agrees_with_the_colour_layer() {
             assert_eq!(back, model);
             back.colors.as_ref().unwrap().assert_valid();
             // The regions as written: non-empty ones, in the layer's order.
-            let regions: Vec<_> = layer.regions().iter().filter(|(_, t)| !t.is_empty()).collect();
+            let regions: Vec<_> = layer
+                .regions()
+                .iter()
+                .filter(|(_, t)| !t.is_empty())
+                .collect();
             if regions.is_empty() {
                 // An empty layer has nothing to index.
                 assert!(parse_layout(&bytes).unwrap().colour_index.is_none());
@@ -236,7 +240,14 @@ fn files_without_the_index_read_as_before() {
                     .into_iter()
                     .map(|(_, s)| s.map(Result::unwrap).count())
                     .sum();
-                let want: usize = model.colors.as_ref().unwrap().regions().iter().map(|(_, t)| t.leaf_count()).sum();
+                let want: usize = model
+                    .colors
+                    .as_ref()
+                    .unwrap()
+                    .regions()
+                    .iter()
+                    .map(|(_, t)| t.leaf_count())
+                    .sum();
                 assert_eq!(n, want);
             }
         }
@@ -259,7 +270,11 @@ fn damaged_colour_bytes_are_found_when_read() {
     let e = f.colour_block(0, r.blocks.0).unwrap_err().to_string();
     assert!(e.contains("d.tess") && e.contains("checksum"), "{e}");
     assert!(f.colour_block(0, r.blocks.0 + 1).is_ok() || r.blocks.1 - r.blocks.0 == 1);
-    let e = f.colour_streams().err().expect("streams check the CRCs").to_string();
+    let e = f
+        .colour_streams()
+        .err()
+        .expect("streams check the CRCs")
+        .to_string();
     assert!(e.contains("checksum"), "{e}");
     // Opened as before, the file's checksum names the damage.
     assert!(TessFile::from_bytes(b.clone(), Path::new("d.tess")).is_err());

@@ -144,7 +144,12 @@ impl<'a> RegionLeaves<'a> {
 
     /// The whole region of `count` leaves in `bytes[start..end]`, which its leaves
     /// must fill exactly.
-    pub(crate) fn region(bytes: &'a [u8], (start, end): (usize, usize), count: u64, depth: u8) -> Self {
+    pub(crate) fn region(
+        bytes: &'a [u8],
+        (start, end): (usize, usize),
+        count: u64,
+        depth: u8,
+    ) -> Self {
         RegionLeaves {
             whole: true,
             ..Self::block(bytes, (start, end), 0, None, count, depth)
@@ -310,7 +315,10 @@ pub(crate) fn colour_regions_flagged<'a>(
         if out.iter().any(|(c, _): &(Rgba, _)| *c == rgba) {
             return Err(format!("colour region {i}: repeats a colour"));
         }
-        out.push((rgba, RegionLeaves::region(bytes, (at, r.pos), leaves, depth)));
+        out.push((
+            rgba,
+            RegionLeaves::region(bytes, (at, r.pos), leaves, depth),
+        ));
     }
     if r.pos != end {
         return Err(format!(

@@ -307,7 +307,8 @@ impl TessFile {
         match &self.body {
             Body::Chunked(b, l) => {
                 let flags = u16::from_le_bytes([b[l.sections.0], b[l.sections.0 + 1]]);
-                let only = flags & (super::sections::FLAG_FREE | super::sections::FLAG_LOG_ODDS) == 0;
+                let only =
+                    flags & (super::sections::FLAG_FREE | super::sections::FLAG_LOG_ODDS) == 0;
                 l.colour_index.as_ref().filter(|_| only)
             }
             _ => None,

@@ -52,7 +52,10 @@ impl<'a> Blocks<'a> {
 
     /// A colour region's stretches found as it was read (by the first pass of a
     /// streamed translation: `partition::scan`), with `f` the file it lies in.
-    pub(super) fn of_stretches(f: &'a TessFile, stretches: Vec<(ChunkInfo, RegionLeaves<'a>)>) -> Self {
+    pub(super) fn of_stretches(
+        f: &'a TessFile,
+        stretches: Vec<(ChunkInfo, RegionLeaves<'a>)>,
+    ) -> Self {
         let (info, parts): (Vec<ChunkInfo>, _) = stretches.into_iter().unzip();
         Self::new(Source::Region(f, parts), info)
     }

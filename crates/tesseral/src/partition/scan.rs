@@ -144,5 +144,8 @@ pub(super) fn scan<'a>(
         },
     )?;
     // The sweep reads every stream to its end, so the stretches cover each region.
-    Ok((bbox.get(), cuts.into_iter().map(RefCell::into_inner).collect()))
+    Ok((
+        bbox.get(),
+        cuts.into_iter().map(RefCell::into_inner).collect(),
+    ))
 }
