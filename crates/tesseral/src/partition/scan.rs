@@ -26,6 +26,9 @@ const RELEASE_EVERY: u64 = 1 << 16;
 /// code range and count.
 pub(super) type Stretches<'a> = Vec<(ChunkInfo, RegionLeaves<'a>)>;
 
+/// What the first pass finds: the bounding box and each region's stretches.
+pub(super) type Scanned<'a> = (Option<(Voxel, Voxel)>, Vec<Stretches<'a>>);
+
 /// A colour region's leaves, letting the mapped bytes behind them go as they are
 /// read (see [`TessFile::release`]), and cutting the region into stretches of
 /// `stretch` leaves as it goes (into `cut`).
@@ -87,7 +90,7 @@ pub(super) fn scan<'a>(
     blocks: &Blocks<'_>,
     colours: &[(Rgba, RegionLeaves<'a>)],
     stretch: usize,
-) -> Result<(Option<(Voxel, Voxel)>, Vec<Stretches<'a>>), PartitionError> {
+) -> Result<Scanned<'a>, PartitionError> {
     let (depth, origin) = (f.depth(), f.origin());
     let bbox = Cell::new(None);
     // Chunk `i`'s runs of touching leaves (when `runs`), its box joined to `bbox`.
