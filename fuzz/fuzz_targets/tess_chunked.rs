@@ -19,10 +19,10 @@ fuzz_target!(|data: &[u8]| {
         let index = u64::from_le_bytes(bytes[t + 8..t + 16].try_into().unwrap());
         if let (Ok(s), Ok(e)) = (usize::try_from(sections), usize::try_from(index)) {
             // The colour index (flag bit 5) ends the sections with its length.
-            if s + 2 <= e && e <= t && bytes[s] & 32 != 0 && e >= s + 2 + 32 {
+            if s.saturating_add(34) <= e && e <= t && bytes[s] & 32 != 0 {
                 let len = u64::from_le_bytes(bytes[e - 8..e].try_into().unwrap());
                 if let Some(ix) = usize::try_from(len).ok().and_then(|l| e.checked_sub(l)) {
-                    if ix >= s + 2 && ix + 16 <= e {
+                    if ix >= s + 2 && ix.saturating_add(16) <= e {
                         let c = crc32fast::hash(&bytes[ix..e - 16]);
                         bytes[e - 16..e - 12].copy_from_slice(&c.to_le_bytes());
                     }
