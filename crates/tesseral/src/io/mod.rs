@@ -38,6 +38,7 @@ mod spool;
 pub(crate) mod tess_colours;
 
 mod tess_file;
+mod tess_file_colours;
 mod tess_v1;
 #[cfg(all(test, target_os = "linux"))]
 mod tests_release;
