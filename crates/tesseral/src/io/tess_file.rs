@@ -152,7 +152,7 @@ impl TessFile {
     /// which has a colour index (every file this version writes with colours) is
     /// opened without reading its colour section: its checksum takes the colour
     /// regions' CRCs from the index, and each block of colours is checked when it
-    /// is read ([`TessFile::colour_block`]). Reading the regions as streams
+    /// is read ([`TessFile::indexed_colour_blocks`]). Reading the regions as streams
     /// ([`TessFile::colour_streams`]) checks their CRCs first, in one pass.
     /// Other files open as with [`TessFile::open`].
     ///
