@@ -65,6 +65,8 @@ pub struct TessWriter<W: Write> {
     header: Vec<u8>,
     leaf_count: u64,
     payload: Vec<u8>,
+    /// Leaves per block of the colour index; `None`: no index (as older writers).
+    pub(crate) colour_block: Option<u64>,
 }
 
 impl<W: Write> TessWriter<W> {
@@ -96,6 +98,7 @@ impl<W: Write> TessWriter<W> {
             header,
             leaf_count: 0,
             payload: Vec::new(),
+            colour_block: Some(super::colour_index::INDEX_BLOCK),
         })
     }
 
@@ -103,6 +106,14 @@ impl<W: Write> TessWriter<W> {
     #[must_use]
     pub fn with_chunk_leaves(mut self, n: usize) -> Self {
         self.chunk_leaves = n.max(1);
+        self
+    }
+
+    /// Sets the leaves per block of the colour index (`None`: no index, a file as
+    /// older versions wrote it, which builds before the index read).
+    #[must_use]
+    pub fn with_colour_index(mut self, block: Option<u64>) -> Self {
+        self.colour_block = block;
         self
     }
 
@@ -189,9 +200,15 @@ impl<W: Write> TessWriter<W> {
     }
 
     pub(crate) fn finish_extras(self, extras: &Extras) -> io::Result<W> {
+        let block = self.colour_block;
         self.finish_with(|emit| {
             let mut meta = vec![0, 0];
-            let flags = put_sections(&mut meta, extras);
+            let mut flags = put_sections(&mut meta, extras);
+            let ix = block.and_then(|b| super::colour_index::index_of_sections(&meta, flags, b));
+            if let Some(ix) = ix {
+                meta.extend_from_slice(&ix);
+                flags |= super::colour_index::FLAG_COLOUR_INDEX;
+            }
             meta[..2].copy_from_slice(&flags.to_le_bytes());
             emit(&meta)
         })
@@ -256,6 +273,12 @@ pub(crate) struct Layout {
     pub(crate) chunks: Vec<ChunkInfo>,
     pub(crate) leaf_count: u64,
     pub(crate) sections: (usize, usize),
+    /// The colour index, when the file has one.
+    pub(crate) colour_index: Option<super::colour_index::ColourIndex>,
+    /// Whether the colour regions' bytes were under the checksum checked at open
+    /// (false when [`parse_layout_with`] skipped them: see
+    /// [`super::colour_index::verify_crcs`]).
+    pub(crate) colours_checked: bool,
 }
 
 fn u64_at(b: &[u8], at: usize) -> u64 {
@@ -266,7 +289,7 @@ fn u64_at(b: &[u8], at: usize) -> u64 {
 
 /// Parses and checks the header, trailer and index of version-2 bytes.
 pub(crate) fn parse_layout(bytes: &[u8]) -> Result<Layout, String> {
-    parse_layout_with(bytes, &|_, _| {})
+    parse_layout_with(bytes, &|_, _| {}, false)
 }
 
 /// Bytes checksummed between two calls of a reader's `done`.
@@ -274,10 +297,15 @@ pub(crate) const RELEASE_STRETCH: usize = 8 << 20;
 
 /// As [`parse_layout`], calling `done(start, end)` after each stretch of the
 /// checksummed sections, and of the chunks whose heads are checked, is read, so
-/// that a mapped reader can let it go.
+/// that a mapped reader can let it go. With `lazy_colours`, a file whose only
+/// layer is colours and which has a colour index has its index read and checked
+/// ([`Layout::colour_index`]) and its colour regions' bytes are not read: the
+/// checksum takes their CRCs from the index (each block is checked when it is
+/// decoded, see [`super::colour_index::decode_block`]).
 pub(crate) fn parse_layout_with(
     bytes: &[u8],
     done: &dyn Fn(usize, usize),
+    lazy_colours: bool,
 ) -> Result<Layout, String> {
     let len = bytes.len();
     if len < HEADER_LEN + TRAILER_LEN {
@@ -315,11 +343,50 @@ pub(crate) fn parse_layout_with(
         ));
     }
     let (sections_offset, index_offset) = (sections_offset as usize, index_offset as usize);
+    // The colour index is read whenever it is flagged (its regions let a streamed
+    // reader find the colour regions without scanning them). Its errors are
+    // reported after the checksum's, which name damage first.
+    let flags = u16::from_le_bytes([bytes[sections_offset], bytes[sections_offset + 1]]);
+    let (colour_index, index_error) = if flags & super::colour_index::FLAG_COLOUR_INDEX != 0 {
+        match super::colour_index::parse(
+            bytes,
+            (sections_offset, index_offset),
+            bytes[12].min(MAX_DEPTH),
+        ) {
+            Ok(ix) => (ix, None),
+            Err(e) => (None, Some(e)),
+        }
+    } else {
+        (None, None)
+    };
+    let skips = match &colour_index {
+        Some(ix)
+            if lazy_colours
+                && flags
+                    & !(super::sections::FLAG_FRAME
+                        | super::sections::FLAG_COLOR_LAYER
+                        | super::colour_index::FLAG_COLOUR_INDEX)
+                    == 0 =>
+        {
+            super::colour_index::skips(ix)
+        }
+        _ => Vec::new(),
+    };
     let mut crc = crc32fast::Hasher::new();
     crc.update(&bytes[..HEADER_LEN]);
     let mut at = sections_offset;
+    let mut skip = skips.iter().peekable();
     while at < len - 12 {
-        let end = (at + RELEASE_STRETCH).min(len - 12);
+        if let Some(&&(s, e, c)) = skip.peek() {
+            if s == at {
+                crc.combine(&crc32fast::Hasher::new_with_initial_len(c, (e - s) as u64));
+                at = e;
+                skip.next();
+                continue;
+            }
+        }
+        let stop = skip.peek().map_or(len - 12, |s| s.0);
+        let end = (at + RELEASE_STRETCH).min(stop);
         crc.update(&bytes[at..end]);
         done(at, end);
         at = end;
@@ -336,6 +403,9 @@ pub(crate) fn parse_layout_with(
     let depth = bytes[12];
     if depth > MAX_DEPTH {
         return Err(format!("depth {depth} exceeds the maximum {MAX_DEPTH}"));
+    }
+    if let Some(e) = index_error {
+        return Err(e);
     }
     let origin = [
         u64_at(bytes, 16) as i64,
@@ -417,6 +487,8 @@ pub(crate) fn parse_layout_with(
         chunks,
         leaf_count,
         sections: (sections_offset, index_offset),
+        colours_checked: skips.is_empty(),
+        colour_index,
     })
 }
 

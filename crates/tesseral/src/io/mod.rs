@@ -24,6 +24,7 @@
 mod atomic;
 pub mod binvox;
 mod chunked;
+pub(crate) mod colour_index;
 mod estimate;
 mod leafstream;
 pub mod mesh;
@@ -35,7 +36,9 @@ pub(crate) mod sections;
 mod sniff;
 mod spool;
 pub(crate) mod tess_colours;
+
 mod tess_file;
+mod tess_file_colours;
 mod tess_v1;
 #[cfg(all(test, target_os = "linux"))]
 mod tests_release;

@@ -50,6 +50,7 @@
 //! | 2 | colours as regions (a *layer*, below) of 4 bytes RGBA |
 //! | 3 | known-free space, a *leaf stream* |
 //! | 4 | occupancy log-odds as a layer of 4-byte `f32` |
+//! | 5 | (version 2 only) the colour index, last (layout in `io/colour_index.rs` and docs/formats.md) |
 //!
 //! A *leaf stream* is a leaf count n (`u64`) then n varints as in the payload. A
 //! *layer* is a region count r (`u64`), then per region its value's bytes and a leaf
@@ -69,6 +70,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use super::chunked::{chunk_leaves, parse_layout, TessWriter, VERSION_CHUNKED};
+use super::colour_index::FLAG_COLOUR_INDEX;
 use super::leafstream::{put_leaves, read_leaves, Reader};
 use super::sections::{check_parts, put_sections, read_sections, Extras, KNOWN_FLAGS};
 use super::FormatError;
@@ -235,10 +237,22 @@ pub(crate) fn decode_sections(
         pos: start,
     };
     let flags = r.u16()?;
-    if flags & !KNOWN_FLAGS != 0 {
+    if flags & !(KNOWN_FLAGS | FLAG_COLOUR_INDEX) != 0 {
         return Err(format!("unknown section flags {flags:#06x}"));
     }
-    let extras = read_sections(&mut r, flags, space)?;
+    let extras = read_sections(&mut r, flags & !FLAG_COLOUR_INDEX, space)?;
+    if let Some(ix) = &layout.colour_index {
+        // Read in full, the colour section is checked against the whole index, so
+        // that a file reads the same in memory and streamed.
+        if r.pos != ix.start {
+            return Err(format!(
+                "colour index: starts at byte {} where the sections before it end at {}",
+                ix.start, r.pos
+            ));
+        }
+        super::colour_index::verify_blocks(bytes, ix, space.depth())?;
+        r.pos = end;
+    }
     if r.pos != end {
         return Err(format!(
             "{} unexpected byte(s) before the index",
@@ -261,7 +275,7 @@ pub(crate) fn decode_frame(
         pos: start,
     };
     let flags = r.u16()?;
-    if flags & !KNOWN_FLAGS != 0 {
+    if flags & !(KNOWN_FLAGS | FLAG_COLOUR_INDEX) != 0 {
         return Err(format!("unknown section flags {flags:#06x}"));
     }
     let frame = read_sections(&mut r, flags & super::sections::FLAG_FRAME, space)?.frame;

@@ -8,6 +8,7 @@ use std::io::{self, BufWriter, Read, Seek, Write};
 use std::path::Path;
 
 use super::chunked::{TessWriter, MERGE_TAIL};
+use super::colour_index::{IndexBuilder, FLAG_COLOUR_INDEX, INDEX_BLOCK};
 use super::leafstream::put_varint;
 use super::sections::{put_sections, Extras, FLAG_COLOR_LAYER};
 use crate::linear::{push_merging, Leaf};
@@ -131,6 +132,7 @@ impl<W: Write> TessWriter<W> {
             }
         }
         regions.sort_unstable_by_key(|(c, _)| c.key());
+        let block = self.colour_block;
         if regions.windows(2).any(|w| w[0].0 == w[1].0) {
             return Err(io::Error::new(
                 io::ErrorKind::InvalidInput,
@@ -150,20 +152,35 @@ impl<W: Write> TessWriter<W> {
                 flags |= FLAG_COLOR_LAYER;
                 head.extend_from_slice(&(regions.len() as u64).to_le_bytes());
             }
+            let indexed = block.is_some() && !regions.is_empty();
+            if indexed {
+                flags |= FLAG_COLOUR_INDEX;
+            }
             head[..2].copy_from_slice(&flags.to_le_bytes());
             emit(&head)?;
+            // The colour index is made as the regions' bytes go by.
+            let mut at = head.len() as u64;
+            let mut index = IndexBuilder::new(block.unwrap_or(INDEX_BLOCK));
             let mut buf = vec![0u8; 1 << 20];
-            for (c, (count, mut file)) in regions {
+            for (c, (count, file)) in &mut regions {
+                let (c, count) = (*c, *count);
                 let mut region = c.to_vec();
                 region.extend_from_slice(&count.to_le_bytes());
                 emit(&region)?;
+                at += region.len() as u64;
+                index.region(c, count, at);
                 loop {
                     let n = file.read(&mut buf)?;
                     if n == 0 {
                         break;
                     }
+                    index.feed(&buf[..n]);
+                    at += n as u64;
                     emit(&buf[..n])?;
                 }
+            }
+            if indexed {
+                emit(&index.finish())?;
             }
             Ok(())
         })

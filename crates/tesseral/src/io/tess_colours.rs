@@ -19,6 +19,8 @@ pub struct RegionLeaves<'a> {
     space_end: u64,
     depth: u8,
     failed: bool,
+    /// Whether the stream must end exactly where its bytes do (a whole region).
+    whole: bool,
     /// What the leaves are, in errors.
     what: &'static str,
 }
@@ -31,7 +33,13 @@ impl Iterator for RegionLeaves<'_> {
             return None;
         }
         self.left -= 1;
-        let r = self.step();
+        let mut r = self.step();
+        if r.is_ok() && self.left == 0 && self.whole && self.r.pos != self.r.bytes.len() {
+            r = Err(format!(
+                "{} byte(s) after the region's last leaf",
+                self.r.bytes.len() - self.r.pos
+            ));
+        }
         self.failed = r.is_err();
         let what = self.what;
         Some(r.map_err(|m| FormatError::corrupt(format!("{what}: {m}"))))
@@ -47,6 +55,13 @@ pub(crate) struct RegionPoint {
     prev_end: Option<u64>,
     /// The leaves left from here to the region's end.
     pub(crate) left: u64,
+}
+
+impl RegionPoint {
+    /// The byte offset (in the file) of the leaf it resumes at.
+    pub(crate) fn offset(&self) -> u64 {
+        self.pos as u64
+    }
 }
 
 impl<'a> RegionLeaves<'a> {
@@ -67,6 +82,20 @@ impl<'a> RegionLeaves<'a> {
         self.r.pos as u64
     }
 
+    /// The leaves left to decode.
+    pub(crate) fn left(&self) -> u64 {
+        self.left
+    }
+
+    /// The next `n` leaves (or those left, if fewer) as a stream of their own,
+    /// with the same checks; `self` does not move.
+    pub(crate) fn limited(&self, n: u64) -> Self {
+        let mut part = self.clone();
+        part.whole = part.whole && part.left <= n;
+        part.left = part.left.min(n);
+        part
+    }
+
     /// The leaves from `p` (a point of a region of these same `bytes`, the whole
     /// file) on, at most `most` of them.
     pub(crate) fn resume(bytes: &'a [u8], p: RegionPoint, depth: u8, most: u64) -> Self {
@@ -81,7 +110,49 @@ impl<'a> RegionLeaves<'a> {
             space_end: 1u64 << (3 * u32::from(depth)),
             depth,
             failed: false,
+            whole: false,
             what: "colour section",
+        }
+    }
+
+    /// The `count` leaves of one indexed block `bytes[start..end]`, decoding from
+    /// the packed leaf `packed` before it (`prev_end` its end, `None` at a region's
+    /// start).
+    pub(crate) fn block(
+        bytes: &'a [u8],
+        (start, end): (usize, usize),
+        packed: u64,
+        prev_end: Option<u64>,
+        count: u64,
+        depth: u8,
+    ) -> Self {
+        RegionLeaves {
+            r: Reader {
+                bytes: &bytes[..end],
+                pos: start,
+            },
+            left: count,
+            packed,
+            prev_end,
+            space_end: 1u64 << (3 * u32::from(depth)),
+            depth,
+            failed: false,
+            whole: false,
+            what: "colour section",
+        }
+    }
+
+    /// The whole region of `count` leaves in `bytes[start..end]`, which its leaves
+    /// must fill exactly.
+    pub(crate) fn region(
+        bytes: &'a [u8],
+        (start, end): (usize, usize),
+        count: u64,
+        depth: u8,
+    ) -> Self {
+        RegionLeaves {
+            whole: true,
+            ..Self::block(bytes, (start, end), 0, None, count, depth)
         }
     }
 
@@ -106,6 +177,7 @@ impl<'a> RegionLeaves<'a> {
             space_end: 1u64 << (3 * u32::from(depth)),
             depth,
             failed: false,
+            whole: false,
             what,
         }
     }
@@ -131,8 +203,7 @@ impl<'a> RegionLeaves<'a> {
         let n = n.max(1) as u64;
         let mut out = Vec::new();
         while self.left > 0 && !self.failed {
-            let mut part = self.clone();
-            part.left = part.left.min(n);
+            let part = self.limited(n);
             let count = part.left;
             let mut lo = None;
             let mut hi = 0;
@@ -246,19 +317,7 @@ pub(crate) fn colour_regions_flagged<'a>(
         }
         out.push((
             rgba,
-            RegionLeaves {
-                r: Reader {
-                    bytes: &bytes[..r.pos],
-                    pos: at,
-                },
-                left: leaves,
-                packed: 0,
-                prev_end: None,
-                space_end: 1u64 << (3 * u32::from(depth)),
-                depth,
-                failed: false,
-                what: "colour section",
-            },
+            RegionLeaves::region(bytes, (at, r.pos), leaves, depth),
         ));
     }
     if r.pos != end {

@@ -13,7 +13,7 @@ use crate::Voxel;
 /// Leaves of a file read one at a time, each checked.
 pub type LeafIter<'a> = Box<dyn Iterator<Item = Result<Leaf, FormatError>> + 'a>;
 
-enum Body {
+pub(super) enum Body {
     /// Version 2: the bytes and their parsed layout.
     Chunked(Bytes, Layout),
     /// Version 1 (one payload): decoded whole, shown as chunks of the decoded leaves.
@@ -23,7 +23,7 @@ enum Body {
     Payload(Bytes, super::tess_v1::V1Index),
 }
 
-enum Bytes {
+pub(super) enum Bytes {
     Map(memmap2::Mmap),
     Owned(Vec<u8>),
 }
@@ -56,14 +56,17 @@ impl std::ops::Deref for Bytes {
 /// assert_eq!(leaves, tree.leaves());
 /// ```
 pub struct TessFile {
-    path: PathBuf,
-    body: Body,
+    pub(super) path: PathBuf,
+    pub(super) body: Body,
     /// Version 1: everything; version 2: the frame only (the layers are decoded
     /// when the model is read, see [`TessFile::to_model`]).
-    extras: Extras,
+    pub(super) extras: Extras,
     /// Version 2: whether sections past the frame (colours, free space, log-odds)
     /// are present.
     layers: bool,
+    /// Whether the colour regions' CRCs were checked (see
+    /// [`TessFile::open_lazy_colours`]).
+    pub(super) colours_checked: std::sync::OnceLock<Result<(), String>>,
 }
 
 impl TessFile {
@@ -129,6 +132,7 @@ impl TessFile {
                 ..Extras::default()
             },
             layers,
+            colours_checked: std::sync::OnceLock::new(),
         })
     }
 
@@ -141,6 +145,38 @@ impl TessFile {
     }
 
     fn from_body(bytes: Bytes, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body_with(bytes, path, false)
+    }
+
+    /// As [`TessFile::open`], but a version-2 file whose only layer is colours and
+    /// which has a colour index (every file this version writes with colours) is
+    /// opened without reading its colour section: its checksum takes the colour
+    /// regions' CRCs from the index, and each block of colours is checked when it
+    /// is read ([`TessFile::indexed_colour_blocks`]). Reading the regions as streams
+    /// ([`TessFile::colour_streams`]) checks their CRCs first, in one pass.
+    /// Other files open as with [`TessFile::open`].
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn open_lazy_colours(path: &Path) -> Result<Self, FormatError> {
+        let file = std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
+        // SAFETY: as in `open`.
+        let bytes = match unsafe { memmap2::Mmap::map(&file) } {
+            Ok(m) => Bytes::Map(m),
+            Err(_) => Bytes::Owned(super::read_limited(path, super::MAX_FILE_BYTES)?),
+        };
+        Self::from_body_with(bytes, path, true)
+    }
+
+    /// As [`TessFile::open_lazy_colours`], for bytes held in memory.
+    ///
+    /// # Errors
+    /// As [`TessFile::open`].
+    pub fn from_bytes_lazy_colours(bytes: Vec<u8>, path: &Path) -> Result<Self, FormatError> {
+        Self::from_body_with(Bytes::Owned(bytes), path, true)
+    }
+
+    fn from_body_with(bytes: Bytes, path: &Path, lazy: bool) -> Result<Self, FormatError> {
         let err = |e: FormatError| e.with_path(path);
         if bytes.len() < 10 || bytes[..8] != super::native::MAGIC {
             return Err(err(FormatError::corrupt(
@@ -158,12 +194,14 @@ impl TessFile {
                 body: Body::Decoded(model.tree),
                 extras,
                 layers,
+                colours_checked: std::sync::OnceLock::new(),
             });
         }
         // The checksum reads the sections (the colours: about half a big file):
         // let their mapped pages go as it goes, so opening keeps memory flat.
-        let layout = super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b))
-            .map_err(|m| err(FormatError::corrupt(m)))?;
+        let layout =
+            super::chunked::parse_layout_with(&bytes, &|a, b| release_map(&bytes, a, b), lazy)
+                .map_err(|m| err(FormatError::corrupt(m)))?;
         let space =
             LinearOctree::empty(layout.depth, layout.origin).map_err(FormatError::octree)?;
         // The sections are under the index's checksum, checked above; the layers
@@ -171,6 +209,7 @@ impl TessFile {
         // never holds its colours.
         let (flags, frame) = super::native::decode_frame(&bytes, &layout, &space)
             .map_err(|m| err(FormatError::corrupt(m)))?;
+        let checked = layout.colours_checked;
         Ok(Self {
             path: path.to_owned(),
             body: Body::Chunked(bytes, layout),
@@ -179,6 +218,11 @@ impl TessFile {
                 ..Extras::default()
             },
             layers: flags & !super::sections::FLAG_FRAME != 0,
+            colours_checked: if checked {
+                Ok(()).into()
+            } else {
+                std::sync::OnceLock::new()
+            },
         })
     }
 
@@ -316,76 +360,6 @@ impl TessFile {
         })
     }
 
-    /// The colour regions as streams of leaves, decoded as they are read, for a
-    /// version-2 file whose only layer is colours; `None` when it has other layers
-    /// or is version 1 (read it with [`TessFile::to_model`]).
-    ///
-    /// # Errors
-    /// [`FormatError::Corrupt`] for a bad colour section.
-    pub fn colour_streams(
-        &self,
-    ) -> Result<Option<Vec<(crate::model::Rgba, super::RegionLeaves<'_>)>>, FormatError> {
-        match &self.body {
-            Body::Chunked(bytes, layout) => super::tess_colours::colour_regions(
-                bytes,
-                layout.sections,
-                layout.depth,
-                &|a, b| {
-                    release_map(bytes, a, b);
-                },
-            )
-            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
-            Body::Payload(bytes, x) => super::tess_colours::colour_regions_flagged(
-                bytes,
-                x.flags,
-                x.sections,
-                x.depth,
-                &|a, b| {
-                    release_map(bytes, a, b);
-                },
-            )
-            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
-            Body::Decoded(_) => Ok(None),
-        }
-    }
-
-    /// The colour regions as streams of leaves, for a file whose only layer is
-    /// colours, whatever its version: a version-2 file's regions are decoded as
-    /// they are read ([`TessFile::colour_streams`]); a version-1 file was decoded
-    /// whole at [`TessFile::open`] and its regions are walked in memory. `None`
-    /// when the file has free space or log-odds.
-    ///
-    /// # Errors
-    /// [`FormatError::Corrupt`] for a bad colour section.
-    pub fn colour_leaves(
-        &self,
-    ) -> Result<Option<Vec<(crate::model::Rgba, LeafIter<'_>)>>, FormatError> {
-        match &self.body {
-            Body::Chunked(..) | Body::Payload(..) => Ok(self.colour_streams()?.map(|v| {
-                v.into_iter()
-                    .map(|(c, r)| (c, Box::new(r) as LeafIter<'_>))
-                    .collect()
-            })),
-            Body::Decoded(_) => {
-                if self.extras.free.is_some() || self.extras.log_odds.is_some() {
-                    return Ok(None);
-                }
-                let regions = self.extras.colors.as_ref().map_or(&[][..], |l| l.regions());
-                Ok(Some(
-                    regions
-                        .iter()
-                        .map(|(c, t)| {
-                            (
-                                *c,
-                                Box::new(t.leaves().iter().copied().map(Ok)) as LeafIter<'_>,
-                            )
-                        })
-                        .collect(),
-                ))
-            }
-        }
-    }
-
     /// Tells the system that the file's bytes in `bytes` (offsets, as
     /// [`ChunkInfo::offset`] gives them) will not be read again soon: a mapped
     /// file's pages there leave the process's resident memory. They stay in the
@@ -448,7 +422,7 @@ const FAULT_AROUND: usize = 2 << 20;
 /// Lets the mapped pages of `bytes[start..end]`, and of the [`FAULT_AROUND`] bytes
 /// before it, leave resident memory (see [`TessFile::release`]); nothing for bytes
 /// held in memory.
-fn release_map(bytes: &Bytes, start: usize, end: usize) {
+pub(super) fn release_map(bytes: &Bytes, start: usize, end: usize) {
     if let Bytes::Map(m) = bytes {
         let start = start.saturating_sub(FAULT_AROUND);
         if start < end && end <= m.len() {

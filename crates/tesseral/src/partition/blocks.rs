@@ -50,28 +50,14 @@ impl<'a> Blocks<'a> {
         Self::new(Source::File(f), f.chunks())
     }
 
-    /// A colour region cut into stretches of `n` leaves (read once to find them)
-    /// (`f` is the file it lies in).
-    pub(super) fn of_region(
+    /// A colour region's stretches found as it was read (by the first pass of a
+    /// streamed translation: `partition::scan`), with `f` the file it lies in.
+    pub(super) fn of_stretches(
         f: &'a TessFile,
-        r: RegionLeaves<'a>,
-        n: usize,
-    ) -> Result<Self, FormatError> {
-        let mut last = 0u64;
-        let (info, parts): (Vec<ChunkInfo>, _) = r
-            .stretches(n, &mut |pos| {
-                if pos - last.min(pos) >= 8 << 20 {
-                    f.release(last..pos);
-                    last = pos;
-                }
-            })?
-            .into_iter()
-            .unzip();
-        // Finding the stretches read the whole region: let it go.
-        if let Some(first) = info.first() {
-            f.release(first.offset..u64::MAX);
-        }
-        Ok(Self::new(Source::Region(f, parts), info))
+        stretches: Vec<(ChunkInfo, RegionLeaves<'a>)>,
+    ) -> Self {
+        let (info, parts): (Vec<ChunkInfo>, _) = stretches.into_iter().unzip();
+        Self::new(Source::Region(f, parts), info)
     }
 
     /// The blocks meeting the code range `[lo, hi)`, as an index range.

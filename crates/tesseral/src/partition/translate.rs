@@ -359,10 +359,9 @@ pub fn stream_translate(
 /// `spool_dir`.
 ///
 /// # Runtime
-/// One pass over the chunks and the colour regions for the bounding box and the
-/// colours' checks, then O(n) in the leaves (each chunk decoded about once per
-/// output cell whose cube meets it), plus one pass over each colour region to cut
-/// it into stretches.
+/// One pass over the chunks and the colour regions for the bounding box, the
+/// colours' checks and the regions' stretches, then O(n) in the leaves (each chunk
+/// or stretch decoded about once per output cell whose cube meets it).
 ///
 /// # Errors
 /// [`PartitionError::Octree`] when the grown space would be too deep or a
@@ -386,7 +385,10 @@ pub fn stream_translate_in(
     f.release(0..u64::MAX);
     let (depth, origin) = (f.depth(), f.origin());
     let mut blocks = Blocks::of_file(f);
-    let bbox = super::scan::scan(f, &blocks, &colours)?;
+    // Stretches of a colour region play the chunks' part; the first pass finds
+    // them as it checks the colours.
+    let stretch = (cell_leaves / 32).clamp(1, DEFAULT_CHUNK_LEAVES);
+    let (bbox, stretches) = super::scan::scan(f, &blocks, &colours, stretch)?;
     let to = translated_space(depth, origin, bbox, by)?;
     let mut tw = TessWriter::new(w, to.0, to.1).map_err(io_err)?;
     let mut voxels = 0u64;
@@ -398,10 +400,8 @@ pub fn stream_translate_in(
             tw.push(l)
         })?;
         drop(blocks);
-        // Stretches of a colour region play the chunks' part.
-        let stretch = (cell_leaves / 32).clamp(1, DEFAULT_CHUNK_LEAVES);
-        for (c, region) in colours {
-            let mut blocks = Blocks::of_region(f, region, stretch)?;
+        for ((c, _), cut) in colours.into_iter().zip(stretches) {
+            let mut blocks = Blocks::of_stretches(f, cut);
             let mut spool = LeafSpool::new_in(spool_dir).map_err(io_err)?;
             mover.run(&mut blocks, &mut |l| spool.push(l))?;
             spools.push((c, spool));

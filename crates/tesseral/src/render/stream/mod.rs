@@ -79,6 +79,9 @@ pub struct StreamStats {
     pub chunks_decoded: u64,
     /// Colour blocks decoded.
     pub colour_blocks_decoded: u64,
+    /// Bytes of the colour sections read: the whole section at open for a file
+    /// without a colour index, then the bytes of each colour block decoded.
+    pub colour_bytes_read: u64,
     /// Bytes of decoded chunks and colour blocks kept now.
     pub cached_bytes: u64,
 }
@@ -94,7 +97,7 @@ impl StreamedTree {
     /// colours, a damaged index or colour section, or a damaged chunk on the way to
     /// the solid's bounding box.
     pub fn open(path: &Path, cache_bytes: u64) -> Result<Self, FormatError> {
-        let f = TessFile::open(path)?;
+        let f = TessFile::open_lazy_colours(path)?;
         let end = 1u64 << (3 * u32::from(f.depth()));
         Self::from_parts(vec![f], vec![(0, end)], cache_bytes)
     }
@@ -255,6 +258,7 @@ impl StreamedTree {
             chunks: self.chunks.len() as u64,
             chunks_decoded: self.cache.loads.load(Ordering::Relaxed),
             colour_blocks_decoded: colour.map_or(0, |c| c.cache.loads.load(Ordering::Relaxed)),
+            colour_bytes_read: colour.map_or(0, |c| c.bytes_read.load(Ordering::Relaxed)),
             cached_bytes: self.cache.used() + colour.map_or(0, |c| c.cache.used()),
         }
     }

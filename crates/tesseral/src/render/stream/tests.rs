@@ -65,12 +65,16 @@ pub(super) fn coloured(rng: &mut rand_pcg::Pcg64, tree: LinearOctree) -> Model {
     Model::new(tree).with_colors(layer).unwrap()
 }
 
-/// Writes `model` as a version-2 `.tess` of `chunk` leaves per chunk.
+/// Writes `model` as a version-2 `.tess` of `chunk` leaves per chunk, with a
+/// colour index of `chunk` leaves per block, or none (as older versions wrote)
+/// when `chunk` is 17.
 pub(super) fn write_v2(path: &std::path::Path, model: &Model, chunk: usize) {
     let t = &model.tree;
+    let index = (chunk != 17).then_some(chunk as u64);
     let mut w = TessWriter::new(Vec::new(), t.depth(), t.origin())
         .unwrap()
-        .with_chunk_leaves(chunk);
+        .with_chunk_leaves(chunk)
+        .with_colour_index(index);
     for &l in t.leaves() {
         w.push(l).unwrap();
     }
@@ -230,6 +234,46 @@ fn a_close_up_reads_only_the_chunks_its_rays_reach() {
         s.chunks_decoded,
         s.chunks
     );
+}
+
+/// With a colour index, opening reads no colour bytes and a close-up reads only
+/// the colour blocks its hits fall in; without one (a file as older versions
+/// wrote it), the whole colour section is read at open. Same images.
+#[test]
+fn a_close_up_reads_only_the_colour_blocks_it_needs() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(0xc010);
+    let model = coloured(&mut rng, terrain(32));
+    let mut opts = RenderOptions {
+        width: 32,
+        height: 24,
+        camera: Camera::view(View::Top),
+        ..Default::default()
+    };
+    opts.camera.zoom = 6.0;
+    let want = in_memory(&model, &opts);
+    let (indexed, plain) = (dir.path().join("i.tess"), dir.path().join("p.tess"));
+    write_v2(&indexed, &model, 8);
+    write_v2(&plain, &model, 17);
+    let f = crate::io::TessFile::open(&indexed).unwrap();
+    let ix = f.colour_only_index().expect("written with an index");
+    let section: u64 = ix.regions.iter().map(|r| (r.end - r.start) as u64).sum();
+    assert!(crate::io::TessFile::open(&plain)
+        .unwrap()
+        .colour_only_index()
+        .is_none());
+    let st = StreamedTree::open(&indexed, 1 << 30).unwrap();
+    assert_eq!(st.stats().colour_bytes_read, 0, "opening read colours");
+    assert!(streamed(&st, &opts) == want);
+    let s = st.stats();
+    assert!(
+        s.colour_bytes_read > 0 && s.colour_bytes_read * 4 < section,
+        "a close-up read {} of {section} colour bytes",
+        s.colour_bytes_read
+    );
+    let old = StreamedTree::open(&plain, 1 << 30).unwrap();
+    assert!(old.stats().colour_bytes_read >= section);
+    assert!(streamed(&old, &opts) == want);
 }
 
 /// A dataset whose part boundaries cut full blocks: the parts join as the
