@@ -11,32 +11,13 @@ mod common;
 
 use std::fs;
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::Command;
 
-use common::{json, ok, render_both, run, run_capped, scenes};
+use common::{json, ok, render_both, run, run_capped, run_stdin, scenes, stdout_of};
 use rand::{Rng, SeedableRng};
 use serde_json::Value;
 use tesseral::linear::LinearOctree;
 use tesseral::model::{Frame, Layer, Model};
-
-/// Runs `tesseral args...` in `dir` with the file `input` as standard input.
-fn run_stdin(dir: &Path, args: &[&str], input: &str) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .current_dir(dir)
-        .args(args)
-        .stdin(Stdio::from(fs::File::open(dir.join(input)).unwrap()))
-        .output()
-        .expect("run tesseral")
-}
-
-fn stdout_of(out: Output, what: &str) -> Vec<u8> {
-    assert!(
-        out.status.success(),
-        "{what}: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out.stdout
-}
 
 /// A seeded random model in the space (`depth`, `origin`) with `frame`:
 /// scattered voxels, sometimes a big block, sometimes nothing (`kind` 0), the

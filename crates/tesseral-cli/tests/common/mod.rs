@@ -7,7 +7,7 @@
 
 use std::fs;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 use serde_json::Value;
 
@@ -133,4 +133,24 @@ pub fn render_both(dir: &Path, input: &str, extra: &[&str]) -> (Value, Value) {
         "{input} {extra:?}: the streamed PNG differs from the in-memory one"
     );
     (v, w)
+}
+
+/// Runs `tesseral args...` in `dir` with the file `input` as standard input.
+pub fn run_stdin(dir: &Path, args: &[&str], input: &str) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_tesseral"))
+        .current_dir(dir)
+        .args(args)
+        .stdin(Stdio::from(fs::File::open(dir.join(input)).unwrap()))
+        .output()
+        .expect("run tesseral")
+}
+
+/// The standard output of a run that must succeed (`what` names it on failure).
+pub fn stdout_of(out: Output, what: &str) -> Vec<u8> {
+    assert!(
+        out.status.success(),
+        "{what}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out.stdout
 }

@@ -304,3 +304,18 @@ impl OccupancyMap {
         self.store.assert_valid(self.fixed);
     }
 }
+
+/// Asks the CPU (shared by the scan's block updates and the store's lookups) to bring the cache line of `x` in (a hint: no effect on results).
+#[inline(always)]
+pub(crate) fn prefetch<T>(x: &T) {
+    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
+    // address is that of a live reference anyway).
+    #[cfg(target_arch = "x86_64")]
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (x as *const T).cast(),
+        );
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
+}

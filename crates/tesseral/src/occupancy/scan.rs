@@ -7,7 +7,7 @@ use rayon::prelude::*;
 use super::ray::Scratch;
 use super::sensor::Pose;
 use super::store::{BlockKey, BLOCK_LOG2};
-use super::{OccupancyMap, ScanStats};
+use super::{prefetch, OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
 /// Rays per rayon task.
@@ -294,21 +294,6 @@ impl OccupancyMap {
         }
         (hits, misses)
     }
-}
-
-/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
-    // address is that of a live reference anyway).
-    #[cfg(target_arch = "x86_64")]
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            (x as *const T).cast(),
-        );
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
 }
 
 #[cfg(test)]

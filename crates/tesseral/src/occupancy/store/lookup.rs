@@ -5,25 +5,11 @@ use super::arena::UNIT;
 use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
 use super::probe::{sparse_value, LANES};
 use super::{local, split, Entry, Store};
+use crate::occupancy::prefetch;
 use crate::occupancy::sensor::UNKNOWN;
 
 /// Cells looked up together by [`Store::get_many`].
 pub(crate) const BATCH: usize = 32;
-
-/// Asks the CPU to bring the cache line of `x` in (a hint: no effect on results).
-#[inline(always)]
-fn prefetch<T>(x: &T) {
-    // SAFETY: SSE is part of every x86_64 CPU, and a prefetch reads nothing (the
-    // address is that of a live reference anyway).
-    #[cfg(target_arch = "x86_64")]
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            (x as *const T).cast(),
-        );
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = x;
-}
 
 impl Store {
     /// The stored value of a cell (`UNKNOWN` when unknown).
