@@ -278,16 +278,22 @@ pub fn with_progress<T>(estimate: u64, write: impl FnOnce() -> T) -> T {
         )
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
+    watch(&bar, || written_bytes().min(estimate), write)
+}
+
+/// Runs `write` while a second thread sets `bar` to `position()` five times a
+/// second, then clears the bar: the library reports no progress for these writes,
+/// so the bar watches what they leave on disk.
+pub fn watch<T>(
+    bar: &indicatif::ProgressBar,
+    position: impl Fn() -> u64 + Sync,
+    write: impl FnOnce() -> T,
+) -> T {
     let done = std::sync::atomic::AtomicBool::new(false);
     let result = std::thread::scope(|scope| {
         scope.spawn(|| {
             while !done.load(std::sync::atomic::Ordering::Relaxed) {
-                let written: u64 = tesseral::io::pending_temporaries()
-                    .iter()
-                    .filter_map(|p| std::fs::metadata(p).ok())
-                    .map(|m| m.len())
-                    .sum();
-                bar.set_position(written.min(estimate));
+                bar.set_position(position());
                 std::thread::sleep(std::time::Duration::from_millis(200));
             }
         });
@@ -316,6 +322,22 @@ pub fn install_signal_handler() {
             std::process::exit(128 + signal);
         }
     });
+}
+
+/// Bytes written so far by the writes in progress: each temporary file's size,
+/// and the files in each staged dataset directory.
+pub fn written_bytes() -> u64 {
+    let len = |p: &Path| std::fs::symlink_metadata(p).map_or(0, |m| m.len());
+    tesseral::io::pending_temporaries()
+        .iter()
+        .map(|p| {
+            if p.is_dir() {
+                std::fs::read_dir(p).map_or(0, |d| d.flatten().map(|e| len(&e.path())).sum())
+            } else {
+                len(p)
+            }
+        })
+        .sum()
 }
 
 #[cfg(test)]

@@ -164,22 +164,6 @@ fn chunk_bytes(f: &TessFile) -> u64 {
     }
 }
 
-/// Bytes written so far by the writes in progress: each temporary file's size,
-/// and the files in each staged dataset directory.
-fn written_bytes() -> u64 {
-    let len = |p: &Path| std::fs::symlink_metadata(p).map_or(0, |m| m.len());
-    tesseral::io::pending_temporaries()
-        .iter()
-        .map(|p| {
-            if p.is_dir() {
-                std::fs::read_dir(p).map_or(0, |d| d.flatten().map(|e| len(&e.path())).sum())
-            } else {
-                len(p)
-            }
-        })
-        .sum()
-}
-
 /// Runs `write`, a streamed write of the leaves of the files `inputs` (`what`: "cutting",
 /// "translating"...), and while it runs shows on standard error, on a terminal
 /// only and for inputs of at least 2^20 leaves, a bar of the input's leaves with
@@ -203,19 +187,12 @@ pub fn with_leaf_progress<T>(what: &str, inputs: &[&[TessFile]], write: impl FnO
         ))
         .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
     );
-    let done = std::sync::atomic::AtomicBool::new(false);
-    let result = std::thread::scope(|scope| {
-        scope.spawn(|| {
-            while !done.load(std::sync::atomic::Ordering::Relaxed) {
-                let share = written_bytes().min(bytes) as f64 / bytes as f64;
-                bar.set_position((share * leaves as f64) as u64);
-                std::thread::sleep(std::time::Duration::from_millis(200));
-            }
-        });
-        let result = write();
-        done.store(true, std::sync::atomic::Ordering::Relaxed);
-        result
-    });
-    bar.finish_and_clear();
-    result
+    super::output::watch(
+        &bar,
+        || {
+            let share = super::output::written_bytes().min(bytes) as f64 / bytes as f64;
+            (share * leaves as f64) as u64
+        },
+        write,
+    )
 }
