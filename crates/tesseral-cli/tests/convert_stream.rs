@@ -8,7 +8,7 @@ use std::fs;
 use std::path::Path;
 use std::process::Command;
 
-use common::{fails, json, ok, run, run_capped, run_stdin, scenes, stdout_of};
+use common::{build_scene, fails, json, ok, run, run_capped, run_stdin, scenes, stdout_of};
 use rand::{Rng, SeedableRng};
 use tesseral::linear::LinearOctree;
 use tesseral::model::{Frame, Layer, Model};
@@ -179,18 +179,7 @@ fn streamed_conversions_equal_the_in_memory_ones() {
 fn convert_parts_replaces_datasets_and_guards_inputs() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("showcase.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "a.tess",
-            "--depth",
-            "6",
-        ],
-    );
+    build_scene(d, "showcase.tss", "a.tess", 6);
     ok(d, &["convert", "a.tess", "-o", "ds", "--parts", "6"]);
     assert_eq!(names(&d.join("ds")).len(), 7);
     ok(d, &["convert", "a.tess", "-o", "ds", "--parts", "2"]);
@@ -242,18 +231,7 @@ fn convert_parts_replaces_datasets_and_guards_inputs() {
 fn streamed_conversions_check_budgets_before_the_work() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("showcase.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "a.tess",
-            "--depth",
-            "6",
-        ],
-    );
+    build_scene(d, "showcase.tss", "a.tess", 6);
     ok(d, &["convert", "a.tess", "-o", "ds", "--parts", "2"]);
     for (args, flag) in [
         (

@@ -13,7 +13,7 @@ use std::fs;
 use std::path::Path;
 use std::process::Command;
 
-use common::{json, ok, render_both, run, run_capped, run_stdin, scenes, stdout_of};
+use common::{build_scene, json, ok, render_both, run, run_capped, run_stdin, stdout_of};
 use rand::{Rng, SeedableRng};
 use serde_json::Value;
 use tesseral::linear::LinearOctree;
@@ -354,18 +354,7 @@ fn a_legacy_colour_list_is_read_whole_with_the_same_results() {
 fn a_version_1_file_streams_in_a_small_address_space() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let scene = scenes().join("fig4c-spheroid.tss");
-    ok(
-        d,
-        &[
-            "build",
-            scene.to_str().unwrap(),
-            "-o",
-            "s.tess",
-            "--depth",
-            "12",
-        ],
-    );
+    build_scene(d, "fig4c-spheroid.tss", "s.tess", 12);
     {
         let model = tesseral::io::read_model(&d.join("s.tess")).unwrap();
         let mut f = std::io::BufWriter::new(fs::File::create(d.join("s1.tess")).unwrap());

@@ -99,20 +99,8 @@ impl<'a> RegionLeaves<'a> {
     /// The leaves from `p` (a point of a region of these same `bytes`, the whole
     /// file) on, at most `most` of them.
     pub(crate) fn resume(bytes: &'a [u8], p: RegionPoint, depth: u8, most: u64) -> Self {
-        RegionLeaves {
-            r: Reader {
-                bytes: &bytes[..p.end],
-                pos: p.pos,
-            },
-            left: p.left.min(most),
-            packed: p.packed,
-            prev_end: p.prev_end,
-            space_end: 1u64 << (3 * u32::from(depth)),
-            depth,
-            failed: false,
-            whole: false,
-            what: "colour section",
-        }
+        let left = p.left.min(most);
+        Self::block(bytes, (p.pos, p.end), p.packed, p.prev_end, left, depth)
     }
 
     /// The `count` leaves of one indexed block `bytes[start..end]`, decoding from
@@ -167,18 +155,8 @@ impl<'a> RegionLeaves<'a> {
         what: &'static str,
     ) -> Self {
         RegionLeaves {
-            r: Reader {
-                bytes: &bytes[..end],
-                pos: start,
-            },
-            left: count,
-            packed: 0,
-            prev_end: None,
-            space_end: 1u64 << (3 * u32::from(depth)),
-            depth,
-            failed: false,
-            whole: false,
             what,
+            ..Self::block(bytes, (start, end), 0, None, count, depth)
         }
     }
 }
