@@ -87,6 +87,27 @@ fn fixed_point_agrees_with_octomap_floats_on_occupancy() {
     assert!(worst < 2e-3, "fixed point drifts by {worst}");
 }
 
+/// `to_f32` multiplies by 2^-scale rather than dividing by 2^scale: the same float,
+/// for every stored value and every scale a model can get.
+#[test]
+fn to_f32_is_the_exact_quotient_at_every_scale() {
+    let m = SensorModel::octomap();
+    for scale_log2 in 0..=14 {
+        let f = Fixed {
+            scale_log2,
+            ..Fixed::new(&m)
+        };
+        for v in i16::MIN..=i16::MAX {
+            let want = f32::from(v) / (1u32 << scale_log2) as f32;
+            assert_eq!(
+                f.to_f32(v).to_bits(),
+                want.to_bits(),
+                "{v} at 2^{scale_log2}"
+            );
+        }
+    }
+}
+
 #[test]
 fn stats_count_skipped_points_and_bad_origins() {
     let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
