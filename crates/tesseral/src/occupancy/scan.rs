@@ -2,6 +2,8 @@
 //! tesseral order of blocks, and applied block by block (a block's masks from several
 //! threads merged there).
 
+use std::sync::{Mutex, PoisonError};
+
 use rayon::prelude::*;
 
 use super::ray::Scratch;
@@ -10,8 +12,9 @@ use super::store::{BlockKey, BLOCK_LOG2};
 use super::{prefetch, OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
-/// Rays per rayon task.
-const CHUNK: usize = 2048;
+/// Rays per rayon task (a few hundred tasks a scan of 100,000 rays: balance without
+/// much overhead).
+const CHUNK: usize = 512;
 
 /// `floor(v)` as an integer, saturating as `v.floor() as i64` does (without a call
 /// to the C library's `floor`, which the baseline x86-64 target makes).
@@ -206,24 +209,34 @@ impl OccupancyMap {
             }
         };
         let (order, skipped) = by_direction(origin, points);
-        // Few chunks of the rays in direction order (one per thread alone, four per
-        // thread with more, for balance): each has its own scratch.
+        // One scratch per thread: the rays in direction order are cut into small
+        // chunks that the threads take as they go (balance), each thread casting into
+        // its own scratch (taken through an uncontended lock), so that a block is in
+        // at most one scratch per thread and the blocks near the origin fill once per
+        // thread. One thread: one scratch, in order.
         let threads = rayon::current_num_threads();
-        let pieces = if threads == 1 { 1 } else { 4 * threads };
-        let chunk = order.len().div_ceil(pieces).max(CHUNK);
-        let scratches: Vec<Scratch> = order
-            .par_chunks(chunk)
-            .with_min_len(1)
-            .fold(
-                || Scratch::new(block_of_origin),
-                |mut s, chunk| {
-                    for p in chunk {
-                        cast(&mut s, p);
-                    }
-                    s
-                },
-            )
-            .collect();
+        let scratches: Vec<Scratch> = if threads == 1 {
+            let mut s = Scratch::new(block_of_origin);
+            for p in &order {
+                cast(&mut s, p);
+            }
+            vec![s]
+        } else {
+            let own: Vec<Mutex<Scratch>> = (0..threads)
+                .map(|_| Mutex::new(Scratch::new(block_of_origin)))
+                .collect();
+            order.par_chunks(CHUNK).for_each(|chunk| {
+                let t = rayon::current_thread_index().unwrap_or(0) % threads;
+                let mut s = own[t].lock().unwrap_or_else(PoisonError::into_inner);
+                for p in chunk {
+                    cast(&mut s, p);
+                }
+            });
+            own.into_iter()
+                .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
+                .filter(|s| !s.keys().is_empty())
+                .collect()
+        };
         stats.skipped = skipped;
         stats.rays = stats.points - skipped;
         // The blocks of all scratches in tesseral order (a block in several scratches
@@ -299,8 +312,67 @@ impl OccupancyMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::occupancy::SensorModel;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64;
+    use std::collections::HashMap;
+
+    /// The map's known cells.
+    fn cells(map: &OccupancyMap) -> HashMap<[i64; 3], i16> {
+        let mut m = HashMap::new();
+        map.store.for_each(|c, v| {
+            m.insert(c, v);
+        });
+        m
+    }
+
+    /// Scans cast by several threads, each into its own scratch from chunks taken
+    /// as they go, give the map (cells, stats, bytes) that one thread gives: the
+    /// one-thread map is checked against the naive model in `tests`.
+    #[test]
+    fn threads_with_their_own_scratches_give_the_map_of_one() {
+        let mut rng = Pcg64::seed_from_u64(21);
+        let res = 0.1;
+        let scans: Vec<([f64; 3], Vec<[f64; 3]>, Option<f64>)> = (0..4)
+            .map(|scan| {
+                let origin = [0, 1, 2].map(|_| rng.random_range(-2.0..2.0));
+                let n = [3000, 5000, 700, 4000][scan];
+                let points = (0..n)
+                    .map(|i| {
+                        if i % 97 == 0 {
+                            return [f64::NAN, 0.0, 0.0];
+                        }
+                        [0, 1, 2].map(|a| origin[a] + rng.random_range(-6.0..6.0))
+                    })
+                    .collect();
+                (origin, points, [None, Some(4.0), None, Some(2.5)][scan])
+            })
+            .collect();
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+            let stats: Vec<ScanStats> = scans
+                .iter()
+                .map(|(o, p, r)| {
+                    let s = pool.install(|| map.insert_scan(*o, p, *r));
+                    map.assert_valid();
+                    s
+                })
+                .collect();
+            (cells(&map), stats, map.bytes())
+        };
+        let one = build(1);
+        assert!(one.0.len() > 10_000, "{} cells", one.0.len());
+        for threads in [2, 3, 7] {
+            let got = build(threads);
+            assert_eq!(got.1, one.1, "{threads} threads: stats");
+            assert!(got.0 == one.0, "{threads} threads: cells differ");
+            assert_eq!(got.2, one.2, "{threads} threads: bytes");
+        }
+    }
 
     /// The bucketed order against one sort of whole codes: keys near the origin
     /// (both signs, few high parts) and keys over the whole range (the fallback), a
