@@ -333,7 +333,9 @@ mod tests {
     fn threads_with_their_own_scratches_give_the_map_of_one() {
         let mut rng = Pcg64::seed_from_u64(21);
         let res = 0.1;
-        let scans: Vec<([f64; 3], Vec<[f64; 3]>, Option<f64>)> = (0..4)
+        // Origin, points and maximum range of each scan.
+        type Scan = ([f64; 3], Vec<[f64; 3]>, Option<f64>);
+        let scans: Vec<Scan> = (0..4)
             .map(|scan| {
                 let origin = [0, 1, 2].map(|_| rng.random_range(-2.0..2.0));
                 let n = [3000, 5000, 700, 4000][scan];
