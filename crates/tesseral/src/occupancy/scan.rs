@@ -2,8 +2,6 @@
 //! tesseral order of blocks, and applied block by block (a block's masks from several
 //! threads merged there).
 
-use std::sync::{Mutex, PoisonError};
-
 use rayon::prelude::*;
 
 use super::ray::Scratch;
@@ -12,9 +10,8 @@ use super::store::{BlockKey, BLOCK_LOG2};
 use super::{prefetch, OccupancyMap, ScanStats};
 use crate::code::encode_wide;
 
-/// Rays per rayon task (a few hundred tasks a scan of 100,000 rays: balance without
-/// much overhead).
-const CHUNK: usize = 512;
+/// Rays per rayon task.
+const CHUNK: usize = 2048;
 
 /// `floor(v)` as an integer, saturating as `v.floor() as i64` does (without a call
 /// to the C library's `floor`, which the baseline x86-64 target makes).
@@ -209,34 +206,24 @@ impl OccupancyMap {
             }
         };
         let (order, skipped) = by_direction(origin, points);
-        // One scratch per thread: the rays in direction order are cut into small
-        // chunks that the threads take as they go (balance), each thread casting into
-        // its own scratch (taken through an uncontended lock), so that a block is in
-        // at most one scratch per thread and the blocks near the origin fill once per
-        // thread. One thread: one scratch, in order.
+        // Few chunks of the rays in direction order (one per thread alone, four per
+        // thread with more, for balance): each has its own scratch.
         let threads = rayon::current_num_threads();
-        let scratches: Vec<Scratch> = if threads == 1 {
-            let mut s = Scratch::new(block_of_origin);
-            for p in &order {
-                cast(&mut s, p);
-            }
-            vec![s]
-        } else {
-            let own: Vec<Mutex<Scratch>> = (0..threads)
-                .map(|_| Mutex::new(Scratch::new(block_of_origin)))
-                .collect();
-            order.par_chunks(CHUNK).for_each(|chunk| {
-                let t = rayon::current_thread_index().unwrap_or(0) % threads;
-                let mut s = own[t].lock().unwrap_or_else(PoisonError::into_inner);
-                for p in chunk {
-                    cast(&mut s, p);
-                }
-            });
-            own.into_iter()
-                .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
-                .filter(|s| !s.keys().is_empty())
-                .collect()
-        };
+        let pieces = if threads == 1 { 1 } else { 4 * threads };
+        let chunk = order.len().div_ceil(pieces).max(CHUNK);
+        let scratches: Vec<Scratch> = order
+            .par_chunks(chunk)
+            .with_min_len(1)
+            .fold(
+                || Scratch::new(block_of_origin),
+                |mut s, chunk| {
+                    for p in chunk {
+                        cast(&mut s, p);
+                    }
+                    s
+                },
+            )
+            .collect();
         stats.skipped = skipped;
         stats.rays = stats.points - skipped;
         // The blocks of all scratches in tesseral order (a block in several scratches
@@ -326,11 +313,11 @@ mod tests {
         m
     }
 
-    /// Scans cast by several threads, each into its own scratch from chunks taken
-    /// as they go, give the map (cells, stats, bytes) that one thread gives: the
-    /// one-thread map is checked against the naive model in `tests`.
+    /// Scans cast by several threads, each piece of the rays into its own scratch,
+    /// give the map (cells, stats, bytes) that one thread gives: the one-thread map
+    /// is checked against the naive model in `tests`.
     #[test]
-    fn threads_with_their_own_scratches_give_the_map_of_one() {
+    fn threads_with_their_own_scratches_give_the_map_of_one_thread() {
         let mut rng = Pcg64::seed_from_u64(21);
         let res = 0.1;
         // Origin, points and maximum range of each scan.
