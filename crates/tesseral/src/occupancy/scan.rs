@@ -299,8 +299,69 @@ impl OccupancyMap {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::occupancy::SensorModel;
     use rand::{Rng, SeedableRng};
     use rand_pcg::Pcg64;
+    use std::collections::HashMap;
+
+    /// The map's known cells.
+    fn cells(map: &OccupancyMap) -> HashMap<[i64; 3], i16> {
+        let mut m = HashMap::new();
+        map.store.for_each(|c, v| {
+            m.insert(c, v);
+        });
+        m
+    }
+
+    /// Scans cast by several threads, each piece of the rays into its own scratch,
+    /// give the map (cells, stats, bytes) that one thread gives: the one-thread map
+    /// is checked against the naive model in `tests`.
+    #[test]
+    fn threads_with_their_own_scratches_give_the_map_of_one_thread() {
+        let mut rng = Pcg64::seed_from_u64(21);
+        let res = 0.1;
+        // Origin, points and maximum range of each scan.
+        type Scan = ([f64; 3], Vec<[f64; 3]>, Option<f64>);
+        let scans: Vec<Scan> = (0..4)
+            .map(|scan| {
+                let origin = [0, 1, 2].map(|_| rng.random_range(-2.0..2.0));
+                let n = [3000, 5000, 700, 4000][scan];
+                let points = (0..n)
+                    .map(|i| {
+                        if i % 97 == 0 {
+                            return [f64::NAN, 0.0, 0.0];
+                        }
+                        [0, 1, 2].map(|a| origin[a] + rng.random_range(-6.0..6.0))
+                    })
+                    .collect();
+                (origin, points, [None, Some(4.0), None, Some(2.5)][scan])
+            })
+            .collect();
+        let build = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+            let stats: Vec<ScanStats> = scans
+                .iter()
+                .map(|(o, p, r)| {
+                    let s = pool.install(|| map.insert_scan(*o, p, *r));
+                    map.assert_valid();
+                    s
+                })
+                .collect();
+            (cells(&map), stats, map.bytes())
+        };
+        let one = build(1);
+        assert!(one.0.len() > 10_000, "{} cells", one.0.len());
+        for threads in [2, 3, 7] {
+            let got = build(threads);
+            assert_eq!(got.1, one.1, "{threads} threads: stats");
+            assert!(got.0 == one.0, "{threads} threads: cells differ");
+            assert_eq!(got.2, one.2, "{threads} threads: bytes");
+        }
+    }
 
     /// The bucketed order against one sort of whole codes: keys near the origin
     /// (both signs, few high parts) and keys over the whole range (the fallback), a

@@ -264,7 +264,7 @@ pub(crate) fn apply_masks(
 }
 
 /// Calls `f` on the index of every set bit of a block mask.
-#[inline]
+#[inline(always)]
 pub(crate) fn for_bits(mask: &[u64; 8], mut f: impl FnMut(usize)) {
     for (w, &m) in mask.iter().enumerate() {
         let mut bits = m;
@@ -279,6 +279,11 @@ pub(crate) fn for_bits(mask: &[u64; 8], mut f: impl FnMut(usize)) {
 /// `miss` gets a miss and each of `hit` a hit, through a per-value map from old to
 /// new value numbers. Returns `false`, leaving the block as it was, when the new
 /// values do not fit in the width (then the caller re-encodes the block).
+///
+/// One pass over the updated cells reads their value numbers; a second writes the
+/// new ones, skipped for misses when every missed value maps to itself (cells
+/// clamped free, the common case of a block seen scan after scan). O(cells updated
+/// + values); the width is a constant in each of its four forms.
 pub(crate) fn palette_update(
     words: &mut [u16],
     w: u32,
@@ -286,6 +291,22 @@ pub(crate) fn palette_update(
     hit: &[u64; 8],
     fixed: Fixed,
 ) -> bool {
+    match w {
+        1 => palette_update_w::<1>(words, miss, hit, fixed),
+        2 => palette_update_w::<2>(words, miss, hit, fixed),
+        4 => palette_update_w::<4>(words, miss, hit, fixed),
+        _ => palette_update_w::<8>(words, miss, hit, fixed),
+    }
+}
+
+/// [`palette_update`] for width `W`.
+fn palette_update_w<const W: u32>(
+    words: &mut [u16],
+    miss: &[u64; 8],
+    hit: &[u64; 8],
+    fixed: Fixed,
+) -> bool {
+    let w = W;
     let at = bits_words(w);
     let k = words[at] as usize;
     let room = if w <= 4 {
@@ -311,6 +332,8 @@ pub(crate) fn palette_update(
     let mut n = k;
     let mut to_miss = [0u8; 256];
     let mut to_hit = [0u8; 256];
+    // Whether some missed value number maps to another.
+    let mut misses_move = false;
     for (set, to, hit) in [(&missed, &mut to_miss, false), (&hits, &mut to_hit, true)] {
         for (q, &m) in set.iter().enumerate() {
             let mut bits = m;
@@ -331,13 +354,16 @@ pub(crate) fn palette_update(
                     }
                     None => return false,
                 };
+                misses_move |= !hit && to[j] as usize != j;
             }
         }
     }
-    for_bits(miss, |i| {
-        let j = palette_index(words, w, i);
-        set_palette_index(words, w, i, to_miss[j] as usize);
-    });
+    if misses_move {
+        for_bits(miss, |i| {
+            let j = palette_index(words, w, i);
+            set_palette_index(words, w, i, to_miss[j] as usize);
+        });
+    }
     for_bits(hit, |i| {
         let j = palette_index(words, w, i);
         set_palette_index(words, w, i, to_hit[j] as usize);
