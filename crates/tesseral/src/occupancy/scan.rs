@@ -162,6 +162,81 @@ fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
     out
 }
 
+/// A scan cast but not applied yet: its threads' scratches, their blocks in tesseral
+/// order, and its counts so far.
+struct Cast {
+    scratches: Vec<Scratch>,
+    order: Vec<Place>,
+    stats: ScanStats,
+}
+
+/// Casts a scan's rays at resolution `res` into per-thread scratches and puts their
+/// blocks in tesseral order. Reads nothing of the map, so that the next scan can be
+/// cast while this one is applied ([`OccupancyMap::insert_scans`]).
+fn cast_scan(res: f64, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<f64>) -> Cast {
+    let mut stats = ScanStats {
+        points: points.len() as u64,
+        ..ScanStats::default()
+    };
+    if !origin.iter().all(|c| c.is_finite()) {
+        stats.skipped = stats.points;
+        return Cast {
+            scratches: Vec::new(),
+            order: Vec::new(),
+            stats,
+        };
+    }
+    let max_range = max_range.filter(|r| *r >= 0.0);
+    let inv = 1.0 / res;
+    let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
+    let key_origin = key(origin);
+    let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
+    let cast = |s: &mut Scratch, p: &[f64; 3]| {
+        let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
+        let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        match max_range {
+            Some(r) if norm > r => {
+                let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
+                s.miss_ray(origin, end, key_origin, key(end), res);
+            }
+            _ => {
+                s.miss_ray(origin, *p, key_origin, key(*p), res);
+                s.hit(key(*p));
+            }
+        }
+    };
+    let (order, skipped) = by_direction(origin, points);
+    // Few chunks of the rays in direction order (one per thread alone, four per
+    // thread with more, for balance): each has its own scratch.
+    let threads = rayon::current_num_threads();
+    let pieces = if threads == 1 { 1 } else { 4 * threads };
+    let chunk = order.len().div_ceil(pieces).max(CHUNK);
+    let scratches: Vec<Scratch> = order
+        .par_chunks(chunk)
+        .with_min_len(1)
+        .fold(
+            || Scratch::new(block_of_origin),
+            |mut s, chunk| {
+                for p in chunk {
+                    cast(&mut s, p);
+                }
+                s
+            },
+        )
+        .collect();
+    stats.skipped = skipped;
+    stats.rays = stats.points - skipped;
+    // The blocks of all scratches in tesseral order (a block in several scratches
+    // comes once per scratch, side by side: merged as it is applied).
+    let keys: Vec<&[BlockKey]> = scratches.iter().map(Scratch::keys).collect();
+    let order = tesseral_order(&keys);
+    Cast {
+        scratches,
+        order,
+        stats,
+    }
+}
+
 impl OccupancyMap {
     /// Inserts a scan taken from `origin`: see the [module docs](super) for the
     /// semantics (OctoMap's `insertPointCloud`). `max_range` of `None`, negative or
@@ -177,63 +252,60 @@ impl OccupancyMap {
         points: &[[f64; 3]],
         max_range: Option<f64>,
     ) -> ScanStats {
-        let mut stats = ScanStats {
-            points: points.len() as u64,
-            ..ScanStats::default()
-        };
-        if !origin.iter().all(|c| c.is_finite()) {
-            stats.skipped = stats.points;
-            return stats;
-        }
-        let max_range = max_range.filter(|r| *r >= 0.0);
+        let cast = cast_scan(self.resolution, origin, points, max_range);
+        self.apply_cast(cast)
+    }
+
+    /// Inserts scans in the order given, each from its origin, and gives each one's
+    /// counts: the map and the counts are those of a loop of
+    /// [`insert_scan`](Self::insert_scan). Faster with several threads: a scan's
+    /// rays are cast while the scan before it is applied to the map (applying is
+    /// serial; casting reads nothing of the map), so that no thread waits while
+    /// one writes blocks.
+    ///
+    /// The iterator is read one scan ahead of the map, and two scans' masks are held
+    /// at once. A block refused for lack of room is recorded as by `insert_scan`:
+    /// check [`check_capacity`](Self::check_capacity) after the call.
+    ///
+    /// # Runtime
+    /// As the loop of `insert_scan` in CPU time; in wall time each scan's apply
+    /// phase overlaps the next scan's casting.
+    pub fn insert_scans<'a>(
+        &mut self,
+        scans: impl IntoIterator<Item = ([f64; 3], &'a [[f64; 3]])>,
+        max_range: Option<f64>,
+    ) -> Vec<ScanStats> {
         let res = self.resolution;
-        let inv = 1.0 / res;
-        let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
-        let key_origin = key(origin);
-        let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
-        let cast = |s: &mut Scratch, p: &[f64; 3]| {
-            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-            let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            match max_range {
-                Some(r) if norm > r => {
-                    let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
-                    s.miss_ray(origin, end, key_origin, key(end), res);
+        let mut done = Vec::new();
+        let mut pending: Option<Cast> = None;
+        for (origin, points) in scans {
+            let next = match pending.take() {
+                None => cast_scan(res, origin, points, max_range),
+                Some(cast) => {
+                    let (stats, next) = rayon::join(
+                        || self.apply_cast(cast),
+                        || cast_scan(res, origin, points, max_range),
+                    );
+                    done.push(stats);
+                    next
                 }
-                _ => {
-                    s.miss_ray(origin, *p, key_origin, key(*p), res);
-                    s.hit(key(*p));
-                }
-            }
-        };
-        let (order, skipped) = by_direction(origin, points);
-        // Few chunks of the rays in direction order (one per thread alone, four per
-        // thread with more, for balance): each has its own scratch.
-        let threads = rayon::current_num_threads();
-        let pieces = if threads == 1 { 1 } else { 4 * threads };
-        let chunk = order.len().div_ceil(pieces).max(CHUNK);
-        let scratches: Vec<Scratch> = order
-            .par_chunks(chunk)
-            .with_min_len(1)
-            .fold(
-                || Scratch::new(block_of_origin),
-                |mut s, chunk| {
-                    for p in chunk {
-                        cast(&mut s, p);
-                    }
-                    s
-                },
-            )
-            .collect();
-        stats.skipped = skipped;
-        stats.rays = stats.points - skipped;
-        // The blocks of all scratches in tesseral order (a block in several scratches
-        // comes once per scratch, side by side: merged as it is applied).
-        let keys: Vec<&[BlockKey]> = scratches.iter().map(Scratch::keys).collect();
-        let order = tesseral_order(&keys);
-        let (hits, misses) = self.apply(&scratches, &order);
-        stats.hits = hits;
-        stats.misses = misses;
-        stats
+            };
+            pending = Some(next);
+        }
+        if let Some(cast) = pending {
+            done.push(self.apply_cast(cast));
+        }
+        done
+    }
+
+    /// Applies a cast scan to the map; gives its counts.
+    fn apply_cast(&mut self, cast: Cast) -> ScanStats {
+        let (hits, misses) = self.apply(&cast.scratches, &cast.order);
+        ScanStats {
+            hits,
+            misses,
+            ..cast.stats
+        }
     }
 
     /// [`insert_scan`](Self::insert_scan) with points in the sensor frame, moved by

@@ -220,3 +220,62 @@ fn soak_scan_insertion() {
         scan += 1;
     }
 }
+
+/// `insert_scans` (a scan cast while the one before it is applied) gives the map
+/// (cells, `bytes`) and the counts of a loop of `insert_scan` on one thread (which
+/// `tests` holds against the naive model), with one thread and with several; a scan
+/// from a non-finite origin among them counts its points skipped and changes nothing.
+#[test]
+fn insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan() {
+    let mut rng = Pcg64::seed_from_u64(31);
+    let res = 0.25;
+    let scans: Vec<([f64; 3], Vec<[f64; 3]>)> = (0..7)
+        .map(|scan| {
+            let origin = if scan == 3 {
+                [f64::NAN, 0.0, 0.0]
+            } else {
+                [0, 1, 2].map(|_| rng.random_range(-3.0..3.0))
+            };
+            let n = [400, 900, 50, 300, 0, 1200, 700][scan];
+            let points = (0..n)
+                .map(|i| {
+                    if i % 53 == 0 {
+                        return [0.0, f64::INFINITY, 0.0];
+                    }
+                    [0, 1, 2].map(|_| rng.random_range(-8.0..8.0))
+                })
+                .collect();
+            (origin, points)
+        })
+        .collect();
+    let cells = |map: &OccupancyMap| {
+        let mut m = HashMap::new();
+        map.store.for_each(|c, v| {
+            m.insert(c, v);
+        });
+        m
+    };
+    for max_range in [None, Some(4.0)] {
+        let mut want_map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+        let want: Vec<ScanStats> = scans
+            .iter()
+            .map(|(o, p)| want_map.insert_scan(*o, p, max_range))
+            .collect();
+        assert_eq!(want[3].skipped, 300, "a non-finite origin skips every point");
+        assert!(cells(&want_map).len() > 10_000);
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut map = OccupancyMap::new(res, SensorModel::octomap()).unwrap();
+            let got = pool.install(|| {
+                map.insert_scans(scans.iter().map(|(o, p)| (*o, p.as_slice())), max_range)
+            });
+            map.assert_valid();
+            assert_eq!(got, want, "{threads} threads, {max_range:?}: counts");
+            assert!(cells(&map) == cells(&want_map), "{threads} threads: cells");
+            assert_eq!(map.bytes(), want_map.bytes(), "{threads} threads: bytes");
+        }
+    }
+}
