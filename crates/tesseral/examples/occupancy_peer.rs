@@ -1,6 +1,7 @@
 //! The tesseral side of `benches/occupancy/run.sh` (issue 13 §8): writes the synthetic
 //! indoor and outdoor scans for the C++ peers (Bonxai, OctoMap) and times
-//! `OccupancyMap::insert_scan` and random lookups on them.
+//! `OccupancyMap::insert_scans` (the scans in order, each cast while the one before
+//! it is applied) and random lookups on them.
 //!
 //! - `occupancy_peer gen DIR SCANS RAYS`: writes `DIR/indoor.scans` and
 //!   `DIR/outdoor.scans` (per scan: origin as 3 × `f64`, point count as `u64`, points
@@ -121,9 +122,13 @@ fn main() -> std::io::Result<()> {
             let rays: usize = sc.iter().map(|s| s.points.len()).sum();
             let mut map = OccupancyMap::new(0.05, SensorModel::octomap()).expect("map");
             let (t, c) = (Instant::now(), process_cpu());
-            for s in &sc {
-                map.insert_scan(s.origin, &s.points, Some(max_range));
-            }
+            // The library's call for a sequence of scans: each scan's rays are cast
+            // while the one before it is applied (one core: the same work as a loop
+            // of `insert_scan`).
+            map.insert_scans(
+                sc.iter().map(|s| (s.origin, s.points.as_slice())),
+                Some(max_range),
+            );
             let (wall, cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
             let mut r = SplitMix64(7);
             let cells: Vec<[i64; 3]> = (0..1_000_000)

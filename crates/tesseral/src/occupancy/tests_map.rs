@@ -261,7 +261,10 @@ fn insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan() {
             .iter()
             .map(|(o, p)| want_map.insert_scan(*o, p, max_range))
             .collect();
-        assert_eq!(want[3].skipped, 300, "a non-finite origin skips every point");
+        assert_eq!(
+            want[3].skipped, 300,
+            "a non-finite origin skips every point"
+        );
         assert!(cells(&want_map).len() > 10_000);
         for threads in [1, 2, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
