@@ -6,13 +6,15 @@
 //! pose per scan, and from point clouds (`.xyz`, `.ply`, `.pcd`), placed with
 //! `--origin` (the sensor position; the points are world coordinates) or `--pose`
 //! (the points are in the sensor frame, moved by the pose). A PCD's `VIEWPOINT` is
-//! its sensor origin unless either is given. Each scan is one
-//! `tesseral::occupancy::OccupancyMap::insert_scan` call.
+//! its sensor origin unless either is given. A file's scans go through
+//! `tesseral::occupancy::OccupancyMap::insert_scans_each` (each scan cast while the
+//! one before it is applied), with the store's capacity checked after each.
 //!
 //! With `--json` one object is printed with exactly the keys `scans`, `points`,
 //! `rays`, `occupied`, `free`, `leaves`, `bytes`, `seconds` (the insertion time,
 //! reading and writing excluded, as `graph2tree` reports it) and `rays_per_second`.
 
+use std::borrow::Cow;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -162,18 +164,26 @@ pub fn run(args: Args) -> Result<()> {
     let mut t = Totals::default();
     for path in &args.scans {
         let scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let at = |i: usize| format!("{}: scan {} of {}", path.display(), i + 1, scans.len());
+        // Every scan's work is checked against --max-cells before any is cast.
+        for (i, s) in scans.iter().enumerate() {
+            check_work(&map, s, &args).with_context(|| at(i))?;
+        }
         bar.inc_length(scans.len() as u64);
         bar.set_message(path.display().to_string());
-        for (i, s) in scans.iter().enumerate() {
-            check_work(&map, s, &args).with_context(|| {
-                format!("{}: scan {} of {}", path.display(), i + 1, scans.len())
-            })?;
-            insert(&mut map, s, &args, &mut t);
-            map.check_capacity().with_context(|| {
-                format!("{}: scan {} of {}", path.display(), i + 1, scans.len())
-            })?;
+        // Each scan is cast while the one before it is applied (insert_scans).
+        let start = Instant::now();
+        let mut i = 0;
+        map.insert_scans_each(placed(&scans, &args), args.max_range, |map, stats| {
+            t.scans += 1;
+            t.points += stats.points;
+            t.rays += stats.rays;
+            map.check_capacity().with_context(|| at(i))?;
+            i += 1;
             bar.inc(1);
-        }
+            anyhow::Ok(())
+        })?;
+        t.seconds += start.elapsed().as_secs_f64();
     }
     bar.finish_and_clear();
 
@@ -253,36 +263,40 @@ fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// Inserts one scan, placed by its own pose or by `--origin` / `--pose`.
-fn insert(map: &mut OccupancyMap, s: &ScanRecord, args: &Args, t: &mut Totals) {
-    let start = Instant::now();
-    let stats = if let Some(o) = args.origin {
-        map.insert_scan(o, &s.points, args.max_range)
-    } else if let Some([x, y, z, roll, pitch, yaw]) = args.pose {
-        let pose = Pose {
-            translation: [x, y, z],
-            roll,
-            pitch,
-            yaw,
-        };
-        map.insert_scan_posed(&pose, &s.points, args.max_range)
-    } else {
-        match s.frame {
-            PointFrame::World => map.insert_scan(s.translation, &s.points, args.max_range),
-            PointFrame::Sensor => {
-                let [roll, pitch, yaw] = s.rpy;
-                let pose = Pose {
-                    translation: s.translation,
-                    roll,
-                    pitch,
-                    yaw,
-                };
-                map.insert_scan_posed(&pose, &s.points, args.max_range)
+/// The scans' sensor origins and points in world coordinates, placed by their own
+/// poses or by `--origin` / `--pose` (points moved by a pose are made as the scans
+/// are read, one at a time).
+fn placed<'a>(
+    scans: &'a [ScanRecord],
+    args: &'a Args,
+) -> impl Iterator<Item = ([f64; 3], Cow<'a, [[f64; 3]]>)> + 'a {
+    let moved =
+        |pose: Pose, points: &[[f64; 3]]| (pose.translation, Cow::Owned(pose.apply_all(points)));
+    scans.iter().map(move |s| {
+        if let Some(o) = args.origin {
+            (o, Cow::Borrowed(s.points.as_slice()))
+        } else if let Some([x, y, z, roll, pitch, yaw]) = args.pose {
+            let pose = Pose {
+                translation: [x, y, z],
+                roll,
+                pitch,
+                yaw,
+            };
+            moved(pose, &s.points)
+        } else {
+            match s.frame {
+                PointFrame::World => (s.translation, Cow::Borrowed(s.points.as_slice())),
+                PointFrame::Sensor => {
+                    let [roll, pitch, yaw] = s.rpy;
+                    let pose = Pose {
+                        translation: s.translation,
+                        roll,
+                        pitch,
+                        yaw,
+                    };
+                    moved(pose, &s.points)
+                }
             }
         }
-    };
-    t.seconds += start.elapsed().as_secs_f64();
-    t.scans += 1;
-    t.points += stats.points;
-    t.rays += stats.rays;
+    })
 }

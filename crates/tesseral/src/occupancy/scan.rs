@@ -263,22 +263,45 @@ impl OccupancyMap {
     /// serial; casting reads nothing of the map), so that no thread waits while
     /// one writes blocks.
     ///
-    /// The iterator is read one scan ahead of the map, and two scans' masks are held
-    /// at once. A block refused for lack of room is recorded as by `insert_scan`:
-    /// check [`check_capacity`](Self::check_capacity) after the call.
+    /// The points of a scan are a slice or anything that holds one (a `Vec` made as
+    /// the iterator is read: each is dropped once its scan is cast). The iterator is
+    /// read one scan ahead of the map, and two scans' masks are held at once. A
+    /// block refused for lack of room is recorded as by `insert_scan`: check
+    /// [`check_capacity`](Self::check_capacity) after the call, or after each scan
+    /// with [`insert_scans_each`](Self::insert_scans_each).
     ///
     /// # Runtime
     /// As the loop of `insert_scan` in CPU time; in wall time each scan's apply
     /// phase overlaps the next scan's casting.
-    pub fn insert_scans<'a>(
+    pub fn insert_scans<P: AsRef<[[f64; 3]]> + Sync>(
         &mut self,
-        scans: impl IntoIterator<Item = ([f64; 3], &'a [[f64; 3]])>,
+        scans: impl IntoIterator<Item = ([f64; 3], P)>,
         max_range: Option<f64>,
     ) -> Vec<ScanStats> {
-        let res = self.resolution;
         let mut done = Vec::new();
+        let all: Result<(), std::convert::Infallible> =
+            self.insert_scans_each(scans, max_range, |_, stats| {
+                done.push(stats);
+                Ok(())
+            });
+        let Ok(()) = all;
+        done
+    }
+
+    /// [`insert_scans`](Self::insert_scans), calling `each` with the map and the
+    /// counts of each scan as soon as it is applied, in order. An error from `each`
+    /// stops the insertion there (the next scan, cast already, is not applied) and
+    /// is returned.
+    pub fn insert_scans_each<P: AsRef<[[f64; 3]]> + Sync, E>(
+        &mut self,
+        scans: impl IntoIterator<Item = ([f64; 3], P)>,
+        max_range: Option<f64>,
+        mut each: impl FnMut(&Self, ScanStats) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let res = self.resolution;
         let mut pending: Option<Cast> = None;
         for (origin, points) in scans {
+            let points = points.as_ref();
             let next = match pending.take() {
                 None => cast_scan(res, origin, points, max_range),
                 Some(cast) => {
@@ -286,16 +309,17 @@ impl OccupancyMap {
                         || self.apply_cast(cast),
                         || cast_scan(res, origin, points, max_range),
                     );
-                    done.push(stats);
+                    each(self, stats)?;
                     next
                 }
             };
             pending = Some(next);
         }
         if let Some(cast) = pending {
-            done.push(self.apply_cast(cast));
+            let stats = self.apply_cast(cast);
+            each(self, stats)?;
         }
-        done
+        Ok(())
     }
 
     /// Applies a cast scan to the map; gives its counts.
@@ -316,10 +340,7 @@ impl OccupancyMap {
         points_in_sensor_frame: &[[f64; 3]],
         max_range: Option<f64>,
     ) -> ScanStats {
-        let world: Vec<[f64; 3]> = points_in_sensor_frame
-            .par_iter()
-            .map(|p| pose.apply(*p))
-            .collect();
+        let world = pose.apply_all(points_in_sensor_frame);
         self.insert_scan(pose.translation, &world, max_range)
     }
 

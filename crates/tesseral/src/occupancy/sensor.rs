@@ -244,4 +244,12 @@ impl Pose {
         let t = self.translation;
         [0, 1, 2].map(|i| m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + t[i])
     }
+
+    /// Points of the sensor frame in the world, as [`apply`](Self::apply) moves
+    /// each (in parallel).
+    #[must_use]
+    pub fn apply_all(&self, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        use rayon::prelude::*;
+        points.par_iter().map(|p| self.apply(*p)).collect()
+    }
 }
