@@ -4,7 +4,7 @@ use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-use tesseral::occupancy::{CellState, OccupancyMap as Map, SensorModel};
+use tesseral::occupancy::{CellState, OccupancyMap as Map, ScanStats, SensorModel};
 
 use crate::arrays::rows;
 
@@ -40,6 +40,22 @@ pub(crate) fn check_work(
         )));
     }
     Ok(())
+}
+
+/// A scan's counts as a dict: points, rays, skipped, hits, misses.
+fn stats_dict<'py>(py: Python<'py>, s: &ScanStats) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("points", s.points)?;
+    d.set_item("rays", s.rays)?;
+    d.set_item("skipped", s.skipped)?;
+    d.set_item("hits", s.hits)?;
+    d.set_item("misses", s.misses)?;
+    Ok(d)
+}
+
+/// An error about scan `i` of a list, with its message prefixed by the scan.
+fn at_scan(py: Python<'_>, i: usize, e: PyErr) -> PyErr {
+    PyValueError::new_err(format!("scan {i}: {}", e.value(py)))
 }
 
 #[pymethods]
@@ -78,13 +94,45 @@ impl OccupancyMap {
         let m = &mut self.map;
         let s = py.allow_threads(|| m.insert_scan(origin, &pts, max_range));
         m.check_capacity().map_err(value_error)?;
-        let d = PyDict::new(py);
-        d.set_item("points", s.points)?;
-        d.set_item("rays", s.rays)?;
-        d.set_item("skipped", s.skipped)?;
-        d.set_item("hits", s.hits)?;
-        d.set_item("misses", s.misses)?;
-        Ok(d)
+        stats_dict(py, &s)
+    }
+
+    /// Inserts scans in order, as a loop of `insert_scan` would, each given as an
+    /// `(origin, points)` pair: each scan is cast while the one before it is written
+    /// into the map, so several threads are kept busy. Returns one dict of counts per
+    /// scan. Every scan's work is checked against `max_cells` before any is cast
+    /// (ValueError naming the scan).
+    #[pyo3(signature = (scans, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
+    fn insert_scans<'py>(
+        &mut self,
+        py: Python<'py>,
+        scans: Vec<([f64; 3], PyReadonlyArray2<'_, f64>)>,
+        max_range: Option<f64>,
+        max_cells: u64,
+    ) -> PyResult<Vec<Bound<'py, PyDict>>> {
+        let mut placed = Vec::with_capacity(scans.len());
+        for (i, (origin, points)) in scans.iter().enumerate() {
+            let pts = rows(points).map_err(|e| at_scan(py, i, e))?;
+            check_work(&self.map, *origin, &pts, max_range, max_cells)
+                .map_err(|e| at_scan(py, i, e))?;
+            placed.push((*origin, pts));
+        }
+        let m = &mut self.map;
+        let mut counts = Vec::with_capacity(placed.len());
+        py.allow_threads(|| {
+            m.insert_scans_each(
+                placed.iter().map(|(o, p)| (*o, p.as_slice())),
+                max_range,
+                |m, s| {
+                    m.check_capacity()
+                        .map_err(|e| format!("scan {}: {e}", counts.len()))?;
+                    counts.push(s);
+                    Ok::<(), String>(())
+                },
+            )
+        })
+        .map_err(PyValueError::new_err)?;
+        counts.iter().map(|s| stats_dict(py, s)).collect()
     }
 
     /// The state of each cell of an N×3 int64 array: 0 unknown, 1 free, 2 occupied.

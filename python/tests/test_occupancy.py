@@ -91,3 +91,32 @@ def test_batched_log_odds_agree_with_one_cell_at_a_time_and_with_state():
     assert np.array_equal(np.isnan(many), st == 0)
     assert (st == 2).any() and (st == 1).any() and (st == 0).any()
     assert np.array_equal(many[st == 2] >= 0, np.ones((st == 2).sum(), dtype=bool))
+
+
+def test_insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan():
+    rng = np.random.default_rng(5)
+    scans = []
+    for _ in range(5):
+        origin = tuple(rng.uniform(-1.0, 1.0, 3))
+        pts = rng.uniform(-3.0, 3.0, (400, 3))
+        pts[::37] = np.nan
+        scans.append((origin, pts))
+    one = t.OccupancyMap(0.1)
+    want = [one.insert_scan(o, p, max_range=2.5) for o, p in scans]
+    m = t.OccupancyMap(0.1)
+    got = m.insert_scans(scans, max_range=2.5)
+    assert got == want
+    assert m.stats() == one.stats()
+    ends = np.concatenate([p for _, p in scans])
+    cells = m.cells_of(ends[~np.isnan(ends).any(axis=1)])
+    np.testing.assert_array_equal(m.log_odds(cells), one.log_odds(cells))  # NaN: unknown
+    assert (m.state(cells) == one.state(cells)).all()
+
+
+def test_insert_scans_checks_every_scans_work_before_casting_any():
+    m = t.OccupancyMap(0.1)
+    near = np.array([[1.0, 0.0, 0.0]])
+    far = np.array([[1.0e9, 0.0, 0.0]])
+    with pytest.raises(ValueError, match="scan 1: .*max_cells"):
+        m.insert_scans([((0.0, 0.0, 0.0), near), ((0.0, 0.0, 0.0), far)])
+    assert m.stats()["occupied"] == 0 and m.stats()["free"] == 0

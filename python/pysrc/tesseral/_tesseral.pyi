@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Optional, Tuple, Union
+from typing import Any, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -115,6 +115,12 @@ class OccupancyMap:
         max_range: Optional[float] = ...,
         max_cells: int = ...,
     ) -> dict[str, int]: ...
+    def insert_scans(
+        self,
+        scans: Sequence[Tuple[Tuple[float, float, float], npt.NDArray[np.float64]]],
+        max_range: Optional[float] = ...,
+        max_cells: int = ...,
+    ) -> List[dict[str, int]]: ...
     def state(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.uint8]: ...
     def log_odds(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.float32]: ...
     def cells_of(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]: ...
