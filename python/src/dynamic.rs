@@ -88,12 +88,7 @@ impl DynamicOctree {
             }
             (s, inserted, removed)
         });
-        let d = PyDict::new(py);
-        d.set_item("points", s.points)?;
-        d.set_item("rays", s.rays)?;
-        d.set_item("skipped", s.skipped)?;
-        d.set_item("hits", s.hits)?;
-        d.set_item("misses", s.misses)?;
+        let d = crate::occupancy::stats_dict(py, &s)?;
         d.set_item("inserted", inserted)?;
         d.set_item("removed", removed)?;
         Ok(d)

@@ -43,7 +43,7 @@ pub(crate) fn check_work(
 }
 
 /// A scan's counts as a dict: points, rays, skipped, hits, misses.
-fn stats_dict<'py>(py: Python<'py>, s: &ScanStats) -> PyResult<Bound<'py, PyDict>> {
+pub(crate) fn stats_dict<'py>(py: Python<'py>, s: &ScanStats) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
     d.set_item("points", s.points)?;
     d.set_item("rays", s.rays)?;

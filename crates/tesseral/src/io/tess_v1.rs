@@ -6,7 +6,7 @@
 //! leaves are sorted in the payload, so nothing else is needed; the colour layer
 //! is read as streams from the sections after the payload.
 
-use super::chunked::RELEASE_STRETCH;
+use super::chunked::{check_crc, crc_released, RELEASE_STRETCH};
 use super::leafstream::Reader;
 use super::sections::{read_sections, FLAG_FRAME, KNOWN_FLAGS};
 use super::tess_colours::{RegionLeaves, RegionPoint};
@@ -49,19 +49,8 @@ pub(crate) fn index_v1(
     let s = &bytes[body_len..];
     let stored = u32::from_le_bytes([s[0], s[1], s[2], s[3]]);
     let mut crc = crc32fast::Hasher::new();
-    let mut at = 0;
-    while at < body_len {
-        let end = (at + RELEASE_STRETCH).min(body_len);
-        crc.update(&bytes[at..end]);
-        done(at, end);
-        at = end;
-    }
-    let actual = crc.finalize();
-    if stored != actual {
-        return Err(format!(
-            "checksum mismatch (stored {stored:08x}, computed {actual:08x}): the file is truncated or corrupted"
-        ));
-    }
+    crc_released(&mut crc, bytes, 0, body_len, done);
+    check_crc("checksum", stored, crc.finalize())?;
     let body = &bytes[..body_len];
     let mut r = Reader {
         bytes: body,

@@ -36,6 +36,35 @@ pub(crate) fn parse_layout(bytes: &[u8]) -> Result<Layout, String> {
 /// Bytes checksummed between two calls of a reader's `done`.
 pub(crate) const RELEASE_STRETCH: usize = 8 << 20;
 
+/// Hashes `bytes[start..stop]` into `crc` a stretch of [`RELEASE_STRETCH`] bytes
+/// at a time, calling `done(start, end)` after each so that a mapped reader can
+/// let the stretch go.
+pub(crate) fn crc_released(
+    crc: &mut crc32fast::Hasher,
+    bytes: &[u8],
+    start: usize,
+    stop: usize,
+    done: &dyn Fn(usize, usize),
+) {
+    let mut at = start;
+    while at < stop {
+        let end = (at + RELEASE_STRETCH).min(stop);
+        crc.update(&bytes[at..end]);
+        done(at, end);
+        at = end;
+    }
+}
+
+/// An error when the `stored` checksum (`what`) differs from the `actual` one.
+pub(crate) fn check_crc(what: &str, stored: u32, actual: u32) -> Result<(), String> {
+    if stored == actual {
+        return Ok(());
+    }
+    Err(format!(
+        "{what} mismatch (stored {stored:08x}, computed {actual:08x}): the file is truncated or corrupted"
+    ))
+}
+
 /// As [`parse_layout`], calling `done(start, end)` after each stretch of the
 /// checksummed sections, and of the chunks whose heads are checked, is read, so
 /// that a mapped reader can let it go. With `lazy_colours`, a file whose only
@@ -127,17 +156,10 @@ pub(crate) fn parse_layout_with(
             }
         }
         let stop = skip.peek().map_or(len - 12, |s| s.0);
-        let end = (at + RELEASE_STRETCH).min(stop);
-        crc.update(&bytes[at..end]);
-        done(at, end);
-        at = end;
+        crc_released(&mut crc, bytes, at, stop, done);
+        at = stop;
     }
-    let actual = crc.finalize();
-    if stored != actual {
-        return Err(format!(
-            "index checksum mismatch (stored {stored:08x}, computed {actual:08x}): the file is truncated or corrupted"
-        ));
-    }
+    check_crc("index checksum", stored, crc.finalize())?;
     if bytes[10..12] != [0, 0] || bytes[13..16] != [0, 0, 0] || bytes[t + 32..t + 36] != [0; 4] {
         return Err("reserved bytes are not zero".into());
     }

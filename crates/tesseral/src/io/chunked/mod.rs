@@ -12,7 +12,9 @@ use crate::model::Frame;
 use crate::Voxel;
 
 mod layout;
-pub(crate) use layout::{chunk_leaves, parse_layout, parse_layout_with, Layout, RELEASE_STRETCH};
+pub(crate) use layout::{
+    check_crc, chunk_leaves, crc_released, parse_layout, parse_layout_with, Layout, RELEASE_STRETCH,
+};
 
 /// The version [`TessWriter`] writes.
 pub const VERSION_CHUNKED: u16 = 2;
