@@ -21,7 +21,7 @@ pub(crate) struct Dda {
 
 impl Dda {
     /// The walk from `origin` (in cell `key_origin`) to `end` (in `key_end`), or
-    /// `None` when both lie in one cell.
+    /// `None` when both lie in one cell: [`RayOrigin::dda`] for one ray.
     ///
     /// The steps left along an axis are never negative (the key of the end lies on
     /// the side `step` goes). The walk reaches the end cell when no step is left, and
@@ -29,7 +29,7 @@ impl Dda {
     /// only float rounding can cause. (OctoMap stops once the border distance exceeds
     /// the length, which can drop the last cell before an end point lying exactly on
     /// a face; the count on keys cannot.)
-    #[inline(always)]
+    #[cfg(test)]
     pub fn new(
         origin: [f64; 3],
         end: [f64; 3],
@@ -37,32 +37,64 @@ impl Dda {
         key_end: [i64; 3],
         res: f64,
     ) -> Option<Self> {
-        if key_origin == key_end {
+        RayOrigin::new(origin, key_origin, res).dda_to(end, key_end)
+    }
+}
+
+/// What the rays of a scan share: the origin, its cell, and the distance from the
+/// origin to its cell's border on each side of each axis (OctoMap: centre ± res/2;
+/// OctoMap adds the half cell rounded to `f32`, which moves the border by up to
+/// 1e-9 of a cell; we keep it exact), so that a ray's set-up is its divisions alone.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct RayOrigin {
+    origin: [f64; 3],
+    key: [i64; 3],
+    res: f64,
+    /// Border minus origin per axis, stepping down (`[0]`) and up (`[1]`).
+    to_border: [[f64; 2]; 3],
+}
+
+impl RayOrigin {
+    /// The shared set-up of rays from `origin`, in cell `key`, at resolution `res`.
+    pub fn new(origin: [f64; 3], key: [i64; 3], res: f64) -> Self {
+        let to_border = [0, 1, 2].map(|i| {
+            [-1.0, 1.0].map(|s: f64| (key[i] as f64 + 0.5) * res + s * res * 0.5 - origin[i])
+        });
+        Self {
+            origin,
+            key,
+            res,
+            to_border,
+        }
+    }
+
+    /// The walk to `end`, in cell `key_end` ([`dda`](Self::dda) with the offset
+    /// and length computed here).
+    #[inline(always)]
+    pub fn dda_to(&self, end: [f64; 3], key_end: [i64; 3]) -> Option<Dda> {
+        let o = self.origin;
+        let d = [end[0] - o[0], end[1] - o[1], end[2] - o[2]];
+        self.dda(d, (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), key_end)
+    }
+
+    /// The walk along `d` (end minus origin) of length `length` (`|d|`, summed
+    /// x, y, z), ending in cell `key_end`, or `None` when that is the origin's
+    /// cell. The divisions do not depend on each other or on a branch, so that
+    /// they overlap.
+    #[inline(always)]
+    pub fn dda(&self, d: [f64; 3], length: f64, key_end: [i64; 3]) -> Option<Dda> {
+        if key_end == self.key {
             return None;
         }
-        let d = [end[0] - origin[0], end[1] - origin[1], end[2] - origin[2]];
-        let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         let dir = d.map(|c| c / length);
-        let mut step = [0i64; 3];
-        let mut t_max = [f64::MAX; 3];
-        let mut t_delta = [f64::MAX; 3];
-        for i in 0..3 {
-            if dir[i] > 0.0 {
-                step[i] = 1;
-            } else if dir[i] < 0.0 {
-                step[i] = -1;
-            }
-            if step[i] != 0 {
-                // The cell's border in the ray's direction (OctoMap: centre ± res/2).
-                // (OctoMap adds the half cell rounded to `f32`, which moves the border
-                // by up to 1e-9 of a cell; we keep it exact.)
-                let border = (key_origin[i] as f64 + 0.5) * res + step[i] as f64 * res * 0.5;
-                t_max[i] = (border - origin[i]) / dir[i];
-                t_delta[i] = res / dir[i].abs();
-            }
-        }
-        let left_axis = [0, 1, 2].map(|i| (key_end[i] - key_origin[i]) * step[i]);
-        Some(Self {
+        // +1, −1, or 0 (also for NaN, from a length that underflowed).
+        let step = dir.map(|c| i64::from(c > 0.0) - i64::from(c < 0.0));
+        let t = [0, 1, 2].map(|i| self.to_border[i][usize::from(dir[i] > 0.0)] / dir[i]);
+        let td = dir.map(|c| self.res / c.abs());
+        let t_max = [0, 1, 2].map(|i| if step[i] != 0 { t[i] } else { f64::MAX });
+        let t_delta = [0, 1, 2].map(|i| if step[i] != 0 { td[i] } else { f64::MAX });
+        let left_axis = [0, 1, 2].map(|i| (key_end[i] - self.key[i]) * step[i]);
+        Some(Dda {
             step,
             t_max,
             t_delta,
@@ -338,7 +370,7 @@ impl Scratch {
     /// crossed. A block whose 512 cells are all missed already is crossed in one
     /// jump to its exit ([`exit_block`]): near the origin most blocks fill after a
     /// few hundred rays.
-    #[inline]
+    #[cfg(test)]
     pub fn miss_ray(
         &mut self,
         origin: [f64; 3],
@@ -347,9 +379,14 @@ impl Scratch {
         key_end: [i64; 3],
         res: f64,
     ) {
-        let Some(w) = Dda::new(origin, end, key_origin, key_end, res) else {
-            return;
-        };
+        if let Some(w) = Dda::new(origin, end, key_origin, key_end, res) {
+            self.miss_walk(&w, key_origin);
+        }
+    }
+
+    /// [`miss_ray`](Self::miss_ray) for the walk `w` from cell `key_origin`.
+    #[inline]
+    pub fn miss_walk(&mut self, w: &Dda, key_origin: [i64; 3]) {
         let mask = (1i64 << BLOCK_LOG2) - 1;
         let mut block = key_origin.map(|c| c >> BLOCK_LOG2);
         let [mut x, mut y, mut z] = key_origin.map(|c| c & mask);

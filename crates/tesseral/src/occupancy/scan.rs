@@ -4,7 +4,7 @@
 
 use rayon::prelude::*;
 
-use super::ray::Scratch;
+use super::ray::{RayOrigin, Scratch};
 use super::sensor::Pose;
 use super::store::{BlockKey, BLOCK_LOG2};
 use super::{prefetch, OccupancyMap, ScanStats};
@@ -191,17 +191,24 @@ fn cast_scan(res: f64, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<
     let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
     let key_origin = key(origin);
     let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
+    let rays = RayOrigin::new(origin, key_origin, res);
     let cast = |s: &mut Scratch, p: &[f64; 3]| {
         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
         let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
         match max_range {
             Some(r) if norm > r => {
                 let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
-                s.miss_ray(origin, end, key_origin, key(end), res);
+                if let Some(w) = rays.dda_to(end, key(end)) {
+                    s.miss_walk(&w, key_origin);
+                }
             }
             _ => {
-                s.miss_ray(origin, *p, key_origin, key(*p), res);
-                s.hit(key(*p));
+                // The walk's offset and length are those just computed.
+                let k = key(*p);
+                if let Some(w) = rays.dda(d, norm, k) {
+                    s.miss_walk(&w, key_origin);
+                }
+                s.hit(k);
             }
         }
     };
