@@ -33,12 +33,16 @@
 //! ```
 
 mod convert;
+mod dda;
 mod ray;
 mod scan;
+mod scan_order;
 mod sensor;
 mod store;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_clamped;
 #[cfg(test)]
 mod tests_dense;
 #[cfg(test)]
@@ -98,7 +102,9 @@ pub struct ScanStats {
     pub skipped: u64,
     /// Cells updated as hits (each once).
     pub hits: u64,
-    /// Cells updated as misses (each once, none of them hit).
+    /// Cells updated as misses (each once, none of them hit), not counting the
+    /// cells of blocks that the map held clamped free (all 512 cells at the lower
+    /// clamp), which a miss leaves unchanged.
     pub misses: u64,
 }
 

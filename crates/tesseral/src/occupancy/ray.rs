@@ -1,215 +1,15 @@
-//! The 3-D DDA of Amanatides & Woo on cell keys, as OctoMap's `computeRayKeys`, and
-//! the per-scan scratch of hit and miss masks per block.
+//! The per-scan scratch of hit and miss masks per block, and the fast walk of a ray
+//! through it (the DDA of [`dda`](super::dda), cell by cell inside a block, one jump
+//! over a block all missed).
+
+use std::sync::Arc;
 
 use rustc_hash::FxHashMap;
 
+#[cfg(test)]
+use super::dda::JUMPS;
+use super::dda::{exit_block, Dda};
 use super::store::{BlockKey, BLOCK_LOG2};
-
-/// The state of one ray's walk (Amanatides & Woo) after its first cell.
-pub(crate) struct Dda {
-    /// ±1 or 0 per axis.
-    pub step: [i64; 3],
-    /// The ray parameter at the next border along each axis.
-    pub t_max: [f64; 3],
-    /// The ray parameter between borders along each axis.
-    pub t_delta: [f64; 3],
-    /// Steps left along each axis before the end cell's plane.
-    pub left_axis: [i64; 3],
-    /// Steps left in all before the end cell.
-    pub left: i64,
-}
-
-impl Dda {
-    /// The walk from `origin` (in cell `key_origin`) to `end` (in `key_end`), or
-    /// `None` when both lie in one cell: [`RayOrigin::dda`] for one ray.
-    ///
-    /// The steps left along an axis are never negative (the key of the end lies on
-    /// the side `step` goes). The walk reaches the end cell when no step is left, and
-    /// stops early when it would step past the end cell's plane along an axis, which
-    /// only float rounding can cause. (OctoMap stops once the border distance exceeds
-    /// the length, which can drop the last cell before an end point lying exactly on
-    /// a face; the count on keys cannot.)
-    #[cfg(test)]
-    pub fn new(
-        origin: [f64; 3],
-        end: [f64; 3],
-        key_origin: [i64; 3],
-        key_end: [i64; 3],
-        res: f64,
-    ) -> Option<Self> {
-        RayOrigin::new(origin, key_origin, res).dda_to(end, key_end)
-    }
-}
-
-/// What the rays of a scan share: the origin, its cell, and the distance from the
-/// origin to its cell's border on each side of each axis (OctoMap: centre ± res/2;
-/// OctoMap adds the half cell rounded to `f32`, which moves the border by up to
-/// 1e-9 of a cell; we keep it exact), so that a ray's set-up is its divisions alone.
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct RayOrigin {
-    origin: [f64; 3],
-    key: [i64; 3],
-    res: f64,
-    /// Border minus origin per axis, stepping down (`[0]`) and up (`[1]`).
-    to_border: [[f64; 2]; 3],
-}
-
-impl RayOrigin {
-    /// The shared set-up of rays from `origin`, in cell `key`, at resolution `res`.
-    pub fn new(origin: [f64; 3], key: [i64; 3], res: f64) -> Self {
-        let to_border = [0, 1, 2].map(|i| {
-            [-1.0, 1.0].map(|s: f64| (key[i] as f64 + 0.5) * res + s * res * 0.5 - origin[i])
-        });
-        Self {
-            origin,
-            key,
-            res,
-            to_border,
-        }
-    }
-
-    /// The walk to `end`, in cell `key_end` ([`dda`](Self::dda) with the offset
-    /// and length computed here).
-    #[inline(always)]
-    pub fn dda_to(&self, end: [f64; 3], key_end: [i64; 3]) -> Option<Dda> {
-        let o = self.origin;
-        let d = [end[0] - o[0], end[1] - o[1], end[2] - o[2]];
-        self.dda(d, (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt(), key_end)
-    }
-
-    /// The walk along `d` (end minus origin) of length `length` (`|d|`, summed
-    /// x, y, z), ending in cell `key_end`, or `None` when that is the origin's
-    /// cell. The divisions do not depend on each other or on a branch, so that
-    /// they overlap.
-    #[inline(always)]
-    pub fn dda(&self, d: [f64; 3], length: f64, key_end: [i64; 3]) -> Option<Dda> {
-        if key_end == self.key {
-            return None;
-        }
-        let dir = d.map(|c| c / length);
-        // +1, −1, or 0 (also for NaN, from a length that underflowed).
-        let step = dir.map(|c| i64::from(c > 0.0) - i64::from(c < 0.0));
-        let t = [0, 1, 2].map(|i| self.to_border[i][usize::from(dir[i] > 0.0)] / dir[i]);
-        let td = dir.map(|c| self.res / c.abs());
-        let t_max = [0, 1, 2].map(|i| if step[i] != 0 { t[i] } else { f64::MAX });
-        let t_delta = [0, 1, 2].map(|i| if step[i] != 0 { td[i] } else { f64::MAX });
-        let left_axis = [0, 1, 2].map(|i| (key_end[i] - self.key[i]) * step[i]);
-        Some(Dda {
-            step,
-            t_max,
-            t_delta,
-            left_axis,
-            left: left_axis[0] + left_axis[1] + left_axis[2],
-        })
-    }
-}
-
-/// One ray's walk: the cells OctoMap's `computeRayKeys(origin, end)` returns.
-///
-/// Nothing when both ends lie in one cell; otherwise the origin's cell, then each
-/// cell entered, stopping before the end's cell (or once the walk has passed it
-/// along an axis, which only float rounding can cause). Ties between axes go as
-/// in OctoMap (x before z, y before z, y before x only when strictly smaller).
-/// This is the reference form; [`Scratch::miss_ray`] is the fast one.
-#[cfg(test)]
-pub(crate) fn walk(
-    origin: [f64; 3],
-    end: [f64; 3],
-    key_origin: [i64; 3],
-    key_end: [i64; 3],
-    res: f64,
-    mut visit: impl FnMut([i64; 3]),
-) {
-    let Some(mut w) = Dda::new(origin, end, key_origin, key_end, res) else {
-        return;
-    };
-    visit(key_origin);
-    let mut key = key_origin;
-    loop {
-        let dim = if w.t_max[0] < w.t_max[1] {
-            if w.t_max[0] < w.t_max[2] {
-                0
-            } else {
-                2
-            }
-        } else if w.t_max[1] < w.t_max[2] {
-            1
-        } else {
-            2
-        };
-        if w.left_axis[dim] == 0 {
-            return;
-        }
-        w.left_axis[dim] -= 1;
-        w.left -= 1;
-        if w.left == 0 {
-            return;
-        }
-        key[dim] += w.step[dim];
-        w.t_max[dim] += w.t_delta[dim];
-        visit(key);
-    }
-}
-
-/// Where a walk leaves its block: the axis it leaves along, the steps it takes along
-/// each axis up to and including the step out, and the ray parameters then, exactly
-/// as [`walk`]'s steps would leave them.
-///
-/// The walk is a merge of three sequences of border parameters, one per axis, each
-/// summed step by step as the walk sums them (`t`, `t + d`, `t + d + d`, ...), in the
-/// order (parameter, then z before y before x on ties). The step out of the block
-/// along axis `i` comes `w_i` borders on (8 − x or x + 1); the first of these in the
-/// merge order is the exit, and the steps along another axis are its borders that
-/// precede the exit. At most 8 sums per axis, whatever the path inside.
-#[inline]
-pub(crate) fn exit_block(
-    t: [f64; 3],
-    d: [f64; 3],
-    step: [i64; 3],
-    c: [i64; 3],
-) -> (usize, [i64; 3], [f64; 3]) {
-    let mut w = [0i64; 3];
-    let mut e = [f64::MAX; 3];
-    for i in 0..3 {
-        if step[i] != 0 {
-            w[i] = if step[i] > 0 { 8 - c[i] } else { c[i] + 1 };
-            let mut v = t[i];
-            for _ in 1..w[i] {
-                v += d[i];
-            }
-            e[i] = v;
-        }
-    }
-    let a = if e[0] < e[1] {
-        if e[0] < e[2] {
-            0
-        } else {
-            2
-        }
-    } else if e[1] < e[2] {
-        1
-    } else {
-        2
-    };
-    let mut n = [0i64; 3];
-    let mut out = t;
-    for j in 0..3 {
-        if j == a {
-            n[j] = w[j];
-            out[j] = e[j] + d[j];
-        } else if step[j] != 0 {
-            while n[j] + 1 < w[j] && (out[j] < e[a] || (out[j] == e[a] && j > a)) {
-                out[j] += d[j];
-                n[j] += 1;
-            }
-        }
-    }
-    (a, n, out)
-}
-
-/// Blocks crossed by [`exit_block`] so far (tests check that the jump is taken).
-#[cfg(test)]
-pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 /// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray
 /// crossing a block touches only its line of miss bits.
@@ -226,6 +26,9 @@ const NO_SLOT: u32 = 0;
 /// The flag of a slot in the dense index whose block is all missed (so that a ray
 /// crossing it jumps to its exit without reading its bits).
 const FULL: u32 = 1 << 31;
+/// An entry of the dense index for a block that the map holds clamped free and no
+/// ray ends in: it has no slot, and rays cross it as a full block.
+const CLAMPED: u32 = u32::MAX;
 
 /// Lines of miss bits per chunk (64 KiB): the chunks never move as a scratch grows
 /// (a `Vec` of 64-byte-aligned lines would be copied at each doubling).
@@ -266,17 +69,30 @@ pub(crate) struct Scratch {
     /// Per slot, 1 + its index in `hits`, or 0 when no ray ends in it.
     hit_at: Vec<u32>,
     hits: Vec<Bits>,
+    /// The blocks of the dense index that the map holds clamped free, one bit each
+    /// in the index's order (see [`near_cube`]), if known.
+    clamped: Option<Arc<[u64]>>,
+}
+
+/// The dense index of a scratch centred on block `centre`: its lowest block and
+/// the log2 of its side in blocks.
+pub(crate) fn near_cube(centre: BlockKey) -> (BlockKey, u32) {
+    (centre.map(|c| c - NEAR_SIDE / 2), NEAR_SIDE_LOG2)
 }
 
 /// No hits.
 const NO_HITS: Bits = Bits([0; 8]);
 
 impl Scratch {
-    /// An empty scratch whose dense index is centred on block `centre`.
-    pub fn new(centre: BlockKey) -> Self {
+    /// An empty scratch whose dense index is centred on block `centre`, with the
+    /// blocks of that index that the map holds clamped free (a bit set over
+    /// [`near_cube`]), if known: a miss changes nothing there, so rays cross
+    /// those blocks without marking their cells (a hit still counts).
+    pub fn new(centre: BlockKey, clamped: Option<Arc<[u64]>>) -> Self {
         Self {
             centre,
-            near_lo: centre.map(|c| c - NEAR_SIDE / 2),
+            clamped,
+            near_lo: near_cube(centre).0,
             near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
             far: FxHashMap::default(),
             wide: FxHashMap::default(),
@@ -303,6 +119,15 @@ impl Scratch {
         &mut self.miss[s >> CHUNK_LOG2][s & (CHUNK - 1)].0
     }
 
+    /// The blocks in which a ray ends.
+    pub fn hit_blocks(&self) -> impl Iterator<Item = BlockKey> + '_ {
+        self.keys
+            .iter()
+            .zip(&self.hit_at)
+            .filter(|(_, &h)| h != 0)
+            .map(|(k, _)| *k)
+    }
+
     /// The hit bits of slot `s`.
     #[inline]
     pub fn hits(&self, s: usize) -> &[u64; 8] {
@@ -312,10 +137,18 @@ impl Scratch {
         }
     }
 
-    /// The slot of block `b`, made (empty) when the scratch has none.
+    /// The slot of block `b`, made (empty) when the scratch has none, also for a
+    /// block the map holds clamped free (still crossed as full).
     #[inline]
     fn slot(&mut self, b: BlockKey) -> usize {
-        (self.enter(b).0 & !FULL) as usize
+        let (v, at) = self.enter(b);
+        if v == CLAMPED - 1 {
+            let n = self.keys.len() as u32;
+            self.near[at] = FULL | (n + 1);
+            self.push(b);
+            return n as usize;
+        }
+        (v & !FULL) as usize
     }
 
     /// The slot of block `b` (made when the scratch has none), with [`FULL`] set when
@@ -325,14 +158,19 @@ impl Scratch {
     fn enter(&mut self, b: BlockKey) -> (u32, usize) {
         let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
         let n = self.keys.len() as u32;
-        debug_assert!(n < FULL - 1, "a scratch holds fewer than 2^31 - 1 blocks");
+        debug_assert!(n < FULL - 2, "a scratch holds fewer than 2^31 - 2 blocks");
         let (i, at) = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
             let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
-            let i = &mut self.near[at];
-            if *i == NO_SLOT {
-                *i = n + 1;
+            let mut i = self.near[at];
+            if i == NO_SLOT {
+                let clamped = self
+                    .clamped
+                    .as_ref()
+                    .is_some_and(|c| c[at / 64] >> (at % 64) & 1 != 0);
+                i = if clamped { CLAMPED } else { n + 1 };
+                self.near[at] = i;
             }
-            (*i - 1, at)
+            (i - 1, at)
         } else {
             (self.far_slot(b, n), usize::MAX)
         };

@@ -4,11 +4,14 @@
 
 use rayon::prelude::*;
 
-use super::ray::{RayOrigin, Scratch};
+use std::sync::Arc;
+
+use super::dda::RayOrigin;
+use super::ray::{near_cube, Scratch};
+use super::scan_order::{by_direction, tesseral_order, Place};
 use super::sensor::Pose;
 use super::store::{BlockKey, BLOCK_LOG2};
 use super::{prefetch, OccupancyMap, ScanStats};
-use crate::code::encode_wide;
 
 /// Rays per rayon task.
 const CHUNK: usize = 2048;
@@ -25,155 +28,40 @@ fn floor(v: f64) -> i64 {
     }
 }
 
-/// Direction cells per face side of the cube round the origin (a power of two).
-const FACE_SIDE: u32 = 32;
-
-/// The bits of a 5-bit number spread to the even places.
-fn spread(x: u32) -> u32 {
-    let x = (x | x << 4) & 0x0F0F;
-    let x = (x | x << 2) & 0x3333;
-    (x | x << 1) & 0x5555
-}
-
-/// The finite points, copied in the order of the direction of their ray (a cube map of
-/// 6 × 32 × 32 cells, each face in Morton order), and the number of points that are
-/// not finite. Rays in one direction cell cross the same blocks, so their masks stay
-/// in cache, and a thread's share of the rays is a few cones, not the whole scene.
-/// The order changes no result: each ray only sets bits.
-fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<[f64; 3]>, u64) {
-    const CELLS: usize = 6 * (FACE_SIDE * FACE_SIDE) as usize;
-    const SKIP: u16 = CELLS as u16;
-    let cell: Vec<u16> = points
-        .par_iter()
-        .with_min_len(4096)
-        .map(|p| {
-            if !p.iter().all(|c| c.is_finite()) {
-                return SKIP;
-            }
-            let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-            let m = d.map(f64::abs);
-            let a = if m[0] >= m[1] && m[0] >= m[2] {
-                0
-            } else if m[1] >= m[2] {
-                1
-            } else {
-                2
-            };
-            if m[a] == 0.0 {
-                return 0;
-            }
-            let inv = 1.0 / m[a];
-            let side = f64::from(FACE_SIDE);
-            let q = |c: f64| ((c * inv + 1.0) * 0.5 * side).clamp(0.0, side - 1.0) as u32;
-            let (u, v) = (q(d[(a + 1) % 3]), q(d[(a + 2) % 3]));
-            let face = 2 * a as u32 + u32::from(d[a] < 0.0);
-            (face * FACE_SIDE * FACE_SIDE + (spread(u) | spread(v) << 1)) as u16
-        })
-        .collect();
-    let mut start = vec![0usize; CELLS + 3];
-    for &c in &cell {
-        start[c as usize + 2] += 1;
-    }
-    let skipped = start[CELLS + 2];
-    for i in 2..start.len() {
-        start[i] += start[i - 1];
-    }
-    let mut order = vec![[0.0; 3]; points.len() - skipped];
-    for (i, &c) in cell.iter().enumerate() {
-        if c != SKIP {
-            let at = &mut start[c as usize + 1];
-            order[*at] = points[i];
-            *at += 1;
-        }
-    }
-    (order, skipped as u64)
-}
-
-/// The tesseral code of a block key (its low 42 bits per axis, offset so that
-/// negative keys sort below positive ones).
-fn block_code(b: [i64; 3]) -> u128 {
-    let m = (1u64 << 42) - 1;
-    let u = b.map(|c| (c as u64 ^ (1 << 41)) & m);
-    encode_wide(u[0], u[1], u[2])
-}
-
-/// A block of a scan: its scratch and its index there.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-struct Place {
-    scratch: u32,
-    index: u32,
-}
-
-/// The blocks of the scratches in tesseral order of their keys (a key in several
-/// scratches: side by side, in scratch order).
-///
-/// The codes' high 64 bits take few values (a scene spans far fewer than 2^21
-/// blocks per axis, and the sign offset splits it in at most eight parts): the blocks
-/// are put in buckets by those bits and each bucket sorted on the low 64 bits, which
-/// moves half the bytes of sorting the whole codes. Many high values (a scan over
-/// thousands of kilometres): one sort of whole codes.
-fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
-    let codes: Vec<(u128, Place)> = blocks
-        .par_iter()
-        .enumerate()
-        .flat_map_iter(|(s, b)| {
-            b.iter().enumerate().map(move |(i, k)| {
-                let p = Place {
-                    scratch: s as u32,
-                    index: i as u32,
-                };
-                (block_code(*k), p)
-            })
-        })
-        .collect();
-    let mut highs: Vec<u64> = Vec::new();
-    let mut last = None;
-    for &(c, _) in &codes {
-        let h = (c >> 64) as u64;
-        if last != Some(h) && !highs.contains(&h) {
-            highs.push(h);
-            if highs.len() > 64 {
-                let mut codes = codes;
-                codes.par_sort_unstable();
-                return codes.into_iter().map(|(_, p)| p).collect();
-            }
-        }
-        last = Some(h);
-    }
-    highs.sort_unstable();
-    let mut buckets: Vec<Vec<(u64, Place)>> = vec![Vec::new(); highs.len()];
-    let mut last = (u64::MAX, 0);
-    for &(c, p) in &codes {
-        let h = (c >> 64) as u64;
-        if h != last.0 {
-            last = (
-                h,
-                highs.binary_search(&h).unwrap_or_else(|_| unreachable!()),
-            );
-        }
-        buckets[last.1].push((c as u64, p));
-    }
-    drop(codes);
-    let mut out = Vec::new();
-    for mut b in buckets {
-        b.par_sort_unstable();
-        out.extend(b.into_iter().map(|(_, p)| p));
-    }
-    out
-}
-
 /// A scan cast but not applied yet: its threads' scratches, their blocks in tesseral
 /// order, and its counts so far.
-struct Cast {
+pub(super) struct Cast {
     scratches: Vec<Scratch>,
     order: Vec<Place>,
     stats: ScanStats,
 }
 
+impl Cast {
+    /// The blocks the scan's rays marked (a block in several scratches once each).
+    #[cfg(test)]
+    pub fn blocks(&self) -> usize {
+        self.order.len()
+    }
+}
+
+/// The block of the origin's cell at resolution `res`.
+fn origin_block(res: f64, origin: [f64; 3]) -> BlockKey {
+    let inv = 1.0 / res;
+    origin.map(|c| floor(c * inv) >> BLOCK_LOG2)
+}
+
 /// Casts a scan's rays at resolution `res` into per-thread scratches and puts their
 /// blocks in tesseral order. Reads nothing of the map, so that the next scan can be
-/// cast while this one is applied ([`OccupancyMap::insert_scans`]).
-fn cast_scan(res: f64, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<f64>) -> Cast {
+/// cast while this one is applied ([`OccupancyMap::insert_scans`]); given the blocks
+/// round the origin that the map holds clamped free
+/// ([`OccupancyMap::clamped_near`]), rays cross those without marking their cells.
+pub(super) fn cast_scan(
+    res: f64,
+    origin: [f64; 3],
+    points: &[[f64; 3]],
+    max_range: Option<f64>,
+    clamped: Option<Arc<[u64]>>,
+) -> Cast {
     let mut stats = ScanStats {
         points: points.len() as u64,
         ..ScanStats::default()
@@ -190,7 +78,7 @@ fn cast_scan(res: f64, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<
     let inv = 1.0 / res;
     let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
     let key_origin = key(origin);
-    let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
+    let block_of_origin = origin_block(res, origin);
     let rays = RayOrigin::new(origin, key_origin, res);
     let cast = |s: &mut Scratch, p: &[f64; 3]| {
         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
@@ -222,7 +110,7 @@ fn cast_scan(res: f64, origin: [f64; 3], points: &[[f64; 3]], max_range: Option<
         .par_chunks(chunk)
         .with_min_len(1)
         .fold(
-            || Scratch::new(block_of_origin),
+            || Scratch::new(block_of_origin, clamped.clone()),
             |mut s, chunk| {
                 for p in chunk {
                     cast(&mut s, p);
@@ -259,7 +147,8 @@ impl OccupancyMap {
         points: &[[f64; 3]],
         max_range: Option<f64>,
     ) -> ScanStats {
-        let cast = cast_scan(self.resolution, origin, points, max_range);
+        let clamped = self.clamped_near(origin, None);
+        let cast = cast_scan(self.resolution, origin, points, max_range, clamped);
         self.apply_cast(cast)
     }
 
@@ -309,12 +198,14 @@ impl OccupancyMap {
         let mut pending: Option<Cast> = None;
         for (origin, points) in scans {
             let points = points.as_ref();
+            // What the map holds clamped free once the pending scan is applied.
+            let clamped = self.clamped_near(origin, pending.as_ref());
             let next = match pending.take() {
-                None => cast_scan(res, origin, points, max_range),
+                None => cast_scan(res, origin, points, max_range, clamped),
                 Some(cast) => {
                     let (stats, next) = rayon::join(
                         || self.apply_cast(cast),
-                        || cast_scan(res, origin, points, max_range),
+                        || cast_scan(res, origin, points, max_range, clamped),
                     );
                     each(self, stats)?;
                     next
@@ -329,8 +220,38 @@ impl OccupancyMap {
         Ok(())
     }
 
+    /// The blocks of the dense index of a scan from `origin` ([`near_cube`]) that
+    /// the map holds clamped free, less those in which a ray of `pending` (a scan
+    /// cast, not applied yet) ends: once `pending` is applied, a miss changes
+    /// nothing in these blocks (its misses keep them clamped free; a miss only
+    /// lowers a value). `None` for an origin not finite or when no block is.
+    pub(super) fn clamped_near(
+        &self,
+        origin: [f64; 3],
+        pending: Option<&Cast>,
+    ) -> Option<Arc<[u64]>> {
+        if !origin.iter().all(|c| c.is_finite()) {
+            return None;
+        }
+        debug_assert!(self.fixed.miss < 0, "a miss lowers a cell's value");
+        let (lo, side_log2) = near_cube(origin_block(self.resolution, origin));
+        let mut bits = self.store.uniform_in(lo, side_log2, self.fixed.min);
+        for b in pending
+            .iter()
+            .flat_map(|c| &c.scratches)
+            .flat_map(Scratch::hit_blocks)
+        {
+            let d = [0, 1, 2].map(|a| b[a].wrapping_sub(lo[a]) as u64);
+            if d.iter().all(|&c| c >> side_log2 == 0) {
+                let at = (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize;
+                bits[at / 64] &= !(1 << (at % 64));
+            }
+        }
+        bits.iter().any(|&w| w != 0).then(|| bits.into())
+    }
+
     /// Applies a cast scan to the map; gives its counts.
-    fn apply_cast(&mut self, cast: Cast) -> ScanStats {
+    pub(super) fn apply_cast(&mut self, cast: Cast) -> ScanStats {
         let (hits, misses) = self.apply(&cast.scratches, &cast.order);
         ScanStats {
             hits,
@@ -389,8 +310,11 @@ impl OccupancyMap {
                 miss[w] &= !hit[w];
             }
             hits += u64::from(hit.iter().map(|w| w.count_ones()).sum::<u32>());
-            misses += u64::from(miss.iter().map(|w| w.count_ones()).sum::<u32>());
-            self.store.update(k, &miss, &hit, fixed);
+            // Misses in a block clamped free change nothing and are not counted
+            // (rays may cross such a block without marking it).
+            if !self.store.update(k, &miss, &hit, fixed) {
+                misses += u64::from(miss.iter().map(|w| w.count_ones()).sum::<u32>());
+            }
         }
         (hits, misses)
     }
@@ -460,43 +384,6 @@ mod tests {
             assert_eq!(got.1, one.1, "{threads} threads: stats");
             assert!(got.0 == one.0, "{threads} threads: cells differ");
             assert_eq!(got.2, one.2, "{threads} threads: bytes");
-        }
-    }
-
-    /// The bucketed order against one sort of whole codes: keys near the origin
-    /// (both signs, few high parts) and keys over the whole range (the fallback), a
-    /// key in several scratches among them.
-    #[test]
-    fn blocks_come_in_tesseral_order_duplicates_side_by_side() {
-        let mut rng = Pcg64::seed_from_u64(5);
-        for (round, span) in [40i64, 1 << 20, 1 << 41, 3].into_iter().enumerate() {
-            let scratches: Vec<Vec<BlockKey>> = (0..3)
-                .map(|_| {
-                    let mut seen = std::collections::HashSet::new();
-                    (0..2000)
-                        .map(|_| [0, 1, 2].map(|_| rng.random_range(-span..span)))
-                        .filter(|k| seen.insert(*k))
-                        .collect()
-                })
-                .collect();
-            let blocks: Vec<&[BlockKey]> = scratches.iter().map(|s| &s[..]).collect();
-            let got = tesseral_order(&blocks);
-            let mut want: Vec<(u128, Place)> = blocks
-                .iter()
-                .enumerate()
-                .flat_map(|(s, b)| {
-                    b.iter().enumerate().map(move |(i, k)| {
-                        let p = Place {
-                            scratch: s as u32,
-                            index: i as u32,
-                        };
-                        (block_code(*k), p)
-                    })
-                })
-                .collect();
-            want.sort_unstable();
-            let want: Vec<Place> = want.into_iter().map(|(_, p)| p).collect();
-            assert_eq!(got, want, "round {round}");
         }
     }
 }

@@ -7,7 +7,7 @@ use std::collections::{HashMap, HashSet};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::ray::walk;
+use super::dda::walk;
 use super::sensor::Fixed;
 use super::*;
 
@@ -134,6 +134,22 @@ impl Naive {
             }
         }
         let (lo, hi) = (i32::from(self.f.min), i32::from(self.f.max));
+        // Blocks whose 512 cells were all at the lower clamp: misses not counted.
+        let clamped = |c: &Cell| {
+            let b = c.map(|k| k >> 3);
+            (0..512).all(|i: i64| {
+                let cell = [
+                    b[0] << 3 | i & 7,
+                    b[1] << 3 | i >> 3 & 7,
+                    b[2] << 3 | i >> 6,
+                ];
+                self.cells.get(&cell) == Some(&lo)
+            })
+        };
+        let counted = misses
+            .iter()
+            .filter(|c| !hits.contains(*c) && !clamped(c))
+            .count() as u64;
         for c in &misses {
             if !hits.contains(c) {
                 let v = self.cells.entry(*c).or_insert(0);
@@ -149,7 +165,7 @@ impl Naive {
             rays: (points.len() - skipped) as u64,
             skipped: skipped as u64,
             hits: hits.len() as u64,
-            misses: misses.difference(&hits).count() as u64,
+            misses: counted,
         }
     }
 }

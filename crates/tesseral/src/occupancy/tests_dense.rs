@@ -7,7 +7,7 @@ use std::sync::atomic::Ordering;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::ray::JUMPS;
+use super::dda::JUMPS;
 use super::tests::{check_same, Naive};
 use super::*;
 

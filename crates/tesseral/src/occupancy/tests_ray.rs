@@ -6,7 +6,8 @@ use std::sync::atomic::Ordering;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::ray::{exit_block, walk, Scratch, JUMPS};
+use super::dda::{exit_block, walk, JUMPS};
+use super::ray::Scratch;
 
 fn key(p: [f64; 3], res: f64) -> [i64; 3] {
     let inv = 1.0 / res;
@@ -81,7 +82,7 @@ fn fast_walk_marks_the_cells_of_the_reference_walk() {
         } else {
             ko.map(|c| (c >> 3) + 40)
         };
-        let mut s = Scratch::new(centre);
+        let mut s = Scratch::new(centre, None);
         s.miss_ray(o, e, ko, ke, res);
         assert_eq!(missed(&s), want, "case {case}: {o:?} -> {e:?} at {res}");
     }
@@ -194,7 +195,7 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
         let mut blocks: Vec<[i64; 3]> = path.iter().map(|c| c.map(|k| k >> 3)).collect();
         blocks.dedup();
         blocks.push(ke.map(|k| k >> 3));
-        let mut s = Scratch::new(ko.map(|c| c >> 3));
+        let mut s = Scratch::new(ko.map(|c| c >> 3), None);
         let mut want: HashSet<[i64; 3]> = path.iter().copied().collect();
         for (i, b) in blocks.iter().enumerate() {
             if i == 0 || i + 1 == blocks.len() || rng.random_range(0..3) == 0 {
@@ -226,7 +227,7 @@ fn a_scratch_holds_one_slot_per_block_near_far_and_beyond_packing() {
     let mut rng = Pcg64::seed_from_u64(21);
     for round in 0..20 {
         let centre = [0, 1, 2].map(|_| rng.random_range(-1000i64..1000));
-        let mut s = Scratch::new(centre);
+        let mut s = Scratch::new(centre, None);
         let mut want: std::collections::HashMap<[i64; 3], HashSet<i64>> =
             std::collections::HashMap::new();
         for _ in 0..3000 {

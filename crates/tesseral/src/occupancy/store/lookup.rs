@@ -4,7 +4,7 @@
 use super::arena::UNIT;
 use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
 use super::probe::{sparse_value, LANES};
-use super::{local, split, Entry, Store};
+use super::{join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
 use crate::occupancy::prefetch;
 use crate::occupancy::sensor::UNKNOWN;
 
@@ -20,6 +20,41 @@ impl Store {
             Some(s) => self.value(self.tables[s], i),
             None => UNKNOWN,
         }
+    }
+
+    /// The blocks of the cube of `1 << side_log2` blocks a side from `lo` that are
+    /// stored uniform at `value` (every cell clamped to it), as a bit set: bit
+    /// `x | y << side_log2 | z << 2 side_log2` for the block at `lo + [x, y, z]`.
+    ///
+    /// # Runtime
+    /// O(t) for the t superblock tables that meet the cube (each entry read once).
+    pub fn uniform_in(&self, lo: BlockKey, side_log2: u32, value: i16) -> Vec<u64> {
+        let side = 1i64 << side_log2;
+        let mut bits = vec![0u64; (1usize << (3 * side_log2)).div_ceil(64)];
+        let want = Entry::uniform(value);
+        let (s_lo, s_hi) = (
+            lo.map(|c| c >> BLOCK_LOG2),
+            lo.map(|c| (c + side - 1) >> BLOCK_LOG2),
+        );
+        for sz in s_lo[2]..=s_hi[2] {
+            for sy in s_lo[1]..=s_hi[1] {
+                for sx in s_lo[0]..=s_hi[0] {
+                    let Some(t) = self.dir.get([sx, sy, sz]) else {
+                        continue;
+                    };
+                    let table = &self.tables[t as usize * TABLE..][..TABLE];
+                    for (i, _) in table.iter().enumerate().filter(|(_, &e)| e == want) {
+                        let b = join([sx, sy, sz], i);
+                        let d = [0, 1, 2].map(|a| b[a] - lo[a]);
+                        if d.iter().all(|&c| (0..side).contains(&c)) {
+                            let at = (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize;
+                            bits[at / 64] |= 1 << (at % 64);
+                        }
+                    }
+                }
+            }
+        }
+        bits
     }
 
     /// The value of cell `i` of the block of entry `e`.

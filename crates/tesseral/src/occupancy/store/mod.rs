@@ -345,8 +345,9 @@ impl Store {
     }
 
     /// Applies one scan's updates to block `b`: the cells of `miss` get a miss, those
-    /// of `hit` a hit (the masks are disjoint; bit `x + 8y` of word `z`).
-    pub fn update(&mut self, b: BlockKey, miss: &[u64; 8], hit: &[u64; 8], fixed: Fixed) {
+    /// of `hit` a hit (the masks are disjoint; bit `x + 8y` of word `z`). Gives
+    /// whether the block was clamped free before (its misses changed nothing).
+    pub fn update(&mut self, b: BlockKey, miss: &[u64; 8], hit: &[u64; 8], fixed: Fixed) -> bool {
         let s = self.slot(b);
         let e = self.tables[s];
         match e.tag() {
@@ -355,11 +356,12 @@ impl Store {
                 // A clamped block that the updates only push further: unchanged.
                 let none = |m: &[u64; 8]| m.iter().all(|&w| w == 0);
                 if (v == fixed.min && none(hit)) || (v == fixed.max && none(miss)) {
-                    return;
+                    return v == fixed.min;
                 }
                 let mut cells = [v; BLOCK_CELLS];
                 apply_masks(&mut cells, miss, hit, fixed);
                 self.put_slot(s, &cells, fixed);
+                return v == fixed.min;
             }
             EMPTY => self.update_empty(s, miss, hit, fixed),
             SPARSE => self.update_sparse(s, e, miss, hit, fixed),
@@ -391,6 +393,7 @@ impl Store {
                 }
             }
         }
+        false
     }
 
     /// Reserves room for `n` more blocks.
