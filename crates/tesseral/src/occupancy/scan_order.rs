@@ -86,16 +86,9 @@ pub(super) struct Place {
     pub index: u32,
 }
 
-/// The blocks of the scratches in tesseral order of their keys (a key in several
-/// scratches: side by side, in scratch order).
-///
-/// The codes' high 64 bits take few values (a scene spans far fewer than 2^21
-/// blocks per axis, and the sign offset splits it in at most eight parts): the blocks
-/// are put in buckets by those bits and each bucket sorted on the low 64 bits, which
-/// moves half the bytes of sorting the whole codes. Many high values (a scan over
-/// thousands of kilometres): one sort of whole codes.
-pub(super) fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
-    let codes: Vec<(u128, Place)> = blocks
+/// Each block of the scratches with its tesseral code, in scratch order.
+fn coded(blocks: &[&[BlockKey]]) -> Vec<(u128, Place)> {
+    blocks
         .par_iter()
         .enumerate()
         .flat_map_iter(|(s, b)| {
@@ -107,7 +100,19 @@ pub(super) fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
                 (block_code(*k), p)
             })
         })
-        .collect();
+        .collect()
+}
+
+/// The blocks of the scratches in tesseral order of their keys (a key in several
+/// scratches: side by side, in scratch order).
+///
+/// The codes' high 64 bits take few values (a scene spans far fewer than 2^21
+/// blocks per axis, and the sign offset splits it in at most eight parts): the blocks
+/// are put in buckets by those bits and each bucket sorted on the low 64 bits, which
+/// moves half the bytes of sorting the whole codes. Many high values (a scan over
+/// thousands of kilometres): one sort of whole codes.
+pub(super) fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
+    let codes = coded(blocks);
     let mut highs: Vec<u64> = Vec::new();
     let mut last = None;
     for &(c, _) in &codes {
@@ -168,19 +173,7 @@ mod tests {
                 .collect();
             let blocks: Vec<&[BlockKey]> = scratches.iter().map(|s| &s[..]).collect();
             let got = tesseral_order(&blocks);
-            let mut want: Vec<(u128, Place)> = blocks
-                .iter()
-                .enumerate()
-                .flat_map(|(s, b)| {
-                    b.iter().enumerate().map(move |(i, k)| {
-                        let p = Place {
-                            scratch: s as u32,
-                            index: i as u32,
-                        };
-                        (block_code(*k), p)
-                    })
-                })
-                .collect();
+            let mut want = coded(&blocks);
             want.sort_unstable();
             let want: Vec<Place> = want.into_iter().map(|(_, p)| p).collect();
             assert_eq!(got, want, "round {round}");

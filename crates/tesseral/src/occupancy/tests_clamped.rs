@@ -49,10 +49,21 @@ fn cell_in_clamped_block(map: &OccupancyMap, origin_block: [i64; 3]) -> [f64; 3]
     c.map(|k| (k as f64 + 0.5) * res)
 }
 
+/// A scan's origin and points.
+type Scan = ([f64; 3], Vec<[f64; 3]>);
+
 /// Scans from two origins with a sensor whose lower clamp is one miss, so that
 /// blocks clamp after one scan; then hits inside a clamped block, crossed again by
-/// the next scans (whose misses must reach the hit cell).
-fn scans(map_for_hits: &mut OccupancyMap, naive: &mut Naive) -> Vec<([f64; 3], Vec<[f64; 3]>)> {
+/// the next scans (whose misses must reach the hit cell). Each scan is inserted and
+/// checked against the naive model as it is made; gives the map and the scans.
+fn scans() -> (OccupancyMap, Vec<Scan>) {
+    let mut map_for_hits = OccupancyMap::new(0.5, model()).unwrap();
+    let mut naive = Naive {
+        cells: HashMap::new(),
+        f: map_for_hits.fixed,
+        res: 0.5,
+    };
+    let map_for_hits = &mut map_for_hits;
     let mut rng = Pcg64::seed_from_u64(5);
     let origins = [[0.3, 0.3, 0.3], [1.3, 0.8, 0.2]];
     let mut out = Vec::new();
@@ -64,11 +75,11 @@ fn scans(map_for_hits: &mut OccupancyMap, naive: &mut Naive) -> Vec<([f64; 3], V
         }
         let got = map_for_hits.insert_scan(origin, &points, None);
         assert_eq!(got, naive.scan(origin, &points, None), "scan {scan}");
-        check_same(map_for_hits, naive);
+        check_same(map_for_hits, &naive);
         map_for_hits.assert_valid();
         out.push((origin, points));
     }
-    out
+    (map_for_hits.clone(), out)
 }
 
 fn model() -> SensorModel {
@@ -77,13 +88,7 @@ fn model() -> SensorModel {
 
 #[test]
 fn rays_cross_clamped_free_blocks_and_keep_the_naive_map() {
-    let mut map = OccupancyMap::new(0.5, model()).unwrap();
-    let mut naive = Naive {
-        cells: HashMap::new(),
-        f: map.fixed,
-        res: 0.5,
-    };
-    let scans = scans(&mut map, &mut naive);
+    let (map, scans) = scans();
     // The skip happened: with the clamped blocks known, the last scan marks fewer
     // blocks, and applying either cast gives the same map.
     let (origin, points) = &scans[6];
@@ -110,7 +115,7 @@ fn rays_cross_clamped_free_blocks_and_keep_the_naive_map() {
 }
 
 /// The map of every scan but the last, inserted one by one.
-fn map_before_last(scans: &[([f64; 3], Vec<[f64; 3]>)]) -> OccupancyMap {
+fn map_before_last(scans: &[Scan]) -> OccupancyMap {
     let mut map = OccupancyMap::new(0.5, model()).unwrap();
     for (o, p) in &scans[..scans.len() - 1] {
         map.insert_scan(*o, p, None);
@@ -120,18 +125,17 @@ fn map_before_last(scans: &[([f64; 3], Vec<[f64; 3]>)]) -> OccupancyMap {
 
 #[test]
 fn insert_scans_keeps_the_misses_of_blocks_the_scan_before_hits() {
-    let mut map = OccupancyMap::new(0.5, model()).unwrap();
-    let mut naive = Naive {
-        cells: HashMap::new(),
-        f: map.fixed,
-        res: 0.5,
-    };
-    let scans = scans(&mut map, &mut naive);
+    let (map, scans) = scans();
     let mut looped = OccupancyMap::new(0.5, model()).unwrap();
     let want: Vec<ScanStats> = scans
         .iter()
         .map(|(o, p)| looped.insert_scan(*o, p, None))
         .collect();
+    assert_eq!(
+        cells(&looped),
+        cells(&map),
+        "the loop gives the checked map"
+    );
     for threads in [1, 2, 3] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
