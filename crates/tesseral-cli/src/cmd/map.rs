@@ -270,33 +270,21 @@ fn placed<'a>(
     scans: &'a [ScanRecord],
     args: &'a Args,
 ) -> impl Iterator<Item = ([f64; 3], Cow<'a, [[f64; 3]]>)> + 'a {
-    let moved =
-        |pose: Pose, points: &[[f64; 3]]| (pose.translation, Cow::Owned(pose.apply_all(points)));
     scans.iter().map(move |s| {
-        if let Some(o) = args.origin {
-            (o, Cow::Borrowed(s.points.as_slice()))
-        } else if let Some([x, y, z, roll, pitch, yaw]) = args.pose {
-            let pose = Pose {
-                translation: [x, y, z],
-                roll,
-                pitch,
-                yaw,
-            };
-            moved(pose, &s.points)
-        } else {
-            match s.frame {
-                PointFrame::World => (s.translation, Cow::Borrowed(s.points.as_slice())),
-                PointFrame::Sensor => {
-                    let [roll, pitch, yaw] = s.rpy;
-                    let pose = Pose {
-                        translation: s.translation,
-                        roll,
-                        pitch,
-                        yaw,
-                    };
-                    moved(pose, &s.points)
-                }
+        let (translation, [roll, pitch, yaw]) = match (args.origin, args.pose, s.frame) {
+            (Some(o), _, _) => return (o, Cow::Borrowed(s.points.as_slice())),
+            (None, Some([x, y, z, roll, pitch, yaw]), _) => ([x, y, z], [roll, pitch, yaw]),
+            (None, None, PointFrame::World) => {
+                return (s.translation, Cow::Borrowed(s.points.as_slice()))
             }
-        }
+            (None, None, PointFrame::Sensor) => (s.translation, s.rpy),
+        };
+        let pose = Pose {
+            translation,
+            roll,
+            pitch,
+            yaw,
+        };
+        (translation, Cow::Owned(pose.apply_all(&s.points)))
     })
 }

@@ -9,7 +9,7 @@ use rustc_hash::FxHashMap;
 #[cfg(test)]
 use super::dda::JUMPS;
 use super::dda::{exit_block, Dda};
-use super::store::{BlockKey, BLOCK_LOG2};
+use super::store::{cube_index, BlockKey, BLOCK_LOG2};
 
 /// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray
 /// crossing a block touches only its line of miss bits.
@@ -156,11 +156,9 @@ impl Scratch {
     /// (`usize::MAX` when beyond).
     #[inline(always)]
     fn enter(&mut self, b: BlockKey) -> (u32, usize) {
-        let d = [0, 1, 2].map(|i| b[i].wrapping_sub(self.near_lo[i]));
         let n = self.keys.len() as u32;
         debug_assert!(n < FULL - 2, "a scratch holds fewer than 2^31 - 2 blocks");
-        let (i, at) = if (d[0] | d[1] | d[2]) & !(NEAR_SIDE - 1) == 0 {
-            let at = (d[0] | d[1] << NEAR_SIDE_LOG2 | d[2] << (2 * NEAR_SIDE_LOG2)) as usize;
+        let (i, at) = if let Some(at) = cube_index(self.near_lo, NEAR_SIDE_LOG2, b) {
             let mut i = self.near[at];
             if i == NO_SLOT {
                 let clamped = self

@@ -10,7 +10,7 @@ use super::dda::RayOrigin;
 use super::ray::{near_cube, Scratch};
 use super::scan_order::{by_direction, tesseral_order, Place};
 use super::sensor::Pose;
-use super::store::{BlockKey, BLOCK_LOG2};
+use super::store::{cube_index, BlockKey, BLOCK_LOG2};
 use super::{prefetch, OccupancyMap, ScanStats};
 
 /// Rays per rayon task.
@@ -44,10 +44,10 @@ impl Cast {
     }
 }
 
-/// The block of the origin's cell at resolution `res`.
-fn origin_block(res: f64, origin: [f64; 3]) -> BlockKey {
-    let inv = 1.0 / res;
-    origin.map(|c| floor(c * inv) >> BLOCK_LOG2)
+/// The cell holding `p`, `inv` being 1 / resolution (as `OccupancyMap::cell_of`).
+#[inline]
+fn key_at(inv: f64, p: [f64; 3]) -> [i64; 3] {
+    p.map(|c| floor(c * inv))
 }
 
 /// Casts a scan's rays at resolution `res` into per-thread scratches and puts their
@@ -76,9 +76,9 @@ pub(super) fn cast_scan(
     }
     let max_range = max_range.filter(|r| *r >= 0.0);
     let inv = 1.0 / res;
-    let key = move |p: [f64; 3]| p.map(|c| floor(c * inv));
+    let key = move |p: [f64; 3]| key_at(inv, p);
     let key_origin = key(origin);
-    let block_of_origin = origin_block(res, origin);
+    let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
     let rays = RayOrigin::new(origin, key_origin, res);
     let cast = |s: &mut Scratch, p: &[f64; 3]| {
         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
@@ -234,16 +234,15 @@ impl OccupancyMap {
             return None;
         }
         debug_assert!(self.fixed.miss < 0, "a miss lowers a cell's value");
-        let (lo, side_log2) = near_cube(origin_block(self.resolution, origin));
+        let centre = key_at(1.0 / self.resolution, origin).map(|c| c >> BLOCK_LOG2);
+        let (lo, side_log2) = near_cube(centre);
         let mut bits = self.store.uniform_in(lo, side_log2, self.fixed.min);
         for b in pending
             .iter()
             .flat_map(|c| &c.scratches)
             .flat_map(Scratch::hit_blocks)
         {
-            let d = [0, 1, 2].map(|a| b[a].wrapping_sub(lo[a]) as u64);
-            if d.iter().all(|&c| c >> side_log2 == 0) {
-                let at = (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize;
+            if let Some(at) = cube_index(lo, side_log2, b) {
                 bits[at / 64] &= !(1 << (at % 64));
             }
         }

@@ -4,7 +4,7 @@
 use super::arena::UNIT;
 use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
 use super::probe::{sparse_value, LANES};
-use super::{join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
+use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
 use crate::occupancy::prefetch;
 use crate::occupancy::sensor::UNKNOWN;
 
@@ -23,8 +23,8 @@ impl Store {
     }
 
     /// The blocks of the cube of `1 << side_log2` blocks a side from `lo` that are
-    /// stored uniform at `value` (every cell clamped to it), as a bit set: bit
-    /// `x | y << side_log2 | z << 2 side_log2` for the block at `lo + [x, y, z]`.
+    /// stored uniform at `value` (every cell clamped to it), as a bit set indexed by
+    /// [`cube_index`].
     ///
     /// # Runtime
     /// O(t) for the t superblock tables that meet the cube (each entry read once).
@@ -44,10 +44,7 @@ impl Store {
                     };
                     let table = &self.tables[t as usize * TABLE..][..TABLE];
                     for (i, _) in table.iter().enumerate().filter(|(_, &e)| e == want) {
-                        let b = join([sx, sy, sz], i);
-                        let d = [0, 1, 2].map(|a| b[a] - lo[a]);
-                        if d.iter().all(|&c| (0..side).contains(&c)) {
-                            let at = (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize;
+                        if let Some(at) = cube_index(lo, side_log2, join([sx, sy, sz], i)) {
                             bits[at / 64] |= 1 << (at % 64);
                         }
                     }

@@ -48,6 +48,16 @@ fn local(c: [i64; 3]) -> usize {
     l[0] | l[1] << 3 | l[2] << 6
 }
 
+/// The index of block `b` in the cube of `1 << side_log2` blocks a side whose lowest
+/// block is `lo` (x fastest), if `b` lies inside.
+#[inline(always)]
+pub(crate) fn cube_index(lo: BlockKey, side_log2: u32, b: BlockKey) -> Option<usize> {
+    // Below `lo`, the difference wraps past every side.
+    let d = [0, 1, 2].map(|a| b[a].wrapping_sub(lo[a]) as u64);
+    ((d[0] | d[1] | d[2]) >> side_log2 == 0)
+        .then(|| (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize)
+}
+
 /// The cell at index `i` of block `b` (or the block at index `i` of superblock `b`).
 #[inline]
 pub(crate) fn join(b: BlockKey, i: usize) -> [i64; 3] {
@@ -355,13 +365,13 @@ impl Store {
                 let v = (e.0 >> 16) as u16 as i16;
                 // A clamped block that the updates only push further: unchanged.
                 let none = |m: &[u64; 8]| m.iter().all(|&w| w == 0);
-                if (v == fixed.min && none(hit)) || (v == fixed.max && none(miss)) {
-                    return v == fixed.min;
+                let clamped_free = v == fixed.min;
+                if !(clamped_free && none(hit) || v == fixed.max && none(miss)) {
+                    let mut cells = [v; BLOCK_CELLS];
+                    apply_masks(&mut cells, miss, hit, fixed);
+                    self.put_slot(s, &cells, fixed);
                 }
-                let mut cells = [v; BLOCK_CELLS];
-                apply_masks(&mut cells, miss, hit, fixed);
-                self.put_slot(s, &cells, fixed);
-                return v == fixed.min;
+                return clamped_free;
             }
             EMPTY => self.update_empty(s, miss, hit, fixed),
             SPARSE => self.update_sparse(s, e, miss, hit, fixed),
