@@ -79,8 +79,8 @@ impl OccupancyMap {
     /// Inserts one scan: `points` is N×3 (world units), `origin` the sensor position.
     /// Returns the scan's counts: points, rays, skipped (NaN/inf), hits, misses
     /// (cells missed, not counting those of blocks already clamped free, which a
-    /// miss leaves unchanged). A scan whose rays may cross more than `max_cells` cells in all is refused
-    /// (ValueError) before any is cast.
+    /// miss leaves unchanged). A scan whose rays may cross more than `max_cells`
+    /// cells in all is refused (ValueError) before any is cast.
     #[pyo3(signature = (origin, points, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
     fn insert_scan<'py>(
         &mut self,
