@@ -107,9 +107,10 @@ impl TessFile {
                 // (which no writer leaves); such a layer is read whole, so that the
                 // streams never differ from the decoded regions.
                 let canonical = *x.colours_canonical.get_or_init(|| {
-                    regions.iter().flatten().all(|(_, r)| {
-                        crate::linear::is_canonical_stream(r.clone())
-                    })
+                    regions
+                        .iter()
+                        .flatten()
+                        .all(|(_, r)| crate::linear::is_canonical_stream(r.clone()))
                 });
                 Ok(regions.filter(|_| canonical))
             }
