@@ -46,8 +46,11 @@ impl TessFile {
     }
 
     /// The colour regions as streams of leaves, decoded as they are read, for a
-    /// version-2 file whose only layer is colours; `None` when it has other layers
-    /// or is version 1 (read it with [`TessFile::to_model`]).
+    /// file whose only layer is colours, opened streaming if it is version 1;
+    /// `None` when it has other layers, when it is version 1 opened whole, or when
+    /// it is version 1 and a region is not canonical (it holds eight sibling
+    /// leaves in a row, which the whole-file reader merges; checked once, in
+    /// O(colour bytes)): read it with [`TessFile::to_model`].
     ///
     /// # Errors
     /// [`FormatError::Corrupt`] for a bad colour section.
@@ -89,16 +92,28 @@ impl TessFile {
                 },
             )
             .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
-            Body::Payload(bytes, x) => super::tess_colours::colour_regions_flagged(
-                bytes,
-                x.flags,
-                x.sections,
-                x.depth,
-                &|a, b| {
-                    release_map(bytes, a, b);
-                },
-            )
-            .map_err(|m| FormatError::corrupt(m).with_path(&self.path)),
+            Body::Payload(bytes, x) => {
+                let regions = super::tess_colours::colour_regions_flagged(
+                    bytes,
+                    x.flags,
+                    x.sections,
+                    x.depth,
+                    &|a, b| {
+                        release_map(bytes, a, b);
+                    },
+                )
+                .map_err(|m| FormatError::corrupt(m).with_path(&self.path))?;
+                // The whole-file reader merges a region's complete sibling octets
+                // (which no writer leaves); such a layer is read whole, so that the
+                // streams never differ from the decoded regions.
+                let canonical = *x.colours_canonical.get_or_init(|| {
+                    regions
+                        .iter()
+                        .flatten()
+                        .all(|(_, r)| crate::linear::is_canonical_stream(r.clone()))
+                });
+                Ok(regions.filter(|_| canonical))
+            }
             Body::Decoded(_) => Ok(None),
         }
     }

@@ -5,13 +5,22 @@
 //! decoder's resume point each), which play the chunks of a version-2 file. The
 //! leaves are sorted in the payload, so nothing else is needed; the colour layer
 //! is read as streams from the sections after the payload.
+//!
+//! The stretches hold the leaves the whole-file decoder gives, so that a file
+//! has one answer however it is read: a payload with eight sibling leaves in a
+//! row (no writer makes one, but the decoder has always accepted it and merged
+//! them, as it does in a version-2 file) is merged as it is read, each stretch
+//! cut between merged leaves and decoded from the first leaf its first merges
+//! from, past its end as far as it takes to know its last merges no further
+//! (`MergingStream`, holding about seven leaves a level). A colour layer with
+//! such a region is not streamed (see `TessFile::colour_streams`).
 
-use super::chunked::{check_crc, crc_released, RELEASE_STRETCH};
+use super::chunked::{check_crc, crc_released, MERGE_TAIL, RELEASE_STRETCH};
 use super::leafstream::Reader;
 use super::sections::{read_sections, FLAG_FRAME, KNOWN_FLAGS};
 use super::tess_colours::{RegionLeaves, RegionPoint};
 use super::{ChunkInfo, FormatError};
-use crate::linear::{Leaf, LinearOctree, MAX_DEPTH};
+use crate::linear::{Leaf, LinearOctree, MergingStream, MAX_DEPTH};
 use crate::model::Frame;
 use crate::Voxel;
 
@@ -29,6 +38,9 @@ pub(crate) struct V1Index {
     points: Vec<RegionPoint>,
     /// The sections, after the payload and before the checksum.
     pub(crate) sections: (usize, usize),
+    /// Whether every colour region is canonical (found when they are first read
+    /// as streams).
+    pub(crate) colours_canonical: std::sync::OnceLock<bool>,
 }
 
 /// Checks a version-1 file's checksum and header and indexes its payload,
@@ -79,36 +91,36 @@ pub(crate) fn index_v1(
             "leaf count {leaf_count} cannot fit in a payload of {payload_len} bytes"
         ));
     }
-    let payload = RegionLeaves::over(
+    let mut released = HEADER_LEN;
+    let mut payload = RegionLeaves::over(
         body,
         (HEADER_LEN, payload_end),
         leaf_count,
         depth,
         "leaf payload",
     );
-    let mut read_to = HEADER_LEN as u64;
-    let mut released = HEADER_LEN;
-    let stretches = payload
-        .stretches(super::DEFAULT_CHUNK_LEAVES, &mut |pos| {
-            read_to = pos;
-            if pos as usize - released >= RELEASE_STRETCH {
-                done(released, pos as usize);
-                released = pos as usize;
-            }
-        })
-        .map_err(|e| e.to_string())?;
-    if read_to != payload_end as u64 {
+    let index = index_merged(&mut payload, depth, &mut |pos| {
+        if pos - released >= RELEASE_STRETCH {
+            done(released, pos);
+            released = pos;
+        }
+    })
+    .map_err(|e| e.to_string())?;
+    let read_to = payload.offset() as usize;
+    done(released, read_to);
+    if read_to != payload_end {
         return Err(format!(
             "payload has {} byte(s) after the last of {leaf_count} leaves",
-            payload_end as u64 - read_to
+            payload_end - read_to
         ));
     }
-    let (chunks, points) = stretches.into_iter().map(|(c, r)| (c, r.point())).unzip();
+    let (chunks, points) = index;
     let mut tail = Reader {
         bytes: body,
         pos: payload_end,
     };
     let frame = read_sections(&mut tail, flags & FLAG_FRAME, &space)?.frame;
+    let leaf_count = chunks.iter().map(|c: &ChunkInfo| c.count).sum();
     Ok((
         V1Index {
             depth,
@@ -118,15 +130,82 @@ pub(crate) fn index_v1(
             chunks,
             points,
             sections: (payload_end, body_len),
+            colours_canonical: std::sync::OnceLock::new(),
         },
         frame,
     ))
 }
 
-/// The leaves of stretch `i` of the payload, checked.
+/// Reads the payload's leaves, merged into canonical form as the whole-file
+/// decoder merges them (`LinearOctree::from_sorted_leaves`), and cuts them into
+/// stretches of [`super::DEFAULT_CHUNK_LEAVES`] merged leaves, each with the
+/// point where the first leaf it merges from starts. `done(pos)` is called as
+/// the bytes before `pos` are read.
+fn index_merged(
+    payload: &mut RegionLeaves<'_>,
+    depth: u8,
+    done: &mut dyn FnMut(usize),
+) -> Result<(Vec<ChunkInfo>, Vec<RegionPoint>), FormatError> {
+    let n = super::DEFAULT_CHUNK_LEAVES as u64;
+    let mut merging = MergingStream::new(depth);
+    let mut out = Vec::new();
+    let (mut chunks, mut points) = (Vec::<ChunkInfo>::new(), Vec::new());
+    let mut add = |out: &mut Vec<(Leaf, RegionPoint)>| {
+        for (l, p) in out.drain(..) {
+            match chunks.last_mut() {
+                Some(c) if c.count < n => {
+                    c.count += 1;
+                    c.hi = l.end();
+                }
+                _ => {
+                    chunks.push(ChunkInfo {
+                        offset: p.offset(),
+                        lo: l.code(),
+                        hi: l.end(),
+                        count: 1,
+                    });
+                    points.push(p);
+                }
+            }
+        }
+    };
+    loop {
+        let p = payload.point();
+        let Some(l) = payload.next() else { break };
+        merging.push(l?, p, &mut out);
+        add(&mut out);
+        done(payload.offset() as usize);
+    }
+    merging.flush(&mut out);
+    add(&mut out);
+    Ok((chunks, points))
+}
+
+/// The leaves of stretch `i` of the payload, checked and merged: decoded from the
+/// first leaf they merge from, past the stretch's end as far as it takes to know
+/// that its last leaf merges no further.
 pub(crate) fn v1_chunk(bytes: &[u8], index: &V1Index, i: usize) -> Result<Vec<Leaf>, FormatError> {
-    let c = index.chunks[i];
-    RegionLeaves::resume(bytes, index.points[i], index.depth, c.count).collect()
+    let count = index.chunks[i].count as usize;
+    let mut merging = MergingStream::new(index.depth);
+    let mut out = Vec::with_capacity(count + MERGE_TAIL);
+    let mut stored = RegionLeaves::resume(bytes, index.points[i], index.depth, u64::MAX);
+    while out.len() < count {
+        match stored.next() {
+            Some(l) => merging.push(l?, (), &mut out),
+            None => {
+                merging.flush(&mut out);
+                break;
+            }
+        }
+    }
+    if out.len() < count {
+        return Err(FormatError::corrupt(format!(
+            "leaf payload: stretch {i} holds {} leaves where the index counted {count}",
+            out.len()
+        )));
+    }
+    out.truncate(count);
+    Ok(out.into_iter().map(|(l, ())| l).collect())
 }
 
 #[cfg(test)]
@@ -290,3 +369,7 @@ mod tests {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "tess_v1_canonical_tests.rs"]
+mod canonical_tests;

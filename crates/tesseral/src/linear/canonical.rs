@@ -122,3 +122,84 @@ pub(crate) fn push_merging(out: &mut Vec<Leaf>, leaf: Leaf) {
         out.push(Leaf::new(first.code(), first.size_log2() + 1));
     }
 }
+
+/// Sorted, disjoint leaves merged into canonical form as they come, as
+/// [`push_merging`] does, each given out (with the tag of the first leaf it was
+/// merged from) as soon as no later leaf can merge it: when the leaves have passed
+/// the end of its parent, or left a gap before that end. So a stream is made
+/// canonical holding only the leaves that may still merge: about seven per level
+/// for a canonical input.
+///
+/// # Runtime
+/// O(1) amortized per leaf, plus O(held) when leaves are given out.
+pub(crate) struct MergingStream<T> {
+    held: Vec<Leaf>,
+    tags: Vec<T>,
+    /// The end of the last leaf pushed.
+    end: Option<u64>,
+    depth: u8,
+}
+
+impl<T: Copy> MergingStream<T> {
+    /// An empty stream of a depth-`depth` space.
+    pub(crate) fn new(depth: u8) -> Self {
+        Self {
+            held: Vec::new(),
+            tags: Vec::new(),
+            end: None,
+            depth,
+        }
+    }
+
+    /// Adds the next leaf (at or after the end of the one before it), tagged `tag`,
+    /// and appends to `out` the merged leaves that are final.
+    pub(crate) fn push(&mut self, leaf: Leaf, tag: T, out: &mut Vec<(Leaf, T)>) {
+        if self.end.is_some_and(|e| e != leaf.code()) {
+            // A gap: no parent of a held leaf can be completed any more.
+            self.flush(out);
+        }
+        self.end = Some(leaf.end());
+        push_merging(&mut self.held, leaf);
+        self.tags.push(tag);
+        // A merged leaf keeps the tag of its first child, which sits where it does.
+        self.tags.truncate(self.held.len());
+        let end = leaf.end();
+        let done = self
+            .held
+            .iter()
+            .take_while(|l| {
+                let k = u32::from(l.size_log2()) + 1;
+                k > u32::from(self.depth) || {
+                    let parent_end = (l.code() >> (3 * k) << (3 * k)) + (1u64 << (3 * k));
+                    end >= parent_end
+                }
+            })
+            .count();
+        out.extend(self.held.drain(..done).zip(self.tags.drain(..done)));
+    }
+
+    /// Appends every held leaf to `out` (at the end of the stream).
+    pub(crate) fn flush(&mut self, out: &mut Vec<(Leaf, T)>) {
+        out.extend(self.held.drain(..).zip(self.tags.drain(..)));
+    }
+}
+
+/// Whether sorted, disjoint leaves are canonical: no eight of them, one after
+/// another, complete their parent (the first merge [`push_merging`] would make is
+/// of eight leaves in a row). Stops at the first error of `leaves`, which it
+/// leaves to the reader.
+///
+/// # Runtime
+/// O(n).
+pub(crate) fn is_canonical_stream<E>(leaves: impl Iterator<Item = Result<Leaf, E>>) -> bool {
+    let mut last = [Leaf::new(0, 0); 8];
+    for (i, l) in leaves.enumerate() {
+        let Ok(l) = l else { return true };
+        last.copy_within(1.., 0);
+        last[7] = l;
+        if i >= 7 && completes_parent_fast(&last) {
+            return false;
+        }
+    }
+    true
+}

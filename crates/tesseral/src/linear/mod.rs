@@ -11,7 +11,7 @@ mod bbox;
 mod box_state;
 mod canonical;
 use canonical::completes_parent;
-pub(crate) use canonical::push_merging;
+pub(crate) use canonical::{is_canonical_stream, push_merging, MergingStream};
 mod bricked;
 mod bricks;
 mod build;
