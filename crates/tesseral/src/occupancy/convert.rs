@@ -130,6 +130,7 @@ impl OccupancyMap {
         for (v, x) in cells {
             map.store.set(v, x, fixed);
         }
+        map.store.settle();
         Ok(map)
     }
 }

@@ -46,6 +46,8 @@ mod tests_clamped;
 #[cfg(test)]
 mod tests_dense;
 #[cfg(test)]
+mod tests_flat;
+#[cfg(test)]
 mod tests_lookup;
 #[cfg(test)]
 mod tests_map;
@@ -178,10 +180,10 @@ impl OccupancyMap {
     /// A cell's state.
     ///
     /// # Runtime
-    /// O(1): the superblock's table found by index arithmetic in a dense directory
-    /// (or one hash probe when the map's superblocks lie far apart), one table load,
-    /// one or two loads in the block (a binary search over its cells in a sparse
-    /// block).
+    /// O(1): the block's entry found by index arithmetic in the read index over the
+    /// blocks' bounding box (or, while that is not built, through the superblock
+    /// directory: index arithmetic or one hash probe, then a table load), then one
+    /// or two loads in the block (compares over a sparse block's cells).
     #[must_use]
     #[inline]
     pub fn state(&self, cell: [i64; 3]) -> CellState {
@@ -250,6 +252,10 @@ impl OccupancyMap {
     }
 
     /// Sets a cell's log-odds (clamped), or forgets it with `None`.
+    ///
+    /// A cell in a new block outside the bounding box of the map's blocks retires
+    /// the read index that lookups use: they go through the superblock directory
+    /// (a little slower) until the next scan inserted rebuilds it.
     pub fn set_log_odds(&mut self, cell: [i64; 3], l: Option<f32>) {
         let v = l.map_or(UNKNOWN, |l| self.fixed.quantise(l));
         self.store.set(cell, v, self.fixed);

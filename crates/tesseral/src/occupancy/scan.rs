@@ -149,7 +149,9 @@ impl OccupancyMap {
     ) -> ScanStats {
         let clamped = self.clamped_near(origin, None);
         let cast = cast_scan(self.resolution, origin, points, max_range, clamped);
-        self.apply_cast(cast)
+        let stats = self.apply_cast(cast);
+        self.store.settle();
+        stats
     }
 
     /// Inserts scans in the order given, each from its origin, and gives each one's
@@ -215,6 +217,7 @@ impl OccupancyMap {
         }
         if let Some(cast) = pending {
             let stats = self.apply_cast(cast);
+            self.store.settle();
             each(self, stats)?;
         }
         Ok(())
@@ -252,6 +255,7 @@ impl OccupancyMap {
     /// Applies a cast scan to the map; gives its counts.
     pub(super) fn apply_cast(&mut self, cast: Cast) -> ScanStats {
         let (hits, misses) = self.apply(&cast.scratches, &cast.order);
+        self.store.worked(hits + misses);
         ScanStats {
             hits,
             misses,

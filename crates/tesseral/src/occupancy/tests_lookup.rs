@@ -1,5 +1,6 @@
 //! Lookups (`Store::get`, the batched `Store::get_many`, `OccupancyMap::log_odds_many`)
-//! through the dense superblock directory and its hash-map fallback, against a
+//! through the read index (live, then mirroring writes or retired by a block outside
+//! its box), the dense superblock directory and its hash-map fallback, against a
 //! `HashMap` of cells; and the arena's limit.
 
 use std::collections::HashMap;
@@ -74,7 +75,12 @@ fn probes(rng: &mut Pcg64, model: &HashMap<[i64; 3], i16>, blocks: &[[i64; 3]]) 
 
 /// Every probe through `get` and `get_many` (in slices of odd lengths) agrees with
 /// the model.
-fn check_lookups(store: &Store, model: &HashMap<[i64; 3], i16>, probes: &[[i64; 3]], what: &str) {
+pub(super) fn check_lookups(
+    store: &Store,
+    model: &HashMap<[i64; 3], i16>,
+    probes: &[[i64; 3]],
+    what: &str,
+) {
     let want: Vec<i16> = probes
         .iter()
         .map(|c| model.get(c).copied().unwrap_or(UNKNOWN))
@@ -91,6 +97,12 @@ fn check_lookups(store: &Store, model: &HashMap<[i64; 3], i16>, probes: &[[i64; 
     }
 }
 
+/// Random updates of every kind to a store, each followed by `assert_valid` and
+/// lookups against the model; the read index rebuilt (`settle`) after one
+/// operation in five (or only asked to, when too little work was done since the
+/// last rebuild), so that later ones are mirrored in it or retire it. `dense`:
+/// whether the directory and the read index end up dense (live after a last
+/// `settle`).
 fn run(seed: u64, layout: Layout, dense: Option<bool>) {
     let fixed = Fixed::new(&SensorModel::octomap());
     let mut rng = Pcg64::seed_from_u64(seed);
@@ -159,8 +171,18 @@ fn run(seed: u64, layout: Layout, dense: Option<bool>) {
                 }
             }
         }
+        if rng.random_range(0..5) == 0 {
+            // Half the time with the work that pays for a rebuild.
+            if rng.random_range(0..2) == 0 {
+                store.worked(u64::MAX);
+            }
+            store.settle();
+        }
         store.assert_valid(fixed);
-        let what = format!("seed {seed} {layout:?} op {op}");
+        let what = format!(
+            "seed {seed} {layout:?} op {op} (read index live: {})",
+            store.flat_live()
+        );
         // The block just changed, and now and then every probe.
         let changed: Vec<[i64; 3]> = (0..512).map(cell).collect();
         check_lookups(&store, &model, &changed, &what);
@@ -171,8 +193,22 @@ fn run(seed: u64, layout: Layout, dense: Option<bool>) {
     }
     let p = probes(&mut rng, &model, &blocks);
     check_lookups(&store, &model, &p, &format!("seed {seed} {layout:?}"));
+    store.worked(u64::MAX);
+    store.settle();
+    store.assert_valid(fixed);
+    check_lookups(
+        &store,
+        &model,
+        &p,
+        &format!("seed {seed} {layout:?} settled"),
+    );
     if let Some(dense) = dense {
         assert_eq!(store.dense_directory(), dense, "seed {seed} {layout:?}");
+        assert_eq!(
+            store.flat_live(),
+            dense,
+            "seed {seed} {layout:?}: read index"
+        );
     }
 }
 

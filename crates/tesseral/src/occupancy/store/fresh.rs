@@ -79,9 +79,7 @@ impl Store {
         }
         if let [(_, v, _)] = present[..] {
             if v == fixed.min || v == fixed.max {
-                self.clear(s);
-                self.tables[s] = Entry::uniform(v);
-                self.blocks += 1;
+                self.set_uniform(s, v);
                 return;
             }
         }

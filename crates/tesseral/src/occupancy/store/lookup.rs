@@ -1,5 +1,6 @@
 //! Reading cells: one at a time ([`Store::get`]) or in batches whose memory
-//! accesses are prefetched in passes ([`Store::get_many`]).
+//! accesses are prefetched in passes ([`Store::get_many`]), through the read
+//! index ([`super::flat`]) while it is live, else the directory and the tables.
 
 use super::arena::UNIT;
 use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
@@ -16,9 +17,22 @@ impl Store {
     #[inline(always)]
     pub fn get(&self, cell: [i64; 3]) -> i16 {
         let (b, i) = split(cell);
-        match self.find(b) {
-            Some(s) => self.value(self.tables[s], i),
+        let (entries, at) = self.locate(b);
+        match at {
+            Some(at) => self.value(entries[at], i),
             None => UNKNOWN,
+        }
+    }
+
+    /// Where block `b`'s entry is read: the read index while it is live (the
+    /// entry straight from the block's key), else the tables through the
+    /// directory. `None` for a block with no entry.
+    #[inline(always)]
+    fn locate(&self, b: BlockKey) -> (&[Entry], Option<usize>) {
+        if self.flat.live() {
+            (self.flat.entries(), self.flat.index(b))
+        } else {
+            (&self.tables, self.find(b))
         }
     }
 
@@ -99,15 +113,16 @@ impl Store {
         assert_eq!(cells.len(), out.len(), "as many values as cells");
         let mut slots = [usize::MAX; BATCH];
         let mut entries = [Entry::EMPTY; BATCH];
+        let from = self.locate([0; 3]).0;
         for (cells, out) in cells.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
             for (s, &c) in slots.iter_mut().zip(cells) {
-                *s = self.find(split(c).0).unwrap_or(usize::MAX);
-                if let Some(e) = self.tables.get(*s) {
+                *s = self.locate(split(c).0).1.unwrap_or(usize::MAX);
+                if let Some(e) = from.get(*s) {
                     prefetch(e);
                 }
             }
             for ((e, &s), &c) in entries.iter_mut().zip(&slots).zip(cells) {
-                *e = self.tables.get(s).copied().unwrap_or(Entry::EMPTY);
+                *e = from.get(s).copied().unwrap_or(Entry::EMPTY);
                 self.prefetch_cell(*e, local(c));
             }
             for ((o, &e), &c) in out.iter_mut().zip(&entries).zip(cells) {

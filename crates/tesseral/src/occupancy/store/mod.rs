@@ -7,16 +7,19 @@
 
 mod arena;
 mod dir;
+mod flat;
 mod forms;
 mod fresh;
 mod lookup;
 mod probe;
 mod sparse;
 mod valid;
+mod visit;
 
 use super::sensor::{Fixed, UNKNOWN};
 use arena::{Arena, UNIT};
 use dir::Directory;
+use flat::Flat;
 use forms::{
     apply_masks, choose, decode, palette_single, palette_update, units_of, write_dense,
     write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
@@ -140,6 +143,10 @@ pub(crate) struct Store {
     tables: Vec<Entry>,
     /// The blocks that are not uniform.
     arena: Arena,
+    /// Every block's entry over the blocks' bounding box, for lookups (see [`flat`]).
+    flat: Flat,
+    /// Cells updated since the read index was last built (see [`Store::settle`]).
+    work: u64,
     /// Blocks stored (entries not empty).
     blocks: usize,
     /// The last superblock updated and its number (scans update blocks in order).
@@ -216,6 +223,7 @@ impl Store {
 
     /// Sets one cell.
     pub fn set(&mut self, cell: [i64; 3], v: i16, fixed: Fixed) {
+        self.work = self.work.saturating_add(1);
         let (b, i) = split(cell);
         if self.get(cell) == v {
             return;
@@ -235,11 +243,25 @@ impl Store {
         if e != Entry::EMPTY {
             self.blocks -= 1;
         }
-        self.tables[s] = Entry::EMPTY;
+        self.set_entry(s, Entry::EMPTY);
         // A quarter of the arena free (and more than a few KiB): compact.
         if self.arena.free_units * 4 > self.arena.len_units() && self.arena.free_units > 256 {
             self.compact();
         }
+    }
+
+    /// Writes slot `s`'s entry, mirrored in the read index.
+    #[inline]
+    fn set_entry(&mut self, s: usize, e: Entry) {
+        self.tables[s] = e;
+        self.flat.set(join(self.keys[s / TABLE], s % TABLE), e);
+    }
+
+    /// Makes slot `s` a uniform block of value `v` (a clamp), freeing its storage.
+    pub(super) fn set_uniform(&mut self, s: usize, v: i16) {
+        self.clear(s);
+        self.set_entry(s, Entry::uniform(v));
+        self.blocks += 1;
     }
 
     /// Gives slot `s` (emptied first) a new block of `units` units with this tag;
@@ -259,7 +281,7 @@ impl Store {
             // Clearing may compact the arena, which only makes room.
             self.arena.alloc(units).expect("room checked")
         };
-        self.tables[s] = Entry::at(tag, at);
+        self.set_entry(s, Entry::at(tag, at));
         Some(self.arena.get_mut(at, units * UNIT))
     }
 
@@ -285,13 +307,14 @@ impl Store {
     fn compact(&mut self) {
         let used = self.arena.len_units() - self.arena.free_units;
         let mut words = Vec::with_capacity((used + used / 8) * UNIT);
-        for e in &mut self.tables {
+        for (s, e) in self.tables.iter_mut().enumerate() {
             if e.in_arena() {
                 let from = e.offset() as usize * UNIT;
                 let len = units_of(e.tag(), &self.arena.words[from..]) * UNIT;
                 let at = (words.len() / UNIT) as u32;
                 words.extend_from_slice(&self.arena.words[from..from + len]);
                 *e = Entry::at(e.tag(), at);
+                self.flat.set(join(self.keys[s / TABLE], s % TABLE), *e);
             }
         }
         self.arena = Arena {
@@ -318,9 +341,7 @@ impl Store {
         }
         if let [v] = census.values[..] {
             if v == fixed.min || v == fixed.max {
-                self.clear(s);
-                self.tables[s] = Entry::uniform(v);
-                self.blocks += 1;
+                self.set_uniform(s, v);
                 return;
             }
         }
@@ -390,9 +411,7 @@ impl Store {
                 if palette_update(words, w, miss, hit, fixed) {
                     if let Some(v) = palette_single(words, w) {
                         if v == fixed.min || v == fixed.max {
-                            self.clear(s);
-                            self.tables[s] = Entry::uniform(v);
-                            self.blocks += 1;
+                            self.set_uniform(s, v);
                         }
                     }
                 } else {
@@ -409,58 +428,6 @@ impl Store {
     /// Reserves room for `n` more blocks.
     pub fn reserve(&mut self, n: usize) {
         self.dir.reserve(n / TABLE);
-    }
-
-    /// Calls `f` on every block's known cells: `(index in block, value)`, or once
-    /// with `None` and the value of a uniform block.
-    fn visit(&self, mut f: impl FnMut(BlockKey, Option<usize>, i16)) {
-        let mut cells = [UNKNOWN; BLOCK_CELLS];
-        for (t, &key) in self.keys.iter().enumerate() {
-            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
-                let b = join(key, l);
-                match e.tag() {
-                    EMPTY => {}
-                    UNIFORM => f(b, None, (e.0 >> 16) as u16 as i16),
-                    tag => {
-                        decode(tag, self.words_of(e), &mut cells);
-                        for (i, &v) in cells.iter().enumerate() {
-                            if v != UNKNOWN {
-                                f(b, Some(i), v);
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-
-    /// Counts the known cells whose value passes `f`.
-    pub fn count(&self, f: impl Fn(i16) -> bool) -> u64 {
-        let mut n = 0u64;
-        self.visit(|_, i, v| {
-            if f(v) {
-                n += if i.is_some() { 1 } else { BLOCK_CELLS as u64 };
-            }
-        });
-        n
-    }
-
-    pub fn leaf_count(&self) -> u64 {
-        let mut n = 0u64;
-        self.visit(|_, _, _| n += 1);
-        n
-    }
-
-    pub fn block_count(&self) -> usize {
-        self.blocks
-    }
-
-    /// Calls `f` on every known cell, in no order.
-    pub fn for_each(&self, mut f: impl FnMut([i64; 3], i16)) {
-        self.visit(|b, i, v| match i {
-            Some(i) => f(join(b, i), v),
-            None => (0..BLOCK_CELLS).for_each(|i| f(join(b, i), v)),
-        });
     }
 
     /// Whether lookups go through the dense directory (not the hash map).
@@ -481,13 +448,14 @@ impl Store {
         self.compactions
     }
 
-    /// Bytes held: the directory, tables and keys, the arena (capacities) and the
-    /// merge buffer.
+    /// Bytes held: the directory, tables and keys, the arena, the read index
+    /// (capacities) and the merge buffer.
     pub fn bytes(&self) -> usize {
         self.dir.bytes()
             + self.keys.capacity() * std::mem::size_of::<BlockKey>()
             + self.tables.capacity() * std::mem::size_of::<Entry>()
             + self.arena.bytes()
+            + self.flat.bytes()
             + self.scratch.capacity() * 4
     }
 }

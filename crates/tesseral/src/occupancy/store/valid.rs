@@ -21,6 +21,13 @@ impl Store {
     /// When an invariant is broken.
     pub fn assert_valid(&self, fixed: Fixed) {
         self.dir.assert_valid(&self.keys);
+        self.flat.assert_valid(
+            self.tables
+                .iter()
+                .enumerate()
+                .filter(|(_, &e)| e != super::Entry::EMPTY)
+                .map(|(s, &e)| (join(self.keys[s / TABLE], s % TABLE), e)),
+        );
         assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
         if let Some((k, t)) = self.last {
             assert_eq!(self.dir.get(k), Some(t), "the last superblock");
