@@ -12,6 +12,12 @@
 //! - It is built only while it takes at most half the bytes of the rest of the
 //!   store (or [`FLAT_MIN`] bytes): a map whose blocks lie far apart keeps the
 //!   directory alone.
+//! - And at most [`FLAT_MAX`] bytes: in a map far bigger than the CPU's caches a
+//!   lookup misses the cache on the block's entry either way (the table's or the
+//!   index's) and again in the block, so the index would save only the directory
+//!   slot, which stays cached, while it cost memory (106 MB beside the 261 MB of
+//!   the outdoor benchmark's map, with no faster lookups measured) and a rebuild
+//!   (0.13 s, 5 % of that map's insertion).
 //! - A rebuild waits until the cells updated since the last one number
 //!   [`AMORTISE`] times the new box's blocks. A rebuild costs 1 to 5 ns a block
 //!   (the latter when its pages are new to the process), an updated cell 15 to
@@ -22,6 +28,9 @@ use super::{join, BlockKey, Entry, Store, TABLE};
 
 /// Bytes the index may always take, whatever the store's size (16 KiB).
 const FLAT_MIN: usize = 16 << 10;
+/// Bytes the index never passes (8 MiB: two million blocks, a box of 126³ blocks,
+/// 50 m a side at 5 cm).
+const FLAT_MAX: usize = 8 << 20;
 /// The read index is rebuilt once AMORTISE times as many cells were updated since it
 /// was last built as it would hold blocks (see [`Store::settle`]).
 const AMORTISE: u64 = 2;
@@ -186,7 +195,7 @@ impl Store {
         if self.flat.live() {
             return;
         }
-        let Some(plan) = self.flat.plan(self.bytes() / 2) else {
+        let Some(plan) = self.flat.plan((self.bytes() / 2).min(FLAT_MAX)) else {
             return;
         };
         if self.work < (plan.2 as u64).saturating_mul(AMORTISE) {
