@@ -36,6 +36,16 @@ impl Store {
         }
     }
 
+    /// The entries that [`locate`](Self::locate) gives positions in.
+    #[inline]
+    fn read_entries(&self) -> &[Entry] {
+        if self.flat.live() {
+            self.flat.entries()
+        } else {
+            &self.tables
+        }
+    }
+
     /// The blocks of the cube of `1 << side_log2` blocks a side from `lo` that are
     /// stored uniform at `value` (every cell clamped to it), as a bit set indexed by
     /// [`cube_index`].
@@ -113,7 +123,7 @@ impl Store {
         assert_eq!(cells.len(), out.len(), "as many values as cells");
         let mut slots = [usize::MAX; BATCH];
         let mut entries = [Entry::EMPTY; BATCH];
-        let from = self.locate([0; 3]).0;
+        let from = self.read_entries();
         for (cells, out) in cells.chunks(BATCH).zip(out.chunks_mut(BATCH)) {
             for (s, &c) in slots.iter_mut().zip(cells) {
                 *s = self.locate(split(c).0).1.unwrap_or(usize::MAX);

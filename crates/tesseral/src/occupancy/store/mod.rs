@@ -61,6 +61,12 @@ pub(crate) fn cube_index(lo: BlockKey, side_log2: u32, b: BlockKey) -> Option<us
         .then(|| (d[0] | d[1] << side_log2 | d[2] << (2 * side_log2)) as usize)
 }
 
+/// The block of slot `s` of the tables, whose superblocks' keys are `keys`.
+#[inline]
+fn block_of(keys: &[BlockKey], s: usize) -> BlockKey {
+    join(keys[s / TABLE], s % TABLE)
+}
+
 /// The cell at index `i` of block `b` (or the block at index `i` of superblock `b`).
 #[inline]
 pub(crate) fn join(b: BlockKey, i: usize) -> [i64; 3] {
@@ -254,7 +260,7 @@ impl Store {
     #[inline]
     fn set_entry(&mut self, s: usize, e: Entry) {
         self.tables[s] = e;
-        self.flat.set(join(self.keys[s / TABLE], s % TABLE), e);
+        self.flat.set(block_of(&self.keys, s), e);
     }
 
     /// Makes slot `s` a uniform block of value `v` (a clamp), freeing its storage.
@@ -314,7 +320,7 @@ impl Store {
                 let at = (words.len() / UNIT) as u32;
                 words.extend_from_slice(&self.arena.words[from..from + len]);
                 *e = Entry::at(e.tag(), at);
-                self.flat.set(join(self.keys[s / TABLE], s % TABLE), *e);
+                self.flat.set(block_of(&self.keys, s), *e);
             }
         }
         self.arena = Arena {

@@ -5,7 +5,7 @@ use super::forms::{
     bits_words, palette_index, sparse_units, units_of, DENSE, EMPTY, PALETTE, SPARSE,
     SPARSE_VALUES, UNIFORM,
 };
-use super::{join, Store, BLOCK_CELLS, TABLE};
+use super::{block_of, Store, BLOCK_CELLS, TABLE};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
 impl Store {
@@ -26,7 +26,7 @@ impl Store {
                 .iter()
                 .enumerate()
                 .filter(|(_, &e)| e != super::Entry::EMPTY)
-                .map(|(s, &e)| (join(self.keys[s / TABLE], s % TABLE), e)),
+                .map(|(s, &e)| (block_of(&self.keys, s), e)),
         );
         assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
         if let Some((k, t)) = self.last {
@@ -59,7 +59,7 @@ impl Store {
         let mut blocks = 0;
         let mut cells = [UNKNOWN; BLOCK_CELLS];
         for (s, &e) in self.tables.iter().enumerate() {
-            let b = join(self.keys[s / TABLE], s % TABLE);
+            let b = block_of(&self.keys, s);
             match e.tag() {
                 EMPTY => {
                     assert_eq!(e.0, 0, "block {b:?}: empty entry with bits");
