@@ -18,7 +18,9 @@
 //! clamped to the same value: the entry alone, as OctoMap prunes), *sparse* (its
 //! known cells, 2 bytes each, and up to six distinct values), a *palette* (1, 2, 4
 //! or 8 bits a cell and a list of the values) or *dense* (512 log-odds), whichever
-//! is smallest, in one arena; log-odds are `i16` fixed point.
+//! is smallest, in one of two arenas (blocks that list an occupied value, and the
+//! others, so that the surfaces most lookups land on lie together); log-odds are
+//! `i16` fixed point.
 //! Unknown blocks are not stored. See `ARCHITECTURE.md` for why.
 //!
 //! ```
@@ -76,11 +78,12 @@ pub enum OccupancyError {
     /// A model cannot be read as a map (its frame, or its extent).
     #[error("model: {0}")]
     Model(String),
-    /// The map's blocks outgrew the most its arena addresses (8 GiB of blocks, as
-    /// far as a block entry's offset reaches): the updates of the blocks that did not
-    /// fit were dropped, the map is otherwise valid.
+    /// The map's blocks outgrew the most one of its two arenas addresses (4 GiB of
+    /// blocks each, as far as a block entry's offset reaches): the updates of the
+    /// blocks that did not fit were dropped, the map is otherwise valid.
     #[error(
-        "the map's blocks would pass {limit_bytes} bytes, the most a map addresses: \
+        "the map's blocks would pass {limit_bytes} bytes in one of its two arenas, \
+         the most an arena addresses: \
          some updates were dropped (use a coarser resolution or a shorter max range, \
          or split the scans into several maps)"
     )]
@@ -240,7 +243,8 @@ impl OccupancyMap {
     ///
     /// # Errors
     /// [`OccupancyError::Capacity`] once a block was refused because the map's blocks
-    /// would pass 8 GiB (the most a block entry addresses): the updates to that block
+    /// would pass 4 GiB in one of its two arenas (the most a block entry addresses:
+    /// those of occupied surfaces, and the others): the updates to that block
     /// were dropped, the map is otherwise valid. Check after each scan.
     pub fn check_capacity(&self) -> Result<(), OccupancyError> {
         if self.store.overflowed() {
@@ -305,8 +309,9 @@ impl OccupancyMap {
     }
 
     /// Checks the invariants: the directory and its tables agree; every uniform
-    /// block is clamped; no block is all unknown or uniformly clamped; the arena's
-    /// blocks and free chunks tile it without overlap; sparse blocks list their cells
+    /// block is clamped; no block is all unknown or uniformly clamped; each arena's
+    /// blocks and free chunks tile it without overlap; a block lies in the arena of
+    /// surfaces if and only if it lists an occupied value; sparse blocks list their cells
     /// in order; palette numbers lie in their value lists; every known value lies in
     /// the clamps.
     ///

@@ -201,3 +201,63 @@ fn blocks_take_the_smallest_form() {
     store.assert_valid(fixed);
     assert_eq!(store.block_count(), 1);
 }
+
+/// Blocks that list an occupied value live in their own arena: a new block with a
+/// hit, a palette updated in place that gains an occupied value (moved), a block
+/// rewritten without one (moved back); a scan's blocks end where they should.
+#[test]
+fn blocks_that_list_an_occupied_value_move_to_their_own_arena() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut store = Store::default();
+    let b = [2, -1, 0];
+    let all = [u64::MAX; 8];
+    let none = [0u64; 8];
+    let mut one = [0u64; 8];
+    one[0] = 1 << 5;
+    // Every cell missed once: a 1-bit palette of one free value.
+    store.update(b, &all, &none, fixed);
+    store.assert_valid(fixed);
+    assert_eq!(store.entry(b).map(|e| e.kind()), Some(Kind::Palette(1)));
+    assert_eq!(store.in_occupied_arena(b), Some(false));
+    // Cell 5 hit: updated in place (a second value fits), now occupied: moved.
+    store.update(b, &none, &one, fixed);
+    store.assert_valid(fixed);
+    assert_eq!(store.entry(b).map(|e| e.kind()), Some(Kind::Palette(1)));
+    assert!(store.get(cell_of(b, 5)) >= fixed.threshold);
+    assert_eq!(store.in_occupied_arena(b), Some(true));
+    // Cell 5 freed: the block rewritten lists no occupied value and moves back.
+    store.set(cell_of(b, 5), fixed.miss, fixed);
+    store.assert_valid(fixed);
+    assert_eq!(store.in_occupied_arena(b), Some(false));
+    // New blocks: a hit places the block with the occupied ones, misses alone not.
+    let (c, d) = ([40, 0, 0], [41, 0, 0]);
+    store.update(c, &none, &one, fixed);
+    store.update(d, &one, &none, fixed);
+    store.assert_valid(fixed);
+    assert_eq!(store.entry(c).map(|e| e.kind()), Some(Kind::Sparse));
+    assert_eq!(store.in_occupied_arena(c), Some(true));
+    assert_eq!(store.in_occupied_arena(d), Some(false));
+    // Random updates: `assert_valid` checks every block's arena after each.
+    let mut rng = Pcg64::seed_from_u64(11);
+    for _ in 0..3000 {
+        let b = BLOCKS[rng.random_range(0..BLOCKS.len())];
+        let mut miss = [0u64; 8];
+        let mut hit = [0u64; 8];
+        for _ in 0..rng.random_range(1..40) {
+            let i = rng.random_range(0..512);
+            if rng.random_range(0..4) == 0 {
+                hit[i >> 6] |= 1 << (i & 63);
+            } else {
+                miss[i >> 6] |= 1 << (i & 63);
+            }
+        }
+        for w in 0..8 {
+            miss[w] &= !hit[w];
+        }
+        store.update(b, &miss, &hit, fixed);
+        store.assert_valid(fixed);
+    }
+    assert!(BLOCKS
+        .iter()
+        .any(|&b| store.in_occupied_arena(b) == Some(true)));
+}

@@ -1,11 +1,12 @@
-//! The arena that holds every non-uniform block: one `Vec<u16>` cut into units of 16
-//! bytes, with a free list per size (the store compacts it once a quarter is free).
+//! An arena of non-uniform blocks (the store keeps two): one `Vec<u16>` cut into
+//! units of 16 bytes, with a free list per size (the store compacts it once a
+//! quarter is free).
 
 /// `u16` words per unit.
 pub(crate) const UNIT: usize = 8;
 
-/// The most units the arena addresses (29 bits of a block entry): 8 GiB.
-pub(crate) const MAX_UNITS: usize = 1 << 29;
+/// The most units an arena addresses (28 bits of a block entry): 4 GiB.
+pub(crate) const MAX_UNITS: usize = 1 << 28;
 
 #[derive(Debug, Clone)]
 pub(crate) struct Arena {
@@ -43,8 +44,8 @@ impl Arena {
     }
 
     /// A chunk of `units` units (contents unspecified), as its offset in units, or
-    /// `None` when the arena would pass its limit (at most [`MAX_UNITS`], 8 GiB of
-    /// blocks, as far as a block entry's 29 bits of offset reach).
+    /// `None` when the arena would pass its limit (at most [`MAX_UNITS`], 4 GiB of
+    /// blocks, as far as a block entry's 28 bits of offset reach).
     pub fn alloc(&mut self, units: usize) -> Option<u32> {
         if let Some(at) = self.free.get_mut(units).and_then(Vec::pop) {
             self.free_units -= units;

@@ -103,6 +103,29 @@ pub(crate) fn units_of(tag: u32, words: &[u16]) -> usize {
     }
 }
 
+/// Whether one of `values` is occupied (known and at least the threshold).
+#[inline]
+pub(crate) fn any_occupied(values: impl IntoIterator<Item = i16>, fixed: Fixed) -> bool {
+    values
+        .into_iter()
+        .any(|v| v != UNKNOWN && v >= fixed.threshold)
+}
+
+/// Whether an arena block (tag and words from its offset) lists an occupied value:
+/// in the values of a sparse block's header or of a palette block's list (a value
+/// listed may no longer be any cell's), in the cells of a dense block.
+pub(crate) fn lists_occupied(tag: u32, words: &[u16], fixed: Fixed) -> bool {
+    let listed = match tag {
+        SPARSE => &words[2..2 + usize::from(words[1])],
+        DENSE => &words[..BLOCK_CELLS],
+        _ => {
+            let at = bits_words(1 << (tag - PALETTE));
+            &words[at + 1..at + 1 + usize::from(words[at])]
+        }
+    };
+    any_occupied(listed.iter().map(|&v| v as i16), fixed)
+}
+
 /// The 512 values of a block in the arena (tag and words from its offset).
 pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
     match tag {

@@ -6,7 +6,7 @@
 //! cell `i`).
 
 use super::arena::UNIT;
-use super::forms::{bits_words, choose, write_sparse, PALETTE, SPARSE};
+use super::forms::{any_occupied, bits_words, choose, write_sparse, PALETTE, SPARSE};
 use super::{Entry, Store, BLOCK_CELLS};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
@@ -54,6 +54,7 @@ impl Store {
         }
         present.sort_unstable_by_key(|p| p.0);
         let k = present.len() - usize::from(n < BLOCK_CELLS);
+        let occupied = any_occupied(present.iter().map(|p| p.1), fixed);
         let (tag, units) = choose(n, present.len(), k);
         if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
             let mut list = std::mem::take(&mut self.scratch);
@@ -71,7 +72,7 @@ impl Store {
                     bits &= bits - 1;
                 }
             }
-            if let Some(words) = self.place(s, SPARSE, units) {
+            if let Some(words) = self.place(s, SPARSE, units, occupied) {
                 write_sparse(words, &list);
             }
             self.scratch = list;
@@ -97,7 +98,7 @@ impl Store {
             })
         };
         // A full arena refuses the block (the store remembers it: `overflowed`).
-        let Some(words) = self.place(s, tag, units) else {
+        let Some(words) = self.place(s, tag, units, occupied) else {
             return;
         };
         words.fill(0);

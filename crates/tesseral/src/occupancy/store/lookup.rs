@@ -89,7 +89,7 @@ impl Store {
                 (e.0 >> 16) as u16 as i16
             };
         }
-        let words = &self.arena.words;
+        let words = &self.arenas[e.arena()].words;
         let at = e.offset() as usize * UNIT;
         if tag == SPARSE {
             // Compares, not a binary search (see `probe`).
@@ -161,7 +161,7 @@ impl Store {
                 (at + ((i * w) >> 4), at + bits_words(w as u32) + 1)
             }
         };
-        let words = &self.arena.words;
+        let words = &self.arenas[e.arena()].words;
         for k in [a, b] {
             if let Some(x) = words.get(k) {
                 prefetch(x);

@@ -1,9 +1,16 @@
 //! Blocks of 8×8×8 cells, found through a two-level directory (superblocks of
-//! 8×8×8 blocks, each a flat table of 512 block entries) and held in
-//! one arena in the smallest of four forms: uniform (in the entry), sparse, palette
-//! (1, 2, 4 or 8 bits a cell and a value list) or dense (see [`forms`]). The
-//! directory is dense over the superblocks' bounding box while that box is small
-//! enough, a hash map otherwise (see [`dir`]); reads are in [`lookup`].
+//! 8×8×8 blocks, each a flat table of 512 block entries) and held in the smallest
+//! of four forms: uniform (in the entry), sparse, palette (1, 2, 4 or 8 bits a cell
+//! and a value list) or dense (see [`forms`]). The directory is dense over the
+//! superblocks' bounding box while that box is small enough, a hash map otherwise
+//! (see [`dir`]); reads are in [`lookup`].
+//!
+//! The blocks not uniform live in two arenas: those that list an occupied value
+//! (the surfaces the sensor hit) in one, the others (free space seen not yet
+//! clamped, most of a big map's bytes) in the other. Lookups land mostly on
+//! surfaces (a scan's end points, collision checks, rays cast to render), and in
+//! their own arena those blocks lie together in a few megabytes, a few hundred
+//! pages, instead of scattered one to a page over the whole arena.
 
 mod arena;
 mod dir;
@@ -11,6 +18,7 @@ mod flat;
 mod forms;
 mod fresh;
 mod lookup;
+mod place;
 mod probe;
 mod sparse;
 mod valid;
@@ -21,8 +29,9 @@ use arena::{Arena, UNIT};
 use dir::Directory;
 use flat::Flat;
 use forms::{
-    apply_masks, choose, decode, palette_single, palette_update, units_of, write_dense,
-    write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
+    any_occupied, apply_masks, choose, decode, lists_occupied, palette_single, palette_update,
+    units_of, write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE,
+    UNIFORM,
 };
 pub(crate) use lookup::BATCH;
 
@@ -32,6 +41,11 @@ pub(crate) const BLOCK_LOG2: u32 = 3;
 pub(crate) const BLOCK_CELLS: usize = 512;
 /// Blocks per superblock.
 const TABLE: usize = 512;
+
+/// The arena of the blocks that list no occupied value.
+const OPEN: usize = 0;
+/// The arena of the blocks that list an occupied value (see [`lists_occupied`]).
+const OCCUPIED: usize = 1;
 
 /// A block's coordinates: cell >> 3 per axis.
 pub(crate) type BlockKey = [i64; 3];
@@ -79,8 +93,9 @@ pub(crate) fn join(b: BlockKey, i: usize) -> [i64; 3] {
 
 /// A block's entry in its superblock's table: a tag in the low three bits
 /// ([`forms::EMPTY`], uniform, sparse, palette of width 1, 2, 4, 8, dense), then the
-/// value of a uniform block (high 16 bits) or the block's offset in the arena, in
-/// 16-byte units.
+/// value of a uniform block (high 16 bits), or for a block in an arena, the arena
+/// (bit 3: [`OCCUPIED`] or [`OPEN`]) and the block's offset there in 16-byte units
+/// (bits 4 to 31).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(crate) struct Entry(u32);
 
@@ -105,8 +120,8 @@ impl Entry {
         Self(UNIFORM | u32::from(v as u16) << 16)
     }
 
-    fn at(tag: u32, at: u32) -> Self {
-        Self(tag | at << 3)
+    fn at(tag: u32, arena: usize, at: u32) -> Self {
+        Self(tag | (arena as u32) << 3 | at << 4)
     }
 
     #[inline]
@@ -117,7 +132,13 @@ impl Entry {
     /// The arena offset of a block not uniform.
     #[inline]
     fn offset(self) -> u32 {
-        self.0 >> 3
+        self.0 >> 4
+    }
+
+    /// The arena of a block not uniform: [`OPEN`] or [`OCCUPIED`].
+    #[inline]
+    fn arena(self) -> usize {
+        (self.0 >> 3 & 1) as usize
     }
 
     /// Whether the block lives in the arena.
@@ -147,8 +168,9 @@ pub(crate) struct Store {
     keys: Vec<BlockKey>,
     /// The tables, 512 entries each, by number.
     tables: Vec<Entry>,
-    /// The blocks that are not uniform.
-    arena: Arena,
+    /// The blocks that are not uniform: `arenas[OCCUPIED]` those that list an
+    /// occupied value, `arenas[OPEN]` the others.
+    arenas: [Arena; 2],
     /// Every block's entry over the blocks' bounding box, for lookups (see [`flat`]).
     flat: Flat,
     /// Cells updated since the read index was last built (see [`Store::settle`]).
@@ -163,6 +185,8 @@ pub(crate) struct Store {
     compactions: usize,
     /// Whether a block was refused for want of room in the arena.
     overflowed: bool,
+    /// Whether a block stayed in the wrong arena because the other was full.
+    crowded: bool,
 }
 
 impl Store {
@@ -204,9 +228,9 @@ impl Store {
             .filter(|e| *e != Entry::EMPTY)
     }
 
-    /// The words of an arena block, from its offset to the arena's end.
+    /// The words of an arena block, from its offset to its arena's end.
     fn words_of(&self, e: Entry) -> &[u16] {
-        &self.arena.words[e.offset() as usize * UNIT..]
+        &self.arenas[e.arena()].words[e.offset() as usize * UNIT..]
     }
 
     /// Decodes an entry's 512 values into `out`.
@@ -239,98 +263,6 @@ impl Store {
         self.put(b, &cells, fixed);
     }
 
-    /// Empties slot `s`, freeing its block's storage.
-    fn clear(&mut self, s: usize) {
-        let e = self.tables[s];
-        if e.in_arena() {
-            let units = units_of(e.tag(), self.words_of(e));
-            self.arena.release(e.offset(), units);
-        }
-        if e != Entry::EMPTY {
-            self.blocks -= 1;
-        }
-        self.set_entry(s, Entry::EMPTY);
-        // A quarter of the arena free (and more than a few KiB): compact.
-        if self.arena.free_units * 4 > self.arena.len_units() && self.arena.free_units > 256 {
-            self.compact();
-        }
-    }
-
-    /// Writes slot `s`'s entry, mirrored in the read index.
-    #[inline]
-    fn set_entry(&mut self, s: usize, e: Entry) {
-        self.tables[s] = e;
-        self.flat.set(block_of(&self.keys, s), e);
-    }
-
-    /// Makes slot `s` a uniform block of value `v` (a clamp), freeing its storage.
-    pub(super) fn set_uniform(&mut self, s: usize, v: i16) {
-        self.clear(s);
-        self.set_entry(s, Entry::uniform(v));
-        self.blocks += 1;
-    }
-
-    /// Gives slot `s` (emptied first) a new block of `units` units with this tag;
-    /// returns the block's words. `None`, leaving the slot as it was, when the arena
-    /// has no room for it (past its limit): then [`Store::overflowed`] tells.
-    fn place(&mut self, s: usize, tag: u32, units: usize) -> Option<&mut [u16]> {
-        let old = self.tables[s];
-        let at = if old.in_arena() && units_of(old.tag(), self.words_of(old)) == units {
-            old.offset()
-        } else {
-            if !self.arena.has_room(units) {
-                self.overflowed = true;
-                return None;
-            }
-            self.clear(s);
-            self.blocks += 1;
-            // Clearing may compact the arena, which only makes room.
-            self.arena.alloc(units).expect("room checked")
-        };
-        self.set_entry(s, Entry::at(tag, at));
-        Some(self.arena.get_mut(at, units * UNIT))
-    }
-
-    /// Whether a block was refused for want of room in the arena (so that some
-    /// updates were dropped), since the store was made.
-    pub fn overflowed(&self) -> bool {
-        self.overflowed
-    }
-
-    /// The arena's limit in bytes.
-    pub fn limit_bytes(&self) -> usize {
-        self.arena.limit * UNIT * 2
-    }
-
-    /// Lowers the arena's limit to `units` units (a test hook: the real limit,
-    /// 8 GiB, is too big for a test).
-    #[cfg(test)]
-    pub fn set_limit_units(&mut self, units: usize) {
-        self.arena.limit = units;
-    }
-
-    /// Moves every arena block to a new arena, in table order, leaving no free chunk.
-    fn compact(&mut self) {
-        let used = self.arena.len_units() - self.arena.free_units;
-        let mut words = Vec::with_capacity((used + used / 8) * UNIT);
-        for (s, e) in self.tables.iter_mut().enumerate() {
-            if e.in_arena() {
-                let from = e.offset() as usize * UNIT;
-                let len = units_of(e.tag(), &self.arena.words[from..]) * UNIT;
-                let at = (words.len() / UNIT) as u32;
-                words.extend_from_slice(&self.arena.words[from..from + len]);
-                *e = Entry::at(e.tag(), at);
-                self.flat.set(block_of(&self.keys, s), *e);
-            }
-        }
-        self.arena = Arena {
-            words,
-            limit: self.arena.limit,
-            ..Arena::default()
-        };
-        self.compactions += 1;
-    }
-
     /// Stores `cells` as block `b`, in the smallest form: nothing when all unknown,
     /// uniform when all clamped to one value, else sparse, palette or dense,
     /// whichever takes the fewest units (a palette on a tie).
@@ -341,6 +273,7 @@ impl Store {
 
     fn put_slot(&mut self, s: usize, cells: &Cells, fixed: Fixed) {
         let census = Census::of(cells);
+        let occupied = any_occupied(census.values.iter().copied(), fixed);
         if census.known == 0 {
             self.clear(s);
             return;
@@ -363,18 +296,18 @@ impl Store {
                         .filter(|(_, &v)| v != UNKNOWN)
                         .map(|(i, &v)| (i as u32) << 16 | u32::from(v as u16)),
                 );
-                if let Some(words) = self.place(s, tag, units) {
+                if let Some(words) = self.place(s, tag, units, occupied) {
                     write_sparse(words, &list);
                 }
                 self.scratch = list;
             }
             DENSE => {
-                if let Some(words) = self.place(s, tag, units) {
+                if let Some(words) = self.place(s, tag, units, occupied) {
                     write_dense(words, cells);
                 }
             }
             t => {
-                if let Some(words) = self.place(s, t, units) {
+                if let Some(words) = self.place(s, t, units, occupied) {
                     write_palette(words, 1 << (t - PALETTE), &census);
                 }
             }
@@ -405,7 +338,11 @@ impl Store {
             DENSE => {
                 let at = e.offset();
                 let mut cells = [0i16; BLOCK_CELLS];
-                decode(DENSE, self.arena.get(at, BLOCK_CELLS), &mut cells);
+                decode(
+                    DENSE,
+                    self.arenas[e.arena()].get(at, BLOCK_CELLS),
+                    &mut cells,
+                );
                 apply_masks(&mut cells, miss, hit, fixed);
                 self.put_slot(s, &cells, fixed);
             }
@@ -413,11 +350,15 @@ impl Store {
                 let w = 1 << (t - PALETTE);
                 let at = e.offset();
                 let units = units_of(t, self.words_of(e));
-                let words = self.arena.get_mut(at, units * UNIT);
+                let words = self.arenas[e.arena()].get_mut(at, units * UNIT);
                 if palette_update(words, w, miss, hit, fixed) {
-                    if let Some(v) = palette_single(words, w) {
-                        if v == fixed.min || v == fixed.max {
-                            self.set_uniform(s, v);
+                    match palette_single(words, w) {
+                        Some(v) if v == fixed.min || v == fixed.max => self.set_uniform(s, v),
+                        _ => {
+                            // The value list may have gained or lost an occupied value.
+                            if lists_occupied(t, words, fixed) != (e.arena() == OCCUPIED) {
+                                self.relocate(s, e);
+                            }
                         }
                     }
                 } else {
@@ -442,10 +383,19 @@ impl Store {
         self.dir.is_dense()
     }
 
-    /// Units in the arena (in use or free).
+    /// Whether block `b` lies in the arena of blocks that list an occupied value
+    /// (`None` for a block not in an arena).
     #[cfg(test)]
-    pub fn arena_units(&self) -> usize {
-        self.arena.len_units()
+    pub fn in_occupied_arena(&self, b: BlockKey) -> Option<bool> {
+        self.entry(b)
+            .filter(|e| e.in_arena())
+            .map(|e| e.arena() == OCCUPIED)
+    }
+
+    /// Units in each arena (in use or free).
+    #[cfg(test)]
+    pub fn arena_units(&self) -> [usize; 2] {
+        self.arenas.each_ref().map(Arena::len_units)
     }
 
     /// Compactions of the arena so far.
@@ -460,7 +410,7 @@ impl Store {
         self.dir.bytes()
             + self.keys.capacity() * std::mem::size_of::<BlockKey>()
             + self.tables.capacity() * std::mem::size_of::<Entry>()
-            + self.arena.bytes()
+            + self.arenas.iter().map(Arena::bytes).sum::<usize>()
             + self.flat.bytes()
             + self.scratch.capacity() * 4
     }

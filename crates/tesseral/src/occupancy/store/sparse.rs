@@ -1,7 +1,7 @@
 //! Updating a sparse (or empty) block: its sorted cells merged with a scan's masks.
 
 use super::arena::UNIT;
-use super::forms::{choose, write_sparse, SPARSE, SPARSE_VALUES};
+use super::forms::{any_occupied, choose, write_sparse, SPARSE, SPARSE_VALUES};
 use super::{Entry, Store, BLOCK_CELLS};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
@@ -70,7 +70,8 @@ impl Store {
         let values_all = if n < BLOCK_CELLS { k + 1 } else { k };
         let (tag, units) = choose(n, values_all, k);
         if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
-            if let Some(words) = self.place(s, SPARSE, units) {
+            let occupied = any_occupied(values[..k].iter().map(|&v| v as i16), fixed);
+            if let Some(words) = self.place(s, SPARSE, units, occupied) {
                 write_sparse(words, &out);
             }
             self.scratch = out;

@@ -2,16 +2,18 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, palette_index, sparse_units, units_of, DENSE, EMPTY, PALETTE, SPARSE,
-    SPARSE_VALUES, UNIFORM,
+    bits_words, lists_occupied, palette_index, sparse_units, units_of, DENSE, EMPTY, PALETTE,
+    SPARSE, SPARSE_VALUES, UNIFORM,
 };
-use super::{block_of, Store, BLOCK_CELLS, TABLE};
+use super::{block_of, Store, BLOCK_CELLS, OCCUPIED, TABLE};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
 impl Store {
     /// Checks the invariants: the directory and the tables agree; every uniform
-    /// block is clamped; every arena block lies inside the arena, overlapping no
-    /// other block and no free chunk, and every unit is a block's or free; a sparse
+    /// block is clamped; every arena block lies inside its arena, overlapping no
+    /// other block and no free chunk, and every unit is a block's or free; a block
+    /// lies in the arena of blocks that list an occupied value if and only if it
+    /// lists one (unless that arena was full when it should have moved); a sparse
     /// block lists 1 to 512 cells in order with at most six distinct values, a
     /// palette block's numbers lie in its value list of distinct values; every
     /// value is unknown (palette, dense) or within the clamps; no block is all
@@ -32,24 +34,28 @@ impl Store {
         if let Some((k, t)) = self.last {
             assert_eq!(self.dir.get(k), Some(t), "the last superblock");
         }
-        let n_units = self.arena.len_units();
-        assert_eq!(self.arena.words.len(), n_units * UNIT, "arena length");
-        let mut owner = vec![false; n_units];
-        let mut claim = |at: usize, units: usize, what: &str| {
-            assert!(at + units <= n_units, "{what}: past the arena's end");
+        let mut owner = self.arenas.each_ref().map(|arena| {
+            assert_eq!(arena.words.len() % UNIT, 0, "arena length");
+            vec![false; arena.len_units()]
+        });
+        let mut claim = |a: usize, at: usize, units: usize, what: &str| {
+            let owner = &mut owner[a];
+            assert!(at + units <= owner.len(), "{what}: past the arena's end");
             for u in &mut owner[at..at + units] {
                 assert!(!*u, "{what}: overlaps another chunk");
                 *u = true;
             }
         };
-        let mut free_units = 0;
-        for (units, list) in self.arena.free.iter().enumerate() {
-            for &at in list {
-                claim(at as usize, units, "a free chunk");
-                free_units += units;
+        for (a, arena) in self.arenas.iter().enumerate() {
+            let mut free_units = 0;
+            for (units, list) in arena.free.iter().enumerate() {
+                for &at in list {
+                    claim(a, at as usize, units, "a free chunk");
+                    free_units += units;
+                }
             }
+            assert_eq!(free_units, arena.free_units, "free units");
         }
-        assert_eq!(free_units, self.arena.free_units, "free units");
         let in_clamps = |b: [i64; 3], v: i16| {
             assert!(
                 (fixed.min..=fixed.max).contains(&v),
@@ -79,11 +85,21 @@ impl Store {
             }
             blocks += 1;
             let at = e.offset() as usize;
-            assert!(at < n_units, "block {b:?}: offset past the arena");
+            assert!(
+                at < self.arenas[e.arena()].len_units(),
+                "block {b:?}: offset past the arena"
+            );
             let words = self.words_of(e);
             let units = units_of(e.tag(), words);
-            claim(at, units, &format!("block {b:?}"));
+            claim(e.arena(), at, units, &format!("block {b:?}"));
             let words = &words[..units * UNIT];
+            if !self.crowded {
+                assert_eq!(
+                    e.arena() == OCCUPIED,
+                    lists_occupied(e.tag(), words, fixed),
+                    "block {b:?}: in the wrong arena"
+                );
+            }
             match e.tag() {
                 SPARSE => {
                     let (len, k) = (words[0] as usize, words[1] as usize);
@@ -156,7 +172,7 @@ impl Store {
         }
         assert_eq!(blocks, self.blocks, "block count");
         assert!(
-            owner.iter().all(|&u| u),
+            owner.iter().flatten().all(|&u| u),
             "an arena unit is neither a block's nor free"
         );
     }

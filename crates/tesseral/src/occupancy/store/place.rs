@@ -1,0 +1,144 @@
+//! Placing blocks in the arenas: a slot's block emptied, made uniform or given
+//! room in the arena its values call for, moved between the arenas, and an arena
+//! compacted once a quarter of it is free.
+
+use super::arena::{Arena, UNIT};
+use super::forms::units_of;
+use super::{block_of, Entry, Store, OPEN};
+
+impl Store {
+    /// Empties slot `s`, freeing its block's storage.
+    pub(super) fn clear(&mut self, s: usize) {
+        let e = self.tables[s];
+        if e != Entry::EMPTY {
+            self.blocks -= 1;
+        }
+        self.set_entry(s, Entry::EMPTY);
+        if e.in_arena() {
+            let units = units_of(e.tag(), self.words_of(e));
+            self.release(e.arena(), e.offset(), units);
+        }
+    }
+
+    /// Writes slot `s`'s entry, mirrored in the read index.
+    #[inline]
+    pub(super) fn set_entry(&mut self, s: usize, e: Entry) {
+        self.tables[s] = e;
+        self.flat.set(block_of(&self.keys, s), e);
+    }
+
+    /// Makes slot `s` a uniform block of value `v` (a clamp), freeing its storage.
+    pub(super) fn set_uniform(&mut self, s: usize, v: i16) {
+        self.clear(s);
+        self.set_entry(s, Entry::uniform(v));
+        self.blocks += 1;
+    }
+
+    /// Gives slot `s` (emptied first) a new block of `units` units with this tag, in
+    /// the arena of blocks that list an occupied value when `occupied` (see
+    /// [`lists_occupied`]); returns the block's words. `None`, leaving the slot as
+    /// it was, when that arena has no room for it (past its limit): then
+    /// [`Store::overflowed`] tells.
+    pub(super) fn place(
+        &mut self,
+        s: usize,
+        tag: u32,
+        units: usize,
+        occupied: bool,
+    ) -> Option<&mut [u16]> {
+        let a = usize::from(occupied);
+        let old = self.tables[s];
+        let at = if old.in_arena()
+            && old.arena() == a
+            && units_of(old.tag(), self.words_of(old)) == units
+        {
+            old.offset()
+        } else {
+            if !self.arenas[a].has_room(units) {
+                self.overflowed = true;
+                return None;
+            }
+            self.clear(s);
+            self.blocks += 1;
+            // Clearing may compact an arena, which only makes room.
+            self.arenas[a].alloc(units).expect("room checked")
+        };
+        self.set_entry(s, Entry::at(tag, a, at));
+        Some(self.arenas[a].get_mut(at, units * UNIT))
+    }
+
+    /// Moves the block of slot `s` (entry `e`, in an arena) to the other arena,
+    /// as it lists an occupied value now or no longer. When that arena is full the
+    /// block stays (its cells are right, only its place is not): then `crowded`.
+    pub(super) fn relocate(&mut self, s: usize, e: Entry) {
+        let (from, to) = (e.arena(), 1 - e.arena());
+        let units = units_of(e.tag(), self.words_of(e));
+        let Some(at) = self.arenas[to].alloc(units) else {
+            self.crowded = true;
+            return;
+        };
+        let [open, occupied] = &mut self.arenas;
+        let (src, dst) = if from == OPEN {
+            (open, occupied)
+        } else {
+            (occupied, open)
+        };
+        let len = units * UNIT;
+        dst.get_mut(at, len)
+            .copy_from_slice(src.get(e.offset(), len));
+        self.set_entry(s, Entry::at(e.tag(), to, at));
+        self.release(from, e.offset(), units);
+    }
+
+    /// Frees the chunk of `units` units at `at` in arena `a`, and compacts that
+    /// arena once a quarter of it is free (and more than a few KiB).
+    fn release(&mut self, a: usize, at: u32, units: usize) {
+        let arena = &mut self.arenas[a];
+        arena.release(at, units);
+        if arena.free_units * 4 > arena.len_units() && arena.free_units > 256 {
+            self.compact(a);
+        }
+    }
+
+    /// Whether a block was refused for want of room in the arena (so that some
+    /// updates were dropped), since the store was made.
+    pub fn overflowed(&self) -> bool {
+        self.overflowed
+    }
+
+    /// An arena's limit in bytes (each has its own).
+    pub fn limit_bytes(&self) -> usize {
+        self.arenas[OPEN].limit * UNIT * 2
+    }
+
+    /// Lowers each arena's limit to `units` units (a test hook: the real limit,
+    /// 4 GiB, is too big for a test).
+    #[cfg(test)]
+    pub fn set_limit_units(&mut self, units: usize) {
+        self.arenas.iter_mut().for_each(|a| a.limit = units);
+    }
+
+    /// Moves every block of arena `a` to a new arena, in table order, leaving no
+    /// free chunk.
+    fn compact(&mut self, a: usize) {
+        let old = std::mem::take(&mut self.arenas[a]);
+        let used = old.len_units() - old.free_units;
+        let mut words = Vec::with_capacity((used + used / 8) * UNIT);
+        for (s, e) in self.tables.iter_mut().enumerate() {
+            if e.in_arena() && e.arena() == a {
+                let from = e.offset() as usize * UNIT;
+                let len = units_of(e.tag(), &old.words[from..]) * UNIT;
+                let at = (words.len() / UNIT) as u32;
+                words.extend_from_slice(&old.words[from..from + len]);
+                *e = Entry::at(e.tag(), a, at);
+                self.flat.set(block_of(&self.keys, s), *e);
+            }
+        }
+        self.arenas[a] = Arena {
+            words,
+            limit: old.limit,
+            ..Arena::default()
+        };
+        self.compactions += 1;
+    }
+}
