@@ -206,8 +206,9 @@ impl Store {
                 let n = self.keys.len() as u32;
                 let t = self.dir.get_or_insert(s, n);
                 if t == n {
-                    if self.tables.len() == self.tables.capacity() {
-                        // A quarter more, not double: the capacity is counted.
+                    if self.tables.capacity() - self.tables.len() < TABLE {
+                        // A quarter more, not double: the capacity is counted. (Room
+                        // for less than a table would let `resize` double it.)
                         self.tables
                             .reserve_exact((self.tables.len() / 4).max(TABLE));
                     }

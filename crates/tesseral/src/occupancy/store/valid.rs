@@ -31,6 +31,11 @@ impl Store {
                 .map(|(s, &e)| (block_of(&self.keys, s), e)),
         );
         assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
+        let (len, cap) = (self.tables.len(), self.tables.capacity());
+        assert!(
+            cap <= len + len / 4 + TABLE,
+            "tables' capacity {cap} for {len} entries: grown by more than a quarter"
+        );
         if let Some((k, t)) = self.last {
             assert_eq!(self.dir.get(k), Some(t), "the last superblock");
         }
