@@ -274,7 +274,6 @@ impl Store {
 
     fn put_slot(&mut self, s: usize, cells: &Cells, fixed: Fixed) {
         let census = Census::of(cells);
-        let occupied = any_occupied(census.values.iter().copied(), fixed);
         if census.known == 0 {
             self.clear(s);
             return;
@@ -285,6 +284,7 @@ impl Store {
                 return;
             }
         }
+        let occupied = any_occupied(census.values.iter().copied(), fixed);
         let (tag, units) = choose(census.known, census.values.len(), census.known_values());
         match tag {
             SPARSE => {
@@ -355,12 +355,12 @@ impl Store {
                 if palette_update(words, w, miss, hit, fixed) {
                     match palette_single(words, w) {
                         Some(v) if v == fixed.min || v == fixed.max => self.set_uniform(s, v),
-                        _ => {
-                            // The value list may have gained or lost an occupied value.
-                            if lists_occupied(t, words, fixed) != (e.arena() == OCCUPIED) {
-                                self.relocate(s, e);
-                            }
+                        // An update in place only appends to the value list: a block
+                        // with the surfaces stays, one without may have gained one.
+                        _ if e.arena() == OPEN && lists_occupied(t, words, fixed) => {
+                            self.relocate(s, e);
                         }
+                        _ => {}
                     }
                 } else {
                     let mut cells = [0i16; BLOCK_CELLS];

@@ -4,7 +4,7 @@
 
 use super::arena::{Arena, UNIT};
 use super::forms::units_of;
-use super::{block_of, Entry, Store, OPEN};
+use super::{block_of, Entry, Store, OCCUPIED, OPEN};
 
 impl Store {
     /// Empties slot `s`, freeing its block's storage.
@@ -67,27 +67,23 @@ impl Store {
         Some(self.arenas[a].get_mut(at, units * UNIT))
     }
 
-    /// Moves the block of slot `s` (entry `e`, in an arena) to the other arena,
-    /// as it lists an occupied value now or no longer. When that arena is full the
-    /// block stays (its cells are right, only its place is not): then `crowded`.
+    /// Moves the block of slot `s` (entry `e`, in the open arena), which lists an
+    /// occupied value now, to the occupied arena. When that arena is full the block
+    /// stays (its cells are right, only its place is not): then `crowded`.
     pub(super) fn relocate(&mut self, s: usize, e: Entry) {
-        let (from, to) = (e.arena(), 1 - e.arena());
+        debug_assert_eq!(e.arena(), OPEN, "only open blocks move in place");
         let units = units_of(e.tag(), self.words_of(e));
-        let Some(at) = self.arenas[to].alloc(units) else {
+        let Some(at) = self.arenas[OCCUPIED].alloc(units) else {
             self.crowded = true;
             return;
         };
         let [open, occupied] = &mut self.arenas;
-        let (src, dst) = if from == OPEN {
-            (open, occupied)
-        } else {
-            (occupied, open)
-        };
         let len = units * UNIT;
-        dst.get_mut(at, len)
-            .copy_from_slice(src.get(e.offset(), len));
-        self.set_entry(s, Entry::at(e.tag(), to, at));
-        self.release(from, e.offset(), units);
+        occupied
+            .get_mut(at, len)
+            .copy_from_slice(open.get(e.offset(), len));
+        self.set_entry(s, Entry::at(e.tag(), OCCUPIED, at));
+        self.release(OPEN, e.offset(), units);
     }
 
     /// Frees the chunk of `units` units at `at` in arena `a`, and compacts that
