@@ -41,7 +41,10 @@ int main(int argc, char** argv) {
   for (auto& c : cells) known += acc.value(c) != nullptr;
   double lookup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   double lookup_cpu = cpu_seconds() - c1;
-  std::printf("RESULT bonxai scans %zu rays %zu insert_s %.3f cpu_s %.3f rays_per_s %.4e bytes %zu occupied %zu free %zu lookup_ns %.1f known %zu lookup_cpu_ns %.1f\n",
+  auto loops = repeat_lookups([&] { size_t n = 0; for (auto& c : cells) n += acc.value(c) != nullptr; return n; }, cells.size());
+  std::printf("RESULT bonxai scans %zu rays %zu insert_s %.3f cpu_s %.3f rays_per_s %.4e bytes %zu occupied %zu free %zu lookup_ns %.1f known %zu lookup_cpu_ns %.1f",
               raw.size(), rays, wall, cpu, rays / wall, map.grid().memUsage(), occ.size(), fr.size(),
               lookup * 1e3, known, lookup_cpu * 1e3);
+  print_loops(loops, lookup_cpu * 1e9 / double(cells.size()));
+  std::printf("\n");
 }

@@ -39,11 +39,14 @@ int main(int argc, char** argv) {
   for (auto& k : keys) known += tree.search(k) != nullptr;
   double lookup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   double lookup_cpu = cpu_seconds() - c1;
+  auto loops = repeat_lookups([&] { size_t n = 0; for (auto& k : keys) n += tree.search(k) != nullptr; return n; }, keys.size());
   size_t occ = 0, fr = 0;
   for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {
     size_t c = size_t(1) << (3 * (16 - it.getDepth()));
     (tree.isNodeOccupied(*it) ? occ : fr) += c;
   }
-  std::printf("RESULT octomap scans %zu rays %zu insert_s %.3f cpu_s %.3f rays_per_s %.4e bytes %zu occupied %zu free %zu lookup_ns %.1f known %zu lookup_cpu_ns %.1f\n",
+  std::printf("RESULT octomap scans %zu rays %zu insert_s %.3f cpu_s %.3f rays_per_s %.4e bytes %zu occupied %zu free %zu lookup_ns %.1f known %zu lookup_cpu_ns %.1f",
               raw.size(), rays, wall, cpu, rays / wall, tree.memoryUsage(), occ, fr, lookup * 1e3, known, lookup_cpu * 1e3);
+  print_loops(loops, lookup_cpu * 1e9 / double(keys.size()));
+  std::printf("\n");
 }

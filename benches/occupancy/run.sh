@@ -10,7 +10,11 @@
 # Bonxai `memUsage()`, OctoMap `memoryUsage()`), occupied and free cells, ns per
 # lookup of 10^6 random cells drawn from the scans' end points (wall, then lookup_cpu_ns
 # in process CPU time; tesseral adds lookup_many_ns and lookup_many_cpu_ns, the same
-# cells through its batched log_odds_many), and peak RSS.
+# cells through its batched log_odds_many), and peak RSS. Every tool then loops over
+# the same cells LOOKUP_LOOPS - 1 more times (default 5 loops in all) and adds
+# lookup_min_cpu_ns and lookup_median_cpu_ns: the fastest and the median loop, so that
+# a loop slowed by another process on the machine can be told from the tool's own
+# time (each tool gets the same loops; none is warmed more than another).
 # One core: `taskset -c 0` and RAYON_NUM_THREADS=1; two cores: RAYON_NUM_THREADS=2 on
 # cores 0,1 (only tesseral is parallel).
 #

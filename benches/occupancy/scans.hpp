@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <algorithm>
 #include <vector>
 
 struct ScanFile {
@@ -48,4 +49,31 @@ inline double cpu_seconds() {
   timespec ts;
   clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
   return ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+// Loops over the lookups after the first timed one (LOOKUP_LOOPS, default 5, in all):
+// the fastest and the median loop's process CPU ns per lookup, so that a loop slowed
+// by another process on the machine can be told from the tool's own time. `loop`
+// runs the lookups once and returns the cells known.
+template <class F>
+std::vector<double> repeat_lookups(F loop, size_t cells) {
+  const char* env = std::getenv("LOOKUP_LOOPS");
+  int loops = env ? std::max(1, std::atoi(env)) : 5;
+  std::vector<double> ns;
+  for (int i = 1; i < loops; i++) {
+    double c = cpu_seconds();
+    volatile size_t known = loop();
+    (void)known;
+    ns.push_back((cpu_seconds() - c) * 1e9 / double(cells));
+  }
+  return ns;
+}
+
+// Appends `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y` (the first loop,
+// `first_ns`, counted in) to a RESULT line.
+inline void print_loops(std::vector<double> ns, double first_ns) {
+  ns.push_back(first_ns);
+  std::sort(ns.begin(), ns.end());
+  std::printf(" lookup_loops %zu lookup_min_cpu_ns %.1f lookup_median_cpu_ns %.1f", ns.size(), ns.front(),
+              ns[ns.size() / 2]);
 }

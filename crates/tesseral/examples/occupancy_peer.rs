@@ -143,6 +143,13 @@ fn main() -> std::io::Result<()> {
                 .filter(|&&c| map.log_odds(std::hint::black_box(c)).is_some())
                 .count();
             let (lookup, lookup_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
+            // More loops over the same cells, as the C++ drivers do (`repeat_lookups`).
+            let loops = lookup_loops(lookup_cpu * 1e9 / cells.len() as f64, cells.len(), || {
+                cells
+                    .iter()
+                    .filter(|&&c| map.log_odds(std::hint::black_box(c)).is_some())
+                    .count()
+            });
             // The same cells through the batched lookup (prefetching in passes).
             let mut out = vec![None; cells.len()];
             let (t, c) = (Instant::now(), process_cpu());
@@ -151,7 +158,7 @@ fn main() -> std::io::Result<()> {
             let (many, many_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
             assert_eq!(known_many, known, "batched and single lookups agree");
             println!(
-                "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known} lookup_cpu_ns {:.1} lookup_many_ns {:.1} lookup_many_cpu_ns {:.1}",
+                "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known} lookup_cpu_ns {:.1} lookup_many_ns {:.1} lookup_many_cpu_ns {:.1} {loops}",
                 sc.len(),
                 rays as f64 / wall,
                 map.bytes(),
@@ -166,4 +173,31 @@ fn main() -> std::io::Result<()> {
         other => panic!("unknown command {other}: gen, xyz or run"),
     }
     Ok(())
+}
+
+/// `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y` over the first loop
+/// (`first_ns`, process CPU ns per lookup) and `LOOKUP_LOOPS − 1` more runs of `run`
+/// (which looks up `cells` cells)
+/// (`LOOKUP_LOOPS` defaults to 5), as `scans.hpp`'s `repeat_lookups` and `print_loops`
+/// give them for the C++ peers: the fastest and the median loop, so that a loop slowed
+/// by another process can be told from the tool's own time.
+fn lookup_loops(first_ns: f64, cells: usize, mut run: impl FnMut() -> usize) -> String {
+    let loops = std::env::var("LOOKUP_LOOPS")
+        .ok()
+        .and_then(|v| v.parse::<usize>().ok())
+        .unwrap_or(5)
+        .max(1);
+    let mut ns = vec![first_ns];
+    for _ in 1..loops {
+        let c = process_cpu();
+        std::hint::black_box(run());
+        ns.push((process_cpu() - c) * 1e9 / cells as f64);
+    }
+    ns.sort_by(f64::total_cmp);
+    format!(
+        "lookup_loops {} lookup_min_cpu_ns {:.1} lookup_median_cpu_ns {:.1}",
+        ns.len(),
+        ns[0],
+        ns[ns.len() / 2]
+    )
 }
