@@ -16,7 +16,9 @@
 //!   occupied and free cells, lookup ns (a loop of `log_odds`, as the peers' loops
 //!   of single lookups; wall, then `lookup_cpu_ns` in process CPU time), cells
 //!   known, and `lookup_many_ns`, `lookup_many_cpu_ns`: the same cells through the
-//!   batched `log_odds_many`, per cell.
+//!   batched `log_odds_many`, per cell; then `lookup_loops`, `lookup_min_cpu_ns` and
+//!   `lookup_median_cpu_ns` over the first loop and `LOOKUP_LOOPS − 1` more (5 in all
+//!   by default), as the C++ drivers report them.
 //!
 //! The rayon pool size is `RAYON_NUM_THREADS` (one core: `RAYON_NUM_THREADS=1`).
 
