@@ -4,7 +4,7 @@
 //!   watertight, manifold triangle mesh. Coplanar faces are merged greedily, vertices
 //!   are split where voxels touch only along an edge or at a corner, and T-junctions
 //!   are closed, so every edge is shared by exactly two triangles.
-//! - **In** ([`voxelize`]): a triangle mesh becomes a solid octree at a chosen depth
+//! - **In** ([`voxelize()`]): a triangle mesh becomes a solid octree at a chosen depth
 //!   or voxel size, top-down through a
 //!   [`crate::linear::Classifier`], with exact integer triangle/box overlap tests and
 //!   exact ray parity for inside/outside.

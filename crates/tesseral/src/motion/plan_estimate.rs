@@ -1,4 +1,4 @@
-//! The memory [`plan`](super::plan) will need, estimated before it starts, so that
+//! The memory [`plan`](fn@super::plan) will need, estimated before it starts, so that
 //! a huge region (`--margin 1000000`) is refused at once instead of growing for
 //! minutes.
 
@@ -20,7 +20,7 @@ pub struct PlanEstimate {
     pub bytes: u64,
 }
 
-/// Estimates the free cells and memory of [`plan`](super::plan) with the same
+/// Estimates the free cells and memory of [`plan`](fn@super::plan) with the same
 /// arguments, without building anything. For an empty environment the cell count
 /// is exact: it is the number of maximal blocks of the region's box.
 ///

@@ -151,7 +151,8 @@ pub(crate) fn walk(
 
 /// Where a walk leaves its block: the axis it leaves along, the steps it takes along
 /// each axis up to and including the step out, and the ray parameters then, exactly
-/// as [`walk`]'s steps would leave them.
+/// as `walk`'s steps would leave them (`walk`, the reference form, is built for
+/// tests only).
 ///
 /// The walk is a merge of three sequences of border parameters, one per axis, each
 /// summed step by step as the walk sums them (`t`, `t + d`, `t + d + d`, ...), in the

@@ -220,7 +220,7 @@ impl Scratch {
         }
     }
 
-    /// [`miss_ray`](Self::miss_ray) for the walk `w` from cell `key_origin`.
+    /// `miss_ray` (built for tests) for the walk `w` from cell `key_origin`.
     #[inline]
     pub fn miss_walk(&mut self, w: &Dda, key_origin: [i64; 3]) {
         let mask = (1i64 << BLOCK_LOG2) - 1;

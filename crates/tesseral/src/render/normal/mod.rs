@@ -35,7 +35,7 @@ impl Brick {
         Self::gather(rt, centre, reach, i64::MAX)
     }
 
-    /// As [`Brick::around`], but only the voxels within `reach + ½` of the centre are
+    /// As `Brick::around` (built for tests), but only the voxels within `reach + ½` of the centre are
     /// sure to be marked (the nodes that miss that ball are skipped): what
     /// [`Brick::ball_moment`] reads.
     pub(crate) fn ball<T: Trace + ?Sized>(rt: &T, centre: [i64; 3], reach: usize) -> Brick {
