@@ -310,6 +310,11 @@ impl TessFile {
 
     /// The leaves of chunk `i` (of [`TessFile::chunks`]), checked.
     ///
+    /// They are the file's leaves as stored. A file from another writer may hold
+    /// eight siblings that were never merged into their parent; they come out as
+    /// eight leaves here (and from [`leaves`](Self::leaves)), while
+    /// [`to_model`](Self::to_model) merges them.
+    ///
     /// # Errors
     /// [`FormatError::Corrupt`] for a bad chunk.
     ///
