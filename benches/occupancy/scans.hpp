@@ -2,12 +2,12 @@
 // count as u64, points as 3 x f64, little-endian), and splitmix64, which draws the
 // same lookup cells as the tesseral side.
 #pragma once
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
-#include <algorithm>
 #include <vector>
 
 struct ScanFile {

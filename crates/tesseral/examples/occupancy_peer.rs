@@ -179,11 +179,11 @@ fn main() -> std::io::Result<()> {
 }
 
 /// `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y` over the first loop
-/// (`first_ns`, process CPU ns per lookup) and `LOOKUP_LOOPS − 1` more runs of `run`
-/// (which looks up `cells` cells)
-/// (`LOOKUP_LOOPS` defaults to 5), as `scans.hpp`'s `repeat_lookups` and `print_loops`
-/// give them for the C++ peers: the fastest and the median loop, so that a loop slowed
-/// by another process can be told from the tool's own time.
+/// (`first_ns`, process CPU ns per lookup) and `LOOKUP_LOOPS − 1` more runs of `run`,
+/// which looks up `cells` cells (`LOOKUP_LOOPS` defaults to 5): the fastest and the
+/// median loop, as `scans.hpp`'s `repeat_lookups` and `print_loops` give them for
+/// the C++ peers, so that a loop slowed by another process can be told from the
+/// tool's own time.
 fn lookup_loops(first_ns: f64, cells: usize, run: impl Fn() -> usize) -> String {
     let loops = std::env::var("LOOKUP_LOOPS")
         .ok()

@@ -145,9 +145,10 @@ impl IndexBuilder {
     }
 }
 
-/// The colour index (blocks of `block` leaves) of sections already written whole (`sections`, flags first,
-/// as [`put_sections`](crate::io::sections::put_sections) writes them): walks the colour layer's
-/// regions. `None` when there is no colour layer or it has no region.
+/// The colour index (blocks of `block` leaves) of sections already written whole
+/// (`sections`, flags first, as [`put_sections`](crate::io::sections::put_sections)
+/// writes them): walks the colour layer's regions. `None` when there is no colour
+/// layer or it has no region.
 pub(crate) fn index_of_sections(sections: &[u8], flags: u16, block: u64) -> Option<Vec<u8>> {
     if flags & FLAG_COLOR_LAYER == 0 || flags & FLAG_COLORS != 0 {
         return None;

@@ -15,7 +15,8 @@
 //!    heuristic, the path found has the least number of unit axis moves: the same
 //!    cost as Dijkstra on the dense grid of positions.
 //! 4. **Smoothing.** Waypoints are joined by straight segments while the swept test
-//!    ([`first_contact`](super::sweep::first_contact)) proves each segment collision-free.
+//!    ([`first_contact`](super::sweep::first_contact)) proves each segment
+//!    collision-free.
 
 use serde::Serialize;
 

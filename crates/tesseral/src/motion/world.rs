@@ -6,9 +6,9 @@
 //! At every step each object stands at its trajectory's position rounded to the
 //! nearest voxel, and every pair (environment–object and object–object) is tested
 //! for interference. Between two steps each object moves in a straight line between
-//! its two step positions, and the swept test ([`first_contact`](super::sweep::first_contact)) gives the exact
-//! time at which a pair begins to overlap, so a fast object cannot tunnel through a
-//! thin wall unseen.
+//! its two step positions, and the swept test
+//! ([`first_contact`](super::sweep::first_contact)) gives the exact time at which a
+//! pair begins to overlap, so a fast object cannot tunnel through a thin wall unseen.
 
 use std::ops::ControlFlow;
 

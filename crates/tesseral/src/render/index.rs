@@ -106,7 +106,8 @@ impl RayTree {
         rt
     }
 
-    /// As `RayTree::unindexed` (built for tests), for sorted leaves in a space; no bounding box.
+    /// As `RayTree::unindexed` (built for tests), for sorted leaves in a space; no
+    /// bounding box.
     fn unindexed_leaves(depth: u8, origin: [i64; 3], leaves: &[Leaf]) -> Self {
         RayTree {
             depth,

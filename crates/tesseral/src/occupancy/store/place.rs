@@ -36,9 +36,9 @@ impl Store {
 
     /// Gives slot `s` (emptied first) a new block of `units` units with this tag, in
     /// the arena of blocks that list an occupied value when `occupied` (see
-    /// [`lists_occupied`](super::forms::lists_occupied)); returns the block's words. `None`, leaving the slot as
-    /// it was, when that arena has no room for it (past its limit): then
-    /// [`Store::overflowed`] tells.
+    /// [`lists_occupied`](super::forms::lists_occupied)); returns the block's words.
+    /// `None`, leaving the slot as it was, when that arena has no room for it (past
+    /// its limit): then [`Store::overflowed`] tells.
     pub(super) fn place(
         &mut self,
         s: usize,

@@ -35,9 +35,9 @@ impl Brick {
         Self::gather(rt, centre, reach, i64::MAX)
     }
 
-    /// As `Brick::around` (built for tests), but only the voxels within `reach + ½` of the centre are
-    /// sure to be marked (the nodes that miss that ball are skipped): what
-    /// [`Brick::ball_moment`] reads.
+    /// As `Brick::around` (built for tests), but only the voxels within `reach + ½` of
+    /// the centre are sure to be marked (the nodes that miss that ball are skipped):
+    /// what [`Brick::ball_moment`] reads.
     pub(crate) fn ball<T: Trace + ?Sized>(rt: &T, centre: [i64; 3], reach: usize) -> Brick {
         let r = reach as i64;
         Self::gather(rt, centre, reach, r * r + r)
