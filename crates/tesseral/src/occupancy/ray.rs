@@ -57,6 +57,10 @@ pub(crate) struct Scratch {
     /// The lowest block of the dense index.
     near_lo: BlockKey,
     near: Vec<u32>,
+    /// One bit per block of the dense index, in its order: set when rays cross the
+    /// block in one jump (it is [`FULL`] or [`CLAMPED`]), so that the walk tests 32
+    /// KiB rather than the index's 1 MiB before a jump.
+    jump: Box<[u64]>,
     /// Blocks beyond the dense index, by their offset from `centre` packed in 21
     /// bits per axis.
     far: FxHashMap<u64, u32>,
@@ -89,7 +93,14 @@ impl Scratch {
     /// [`near_cube`]), if known: a miss changes nothing there, so rays cross
     /// those blocks without marking their cells (a hit still counts).
     pub fn new(centre: BlockKey, clamped: Option<Arc<[u64]>>) -> Self {
+        let words = 1 << (3 * NEAR_SIDE_LOG2 - 6);
+        let jump = match &clamped {
+            Some(c) => c.to_vec().into_boxed_slice(),
+            None => vec![0; words].into_boxed_slice(),
+        };
+        debug_assert_eq!(jump.len(), words);
         Self {
+            jump,
             centre,
             clamped,
             near_lo: near_cube(centre).0,
@@ -156,9 +167,22 @@ impl Scratch {
     /// (`usize::MAX` when beyond).
     #[inline(always)]
     fn enter(&mut self, b: BlockKey) -> (u32, usize) {
+        self.enter_at(b, cube_index(self.near_lo, NEAR_SIDE_LOG2, b))
+    }
+
+    /// Marks the block at `at` in the dense index all missed.
+    #[inline(always)]
+    fn set_full(&mut self, at: usize) {
+        self.near[at] |= FULL;
+        self.jump[at >> 6] |= 1 << (at & 63);
+    }
+
+    /// [`enter`](Self::enter) with `b`'s place in the dense index, if any.
+    #[inline(always)]
+    fn enter_at(&mut self, b: BlockKey, near: Option<usize>) -> (u32, usize) {
         let n = self.keys.len() as u32;
         debug_assert!(n < FULL - 2, "a scratch holds fewer than 2^31 - 2 blocks");
-        let (i, at) = if let Some(at) = cube_index(self.near_lo, NEAR_SIDE_LOG2, b) {
+        let (i, at) = if let Some(at) = near {
             let mut i = self.near[at];
             if i == NO_SLOT {
                 let clamped = self
@@ -234,9 +258,16 @@ impl Scratch {
         let all = |m: &[u64; 8]| m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX;
         loop {
             // (x, y, z) is the walk's cell, in `block`, not marked yet. A block of the
-            // dense index is known full by its flag, set as a ray leaves it full (its
-            // line is in cache then); one beyond is checked as it is entered.
-            let (v, at) = self.enter(block);
+            // dense index is known full by its bit in `jump`, set as a ray leaves it
+            // full (its line is in cache then); one beyond is checked as it is
+            // entered.
+            let near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
+            let jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+            let (v, at) = if jump {
+                (FULL, 0)
+            } else {
+                self.enter_at(block, near)
+            };
             let s = (v & !FULL) as usize;
             let full = v & FULL != 0 || {
                 let m = self.miss_mut(s);
@@ -319,7 +350,7 @@ impl Scratch {
             // (One word first: stores to the line are still in flight, and a wider
             // load of them would wait for them all.)
             if at != usize::MAX && m[0] == u64::MAX && all(m) {
-                self.near[at] |= FULL;
+                self.set_full(at);
             }
         }
     }
@@ -330,7 +361,7 @@ impl Scratch {
         let (v, at) = self.enter(b);
         *self.miss_mut((v & !FULL) as usize) = [u64::MAX; 8];
         if at != usize::MAX {
-            self.near[at] |= FULL;
+            self.set_full(at);
         }
     }
 
