@@ -116,11 +116,16 @@ pub(crate) fn walk(
     key_origin: [i64; 3],
     key_end: [i64; 3],
     res: f64,
-    mut visit: impl FnMut([i64; 3]),
+    visit: impl FnMut([i64; 3]),
 ) {
-    let Some(mut w) = Dda::new(origin, end, key_origin, key_end, res) else {
-        return;
-    };
+    if let Some(w) = Dda::new(origin, end, key_origin, key_end, res) {
+        walk_from(w, key_origin, visit);
+    }
+}
+
+/// The cells of the walk `w` from cell `key_origin`: [`walk`] after its set-up.
+#[cfg(test)]
+pub(crate) fn walk_from(mut w: Dda, key_origin: [i64; 3], mut visit: impl FnMut([i64; 3])) {
     visit(key_origin);
     let mut key = key_origin;
     loop {
@@ -209,3 +214,8 @@ pub(crate) fn exit_block(
 /// Blocks crossed by [`exit_block`] so far (tests check that the jump is taken).
 #[cfg(test)]
 pub(crate) static JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+
+/// Blocks crossed in runs of full blocks, face to face, so far (tests check that
+/// runs are taken).
+#[cfg(test)]
+pub(crate) static RUN_JUMPS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);

@@ -7,7 +7,7 @@ use std::sync::Arc;
 use rustc_hash::FxHashMap;
 
 #[cfg(test)]
-use super::dda::JUMPS;
+use super::dda::{JUMPS, RUN_JUMPS};
 use super::dda::{exit_block, Dda};
 use super::store::{cube_index, BlockKey, BLOCK_LOG2};
 
@@ -256,13 +256,105 @@ impl Scratch {
         let [mut lx, mut ly, mut lz] = w.left_axis;
         let mut left = w.left;
         let all = |m: &[u64; 8]| m.iter().fold(u64::MAX, |a, &w| a & w) == u64::MAX;
+        // The block of the end cell, and whether `b` is two blocks or more from it
+        // along some axis (then the walk cannot end in `b` or on its exit step).
+        let end_block: BlockKey =
+            [0, 1, 2].map(|i| (key_origin[i] + w.step[i] * w.left_axis[i]) >> BLOCK_LOG2);
+        let far = |b: BlockKey| (0..3).any(|i| (b[i] - end_block[i]).abs() >= 2);
         loop {
             // (x, y, z) is the walk's cell, in `block`, not marked yet. A block of the
             // dense index is known full by its bit in `jump`, set as a ray leaves it
             // full (its line is in cache then); one beyond is checked as it is
             // entered.
-            let near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
-            let jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+            let mut near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
+            let mut jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+            if jump && far(block) {
+                // A run of full blocks far from the end: only the faces matter. Each
+                // axis keeps the parameter of its next face (`e*`, summed as the walk
+                // sums), and its cell state (`t*`, the coordinate, steps left) as of
+                // the last face it crossed; the others' state is caught up once, on
+                // leaving the run.
+                let face = |t: f64, d: f64, c: i64, s: i64| {
+                    if s == 0 {
+                        return f64::MAX;
+                    }
+                    let mut v = t;
+                    for _ in 1..if s > 0 { 8 - c } else { c + 1 } {
+                        v += d;
+                    }
+                    v
+                };
+                let (mut ex, mut ey, mut ez) = (
+                    face(tx, dx, x, sx),
+                    face(ty, dy, y, sy),
+                    face(tz, dz, z, sz),
+                );
+                // The axis and parameter of the last face crossed.
+                let mut entry = None;
+                macro_rules! cross {
+                    ($e:ident, $t:ident, $d:ident, $c:ident, $s:ident, $l:ident, $axis:expr) => {{
+                        let steps = if $s > 0 { 8 - $c } else { $c + 1 };
+                        if $l < steps {
+                            // (Not expected far from the end.) The exact path takes it.
+                            break;
+                        }
+                        $l -= steps;
+                        entry = Some(($axis, $e));
+                        $t = $e + $d;
+                        $c = if $s > 0 { 0 } else { mask };
+                        $e = face($t, $d, $c, $s);
+                        block[$axis] += $s;
+                    }};
+                }
+                loop {
+                    // Ties: as `walk` (z first, then y, then x).
+                    if ex < ey {
+                        if ex < ez {
+                            cross!(ex, tx, dx, x, sx, lx, 0);
+                        } else {
+                            cross!(ez, tz, dz, z, sz, lz, 2);
+                        }
+                    } else if ey < ez {
+                        cross!(ey, ty, dy, y, sy, ly, 1);
+                    } else {
+                        cross!(ez, tz, dz, z, sz, lz, 2);
+                    }
+                    #[cfg(test)]
+                    RUN_JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
+                    jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+                    if !(jump && far(block)) {
+                        break;
+                    }
+                }
+                if let Some((a, p)) = entry {
+                    // The other axes' borders before the last face crossed, as the walk
+                    // would have stepped them (a border at the face's parameter comes
+                    // first when its axis is higher); none is past its own next face.
+                    // Where the walk would have stopped on one (no step left along its
+                    // axis: float rounding at the end), it stopped in a full block of
+                    // the run: nothing is left to mark.
+                    macro_rules! catch_up {
+                        ($t:ident, $d:ident, $c:ident, $s:ident, $l:ident, $axis:expr) => {
+                            if $axis != a && $s != 0 {
+                                while $t < p || ($t == p && $axis > a) {
+                                    if $l == 0 {
+                                        return;
+                                    }
+                                    $t += $d;
+                                    $c += $s;
+                                    $l -= 1;
+                                }
+                                debug_assert!($c & !mask == 0);
+                            }
+                        };
+                    }
+                    catch_up!(tx, dx, x, sx, lx, 0);
+                    catch_up!(ty, dy, y, sy, ly, 1);
+                    catch_up!(tz, dz, z, sz, lz, 2);
+                    left = lx + ly + lz;
+                }
+            }
             let (v, at) = if jump {
                 (FULL, 0)
             } else {

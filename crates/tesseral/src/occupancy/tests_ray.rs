@@ -6,7 +6,7 @@ use std::sync::atomic::Ordering;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
-use super::dda::{exit_block, walk, JUMPS};
+use super::dda::{exit_block, walk, walk_from, Dda, JUMPS, RUN_JUMPS};
 use super::ray::Scratch;
 
 fn key(p: [f64; 3], res: f64) -> [i64; 3] {
@@ -171,6 +171,7 @@ fn exit_block_takes_the_steps_of_the_walk() {
 fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
     let mut rng = Pcg64::seed_from_u64(13);
     let before = JUMPS.load(Ordering::Relaxed);
+    let runs_before = RUN_JUMPS.load(Ordering::Relaxed);
     for case in 0..4000 {
         let (res, o, mut e) = random_ray(&mut rng, case);
         match case % 7 {
@@ -191,14 +192,16 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
         let mut path = Vec::new();
         walk(o, e, ko, ke, res, |c| path.push(c));
         // Fill some of the blocks the walk crosses (the first, the last, the one
-        // holding the end cell, others at random) before the ray is cast.
+        // holding the end cell, others at random: a third, most or all of them, so
+        // that rays cross runs of full blocks) before the ray is cast.
+        let fill = [3, 8, 10][case % 3];
         let mut blocks: Vec<[i64; 3]> = path.iter().map(|c| c.map(|k| k >> 3)).collect();
         blocks.dedup();
         blocks.push(ke.map(|k| k >> 3));
         let mut s = Scratch::new(ko.map(|c| c >> 3), None);
         let mut want: HashSet<[i64; 3]> = path.iter().copied().collect();
         for (i, b) in blocks.iter().enumerate() {
-            if i == 0 || i + 1 == blocks.len() || rng.random_range(0..3) == 0 {
+            if i == 0 || i + 1 == blocks.len() || rng.random_range(0..10) < fill {
                 s.fill(*b);
                 for bit in 0..512 {
                     want.insert([
@@ -216,6 +219,8 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
         JUMPS.load(Ordering::Relaxed) > before + 4000,
         "the jumps were taken"
     );
+    let runs = RUN_JUMPS.load(Ordering::Relaxed) - runs_before;
+    assert!(runs > 20_000, "runs of full blocks were crossed ({runs} blocks)");
 }
 
 /// A scratch's slots against a map from block to hit cells: one slot per block, in
@@ -258,4 +263,76 @@ fn a_scratch_holds_one_slot_per_block_near_far_and_beyond_packing() {
             assert_eq!(Some(&got), want.get(k), "round {round}: block {k:?}");
         }
     }
+}
+
+/// Runs of full blocks on walks whose parameters are coarse dyadic numbers, so that
+/// borders of different axes often fall on one parameter at a block's face (where
+/// the order of the steps decides the cells): the walk marks the cells of the
+/// reference walk from the same state.
+#[test]
+fn runs_of_full_blocks_keep_the_reference_order_on_ties() {
+    let mut rng = Pcg64::seed_from_u64(14);
+    let runs_before = RUN_JUMPS.load(Ordering::Relaxed);
+    for case in 0..3000 {
+        let step = [0, 1, 2].map(|_| [-1i64, 1, 1, 0][rng.random_range(0..4)]);
+        if step == [0; 3] {
+            continue;
+        }
+        let d = [0, 1, 2].map(|i| {
+            if step[i] == 0 {
+                f64::MAX
+            } else {
+                f64::from(rng.random_range(1..5u32)) / 4.0
+            }
+        });
+        let t_max = [0, 1, 2].map(|i| {
+            if step[i] == 0 {
+                f64::MAX
+            } else {
+                f64::from(rng.random_range(1..=(d[i] * 8.0) as u32)) / 8.0
+            }
+        });
+        let left_axis = [0, 1, 2].map(|i| if step[i] == 0 { 0 } else { rng.random_range(0..70) });
+        let make = || Dda {
+            step,
+            t_max,
+            t_delta: d,
+            left_axis,
+            left: left_axis.iter().sum(),
+        };
+        if make().left == 0 {
+            continue;
+        }
+        let ko = [0, 1, 2].map(|_| rng.random_range(-40..40i64));
+        let mut path = Vec::new();
+        walk_from(make(), ko, |c| path.push(c));
+        let mut blocks: Vec<[i64; 3]> = path.iter().map(|c| c.map(|k| k >> 3)).collect();
+        blocks.dedup();
+        let mut s = Scratch::new(ko.map(|c| c >> 3), None);
+        let mut want: HashSet<[i64; 3]> = path.iter().copied().collect();
+        // Most blocks full, a few (where the walk goes cell by cell again) not.
+        for b in &blocks {
+            if rng.random_range(0..10) < [7, 9, 10][case % 3] {
+                s.fill(*b);
+                want.extend((0..512).map(|bit| {
+                    [
+                        b[0] * 8 + (bit & 7),
+                        b[1] * 8 + (bit >> 3 & 7),
+                        b[2] * 8 + (bit >> 6),
+                    ]
+                }));
+            }
+        }
+        s.miss_walk(&make(), ko);
+        let got = missed(&s);
+        let extra: Vec<_> = got.difference(&want).collect();
+        let lost: Vec<_> = want.difference(&got).collect();
+        assert!(
+            extra.is_empty() && lost.is_empty(),
+            "case {case}: step {step:?} t {t_max:?} d {d:?} left {left_axis:?} from {ko:?}: \
+             extra {extra:?}, lost {lost:?}"
+        );
+    }
+    let runs = RUN_JUMPS.load(Ordering::Relaxed) - runs_before;
+    assert!(runs > 10_000, "runs of full blocks were crossed ({runs} blocks)");
 }
