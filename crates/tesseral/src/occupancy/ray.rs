@@ -6,9 +6,9 @@ use std::sync::Arc;
 
 use rustc_hash::FxHashMap;
 
+use super::dda::{exit_block, Dda};
 #[cfg(test)]
 use super::dda::{JUMPS, RUN_JUMPS};
-use super::dda::{exit_block, Dda};
 use super::store::{cube_index, BlockKey, BLOCK_LOG2};
 
 /// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray

@@ -220,7 +220,10 @@ fn jumps_over_full_blocks_keep_the_cells_of_the_reference_walk() {
         "the jumps were taken"
     );
     let runs = RUN_JUMPS.load(Ordering::Relaxed) - runs_before;
-    assert!(runs > 20_000, "runs of full blocks were crossed ({runs} blocks)");
+    assert!(
+        runs > 20_000,
+        "runs of full blocks were crossed ({runs} blocks)"
+    );
 }
 
 /// A scratch's slots against a map from block to hit cells: one slot per block, in
@@ -292,7 +295,13 @@ fn runs_of_full_blocks_keep_the_reference_order_on_ties() {
                 f64::from(rng.random_range(1..=(d[i] * 8.0) as u32)) / 8.0
             }
         });
-        let left_axis = [0, 1, 2].map(|i| if step[i] == 0 { 0 } else { rng.random_range(0..70) });
+        let left_axis = [0, 1, 2].map(|i| {
+            if step[i] == 0 {
+                0
+            } else {
+                rng.random_range(0..70)
+            }
+        });
         let make = || Dda {
             step,
             t_max,
@@ -334,5 +343,8 @@ fn runs_of_full_blocks_keep_the_reference_order_on_ties() {
         );
     }
     let runs = RUN_JUMPS.load(Ordering::Relaxed) - runs_before;
-    assert!(runs > 10_000, "runs of full blocks were crossed ({runs} blocks)");
+    assert!(
+        runs > 10_000,
+        "runs of full blocks were crossed ({runs} blocks)"
+    );
 }
