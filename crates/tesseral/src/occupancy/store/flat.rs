@@ -41,6 +41,10 @@ pub(crate) struct Flat {
     lo: BlockKey,
     /// The box's sides in blocks (all 0 when the index is not live).
     dims: [u64; 3],
+    /// The entries from one block to the next along y and z (`dims[0]`,
+    /// `dims[0] * dims[1]`), so that a lookup's two products do not wait on each
+    /// other.
+    strides: [u64; 2],
     /// Block entries, x fastest (empty when not live).
     entries: Vec<Entry>,
     /// The bounding box of every block ever given an entry (lowest, highest).
@@ -61,7 +65,7 @@ impl Flat {
         // Below `lo`, the difference wraps past every side.
         let d = [0, 1, 2].map(|a| b[a].wrapping_sub(self.lo[a]) as u64);
         (d[0] < self.dims[0] && d[1] < self.dims[1] && d[2] < self.dims[2])
-            .then(|| (d[0] + self.dims[0] * (d[1] + self.dims[1] * d[2])) as usize)
+            .then(|| (d[0] + self.strides[0] * d[1] + self.strides[1] * d[2]) as usize)
     }
 
     /// The entries, by [`index`](Self::index).
@@ -93,6 +97,7 @@ impl Flat {
     /// Stops mirroring and frees the entries.
     pub fn retire(&mut self) {
         self.dims = [0; 3];
+        self.strides = [0; 2];
         self.entries = Vec::new();
     }
 
@@ -134,6 +139,7 @@ impl Flat {
     ) {
         self.lo = lo;
         self.dims = dims;
+        self.strides = [dims[0], dims[0] * dims[1]];
         self.entries = vec![Entry::EMPTY; volume];
         fill(self);
     }
