@@ -36,6 +36,7 @@
 
 mod convert;
 mod dda;
+mod far;
 mod ray;
 mod scan;
 mod scan_order;

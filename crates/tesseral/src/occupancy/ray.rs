@@ -9,6 +9,7 @@ use rustc_hash::FxHashMap;
 use super::dda::{exit_block, Dda};
 #[cfg(test)]
 use super::dda::{JUMPS, RUN_JUMPS};
+use super::far::Far;
 use super::store::{cube_index, BlockKey, BLOCK_LOG2};
 
 /// The bits of one block's cells, one cache line: bit `x + 8y` of word `z`. A ray
@@ -61,9 +62,9 @@ pub(crate) struct Scratch {
     /// block in one jump (it is [`FULL`] or [`CLAMPED`]), so that the walk tests 32
     /// KiB rather than the index's 1 MiB before a jump.
     jump: Box<[u64]>,
-    /// Blocks beyond the dense index, by their offset from `centre` packed in 21
-    /// bits per axis.
-    far: FxHashMap<u64, u32>,
+    /// Blocks beyond the dense index, by their offset from `centre` (21 bits per
+    /// axis), in bricks of 8³ blocks.
+    far: Far,
     /// Blocks too far from `centre` to pack.
     wide: FxHashMap<BlockKey, u32>,
     /// The key of each slot.
@@ -105,7 +106,7 @@ impl Scratch {
             clamped,
             near_lo: near_cube(centre).0,
             near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
-            far: FxHashMap::default(),
+            far: Far::default(),
             wide: FxHashMap::default(),
             keys: Vec::new(),
             miss: Vec::new(),
@@ -209,7 +210,7 @@ impl Scratch {
         if let [Some(x), Some(y), Some(z)] = d {
             if [x, y, z].iter().all(|c| (-PACK..PACK).contains(c)) {
                 let p = |c: i64| (c + PACK) as u64;
-                return *self.far.entry(p(x) | p(y) << 21 | p(z) << 42).or_insert(n);
+                return self.far.slot([p(x), p(y), p(z)], n);
             }
         }
         *self.wide.entry(b).or_insert(n)
