@@ -176,12 +176,8 @@ pub(crate) fn exit_block(
     let mut e = [f64::MAX; 3];
     for i in 0..3 {
         if step[i] != 0 {
-            w[i] = if step[i] > 0 { 8 - c[i] } else { c[i] + 1 };
-            let mut v = t[i];
-            for _ in 1..w[i] {
-                v += d[i];
-            }
-            e[i] = v;
+            w[i] = steps_to_face(c[i], step[i]);
+            e[i] = face(t[i], d[i], c[i], step[i]);
         }
     }
     let a = if e[0] < e[1] {
@@ -209,6 +205,32 @@ pub(crate) fn exit_block(
         }
     }
     (a, n, out)
+}
+
+/// The borders a walk at block-local coordinate `c` crosses along an axis, stepping
+/// `s` (±1), up to and including its block's face (8 − c or c + 1).
+#[inline(always)]
+pub(crate) fn steps_to_face(c: i64, s: i64) -> i64 {
+    if s > 0 {
+        8 - c
+    } else {
+        c + 1
+    }
+}
+
+/// The parameter of the block face ahead along an axis, from `t`, the parameter of
+/// the next border, `d` apart, summed border by border as the walk sums them; the
+/// largest float when the axis is not stepped (`s` 0).
+#[inline(always)]
+pub(crate) fn face(t: f64, d: f64, c: i64, s: i64) -> f64 {
+    if s == 0 {
+        return f64::MAX;
+    }
+    let mut v = t;
+    for _ in 1..steps_to_face(c, s) {
+        v += d;
+    }
+    v
 }
 
 /// Blocks crossed by [`exit_block`] so far (tests check that the jump is taken).

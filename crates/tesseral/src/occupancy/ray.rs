@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use rustc_hash::FxHashMap;
 
-use super::dda::{exit_block, Dda};
+use super::dda::{exit_block, face, steps_to_face, Dda};
 #[cfg(test)]
 use super::dda::{JUMPS, RUN_JUMPS};
 use super::far::Far;
@@ -59,8 +59,9 @@ pub(crate) struct Scratch {
     near_lo: BlockKey,
     near: Vec<u32>,
     /// One bit per block of the dense index, in its order: set when rays cross the
-    /// block in one jump (it is [`FULL`] or [`CLAMPED`]), so that the walk tests 32
-    /// KiB rather than the index's 1 MiB before a jump.
+    /// block in one jump (it is [`FULL`], or [`CLAMPED`]: the map's clamped blocks
+    /// are set from the start), so that the walk tests 32 KiB rather than the
+    /// index's 1 MiB before a jump.
     jump: Box<[u64]>,
     /// Blocks beyond the dense index, by their offset from `centre` (21 bits per
     /// axis), in bricks of 8³ blocks.
@@ -74,9 +75,6 @@ pub(crate) struct Scratch {
     /// Per slot, 1 + its index in `hits`, or 0 when no ray ends in it.
     hit_at: Vec<u32>,
     hits: Vec<Bits>,
-    /// The blocks of the dense index that the map holds clamped free, one bit each
-    /// in the index's order (see [`near_cube`]), if known.
-    clamped: Option<Arc<[u64]>>,
 }
 
 /// The dense index of a scratch centred on block `centre`: its lowest block and
@@ -103,7 +101,6 @@ impl Scratch {
         Self {
             jump,
             centre,
-            clamped,
             near_lo: near_cube(centre).0,
             near: vec![NO_SLOT; 1 << (3 * NEAR_SIDE_LOG2)],
             far: Far::default(),
@@ -171,6 +168,17 @@ impl Scratch {
         self.enter_at(b, cube_index(self.near_lo, NEAR_SIDE_LOG2, b))
     }
 
+    /// Block `b`'s place in the dense index, if any, and whether rays cross it in one
+    /// jump (its bit in `jump`).
+    #[inline(always)]
+    fn near_jump(&self, b: BlockKey) -> (Option<usize>, bool) {
+        let near = cube_index(self.near_lo, NEAR_SIDE_LOG2, b);
+        (
+            near,
+            near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0),
+        )
+    }
+
     /// Marks the block at `at` in the dense index all missed.
     #[inline(always)]
     fn set_full(&mut self, at: usize) {
@@ -186,10 +194,9 @@ impl Scratch {
         let (i, at) = if let Some(at) = near {
             let mut i = self.near[at];
             if i == NO_SLOT {
-                let clamped = self
-                    .clamped
-                    .as_ref()
-                    .is_some_and(|c| c[at / 64] >> (at % 64) & 1 != 0);
+                // A block with no slot is in `jump` only as clamped by the map (a
+                // block full of misses has a slot).
+                let clamped = self.jump[at >> 6] >> (at & 63) & 1 != 0;
                 i = if clamped { CLAMPED } else { n + 1 };
                 self.near[at] = i;
             }
@@ -267,24 +274,13 @@ impl Scratch {
             // dense index is known full by its bit in `jump`, set as a ray leaves it
             // full (its line is in cache then); one beyond is checked as it is
             // entered.
-            let mut near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
-            let mut jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+            let (mut near, mut jump) = self.near_jump(block);
             if jump && far(block) {
                 // A run of full blocks far from the end: only the faces matter. Each
                 // axis keeps the parameter of its next face (`e*`, summed as the walk
                 // sums), and its cell state (`t*`, the coordinate, steps left) as of
                 // the last face it crossed; the others' state is caught up once, on
                 // leaving the run.
-                let face = |t: f64, d: f64, c: i64, s: i64| {
-                    if s == 0 {
-                        return f64::MAX;
-                    }
-                    let mut v = t;
-                    for _ in 1..if s > 0 { 8 - c } else { c + 1 } {
-                        v += d;
-                    }
-                    v
-                };
                 let (mut ex, mut ey, mut ez) = (
                     face(tx, dx, x, sx),
                     face(ty, dy, y, sy),
@@ -294,7 +290,7 @@ impl Scratch {
                 let mut entry = None;
                 macro_rules! cross {
                     ($e:ident, $t:ident, $d:ident, $c:ident, $s:ident, $l:ident, $axis:expr) => {{
-                        let steps = if $s > 0 { 8 - $c } else { $c + 1 };
+                        let steps = steps_to_face($c, $s);
                         if $l < steps {
                             // (Not expected far from the end.) The exact path takes it.
                             break;
@@ -322,8 +318,7 @@ impl Scratch {
                     }
                     #[cfg(test)]
                     RUN_JUMPS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
-                    near = cube_index(self.near_lo, NEAR_SIDE_LOG2, block);
-                    jump = near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0);
+                    (near, jump) = self.near_jump(block);
                     if !(jump && far(block)) {
                         break;
                     }
