@@ -68,6 +68,16 @@ impl Flat {
             .then(|| (d[0] + self.strides[0] * d[1] + self.strides[1] * d[2]) as usize)
     }
 
+    /// The entry at position `at`, as [`index`](Self::index) gives it.
+    #[inline(always)]
+    pub fn entry(&self, at: usize) -> Entry {
+        debug_assert!(at < self.entries.len());
+        // SAFETY: `index` gives positions below the product of the sides, and while
+        // the index is live `entries` holds that many (set together in `rebuild`,
+        // cleared together in `retire`; checked by `assert_valid`).
+        unsafe { *self.entries.get_unchecked(at) }
+    }
+
     /// The entries, by [`index`](Self::index).
     #[inline(always)]
     pub fn entries(&self) -> &[Entry] {

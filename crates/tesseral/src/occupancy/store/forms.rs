@@ -31,7 +31,7 @@ pub(crate) fn sparse_units(len: usize) -> usize {
 
 /// Words of a palette block's cells.
 #[inline]
-pub(crate) fn bits_words(w: u32) -> usize {
+pub(crate) const fn bits_words(w: u32) -> usize {
     32 * w as usize
 }
 

@@ -9,6 +9,33 @@ use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, 
 use crate::occupancy::prefetch;
 use crate::occupancy::sensor::UNKNOWN;
 
+/// Word `k` of an arena's words, which holds it: the stored entries point inside
+/// their arena (checked by [`Store::assert_valid`]), and a block's cells and value
+/// list inside its units.
+#[inline(always)]
+fn words_at(words: &[u16], k: usize) -> u16 {
+    debug_assert!(k < words.len(), "word {k} of {}", words.len());
+    // SAFETY: every entry stored in the tables and the read index points at a block
+    // wholly inside its arena (`assert_valid` checks each block's units against the
+    // arena's length), and `value` reads only the words of the block's form: a
+    // palette's cells and the value its cell numbers (each below the list's
+    // length, also checked there), a dense block's cells.
+    unsafe { *words.get_unchecked(k) }
+}
+
+/// Palettes of width 1, 2, 4 and 8 (by `tag − PALETTE`): where the value list
+/// starts (after the cells and the count), above the mask of a cell's bits.
+const PALETTES: [u32; 4] = {
+    let mut p = [0; 4];
+    let mut k = 0;
+    while k < 4 {
+        let w = 1 << k;
+        p[k] = (bits_words(w) as u32 + 1) << 8 | ((1 << w) - 1);
+        k += 1;
+    }
+    p
+};
+
 /// Cells looked up together by [`Store::get_many`].
 pub(crate) const BATCH: usize = 32;
 
@@ -17,11 +44,16 @@ impl Store {
     #[inline(always)]
     pub fn get(&self, cell: [i64; 3]) -> i16 {
         let (b, i) = split(cell);
-        let (entries, at) = self.locate(b);
-        match at {
-            Some(at) => self.value(entries[at], i),
-            None => UNKNOWN,
-        }
+        let e = match self.flat.index(b) {
+            Some(at) => self.flat.entry(at),
+            // A retired index has no box: every block goes through the directory.
+            None if !self.flat.live() => match self.find(b) {
+                Some(at) => self.tables[at],
+                None => return UNKNOWN,
+            },
+            None => return UNKNOWN,
+        };
+        self.value(e, i)
     }
 
     /// Where block `b`'s entry is read: the read index while it is live (the
@@ -82,34 +114,25 @@ impl Store {
     #[inline(always)]
     fn value(&self, e: Entry, i: usize) -> i16 {
         let tag = e.tag();
-        if tag <= UNIFORM {
-            return if tag == EMPTY {
-                UNKNOWN
-            } else {
-                (e.0 >> 16) as u16 as i16
-            };
-        }
         let words = &self.arenas[e.arena()].words;
         let at = e.offset() as usize * UNIT;
-        if tag == SPARSE {
+        // Palettes of width w = 1, 2, 4 or 8 (tags 3 to 6) first: most lookups land
+        // on surfaces, stored as palettes. No branch on the width.
+        if tag.wrapping_sub(PALETTE) < 4 {
+            let bit = i << (tag - PALETTE);
+            let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
+            let p = PALETTES[tag as usize - PALETTE as usize];
+            let j = usize::from(x) & (p as usize & 0xff);
+            return words_at(words, at + (p >> 8) as usize + j) as i16;
+        }
+        match tag {
+            EMPTY => UNKNOWN,
+            UNIFORM => (e.0 >> 16) as u16 as i16,
             // Compares, not a binary search (see `probe`).
-            return sparse_value(words, at, i);
+            SPARSE => sparse_value(words, at, i),
+            // DENSE: the cells are the values.
+            _ => words_at(words, at + i) as i16,
         }
-        // A palette of width w, or a dense block read as a palette of width 16
-        // whose cells are their values (tags 3 to 7): no branch on the width. The
-        // value list's first line is fetched while the cell's bits are read.
-        let w = 1usize << (tag - PALETTE);
-        if let Some(x) = words.get(at + bits_words(w as u32) + 1) {
-            prefetch(x);
-        }
-        let bit = i * w;
-        let j = (words[at + (bit >> 4)] >> (bit & 15)) as usize & ((1 << w) - 1);
-        let v = if tag == DENSE {
-            at + i
-        } else {
-            at + bits_words(w as u32) + 1 + j
-        };
-        words[v] as i16
     }
 
     /// The values of `cells` into `out` (as many), as [`get`](Self::get) would give
