@@ -18,8 +18,8 @@ fn words_at(words: &[u16], k: usize) -> u16 {
     // SAFETY: every entry stored in the tables and the read index points at a block
     // wholly inside its arena (`assert_valid` checks each block's units against the
     // arena's length), and `value` reads only the words of the block's form: a
-    // palette's cells and the value its cell numbers (each below the list's
-    // length, also checked there), a dense block's cells.
+    // palette's cells and the list entries their numbers give (each number below
+    // the list's length, also checked there), a dense block's cells.
     unsafe { *words.get_unchecked(k) }
 }
 
