@@ -297,11 +297,16 @@ fn sparse_blocks_of_every_length_agree_with_the_model() {
             model.insert(c, fixed.hit);
         }
         let blocks = [at, [at[0] + 1, at[1] - 1, at[2]]];
-        // Six distinct values inside the clamps.
-        let step = (i32::from(fixed.max) - i32::from(fixed.min)) / 7;
-        let values: Vec<i16> = (1..=6)
-            .map(|k| (i32::from(fixed.min) + k * step) as i16)
-            .collect();
+        // Six distinct values inside the clamps for the second block, and six free
+        // ones for the first: a surface whose values fit a palette of two bits takes
+        // it, so only the first is sparse at every length.
+        let spread = |top: i16| {
+            let step = (i32::from(top) - i32::from(fixed.min)) / 7;
+            (1..=6)
+                .map(|k| (i32::from(fixed.min) + k * step) as i16)
+                .collect::<Vec<i16>>()
+        };
+        let values = [spread(fixed.threshold), spread(fixed.max)];
         let mut order: Vec<Vec<usize>> = Vec::new();
         for _ in blocks {
             let mut o: Vec<usize> = (0..512).collect();
@@ -312,7 +317,7 @@ fn sparse_blocks_of_every_length_agree_with_the_model() {
         }
         let mut sparse_lengths = Vec::new();
         for len in 1..=140 {
-            for (b, o) in blocks.iter().zip(&order) {
+            for ((b, o), values) in blocks.iter().zip(&order).zip(&values) {
                 let i = o[len - 1];
                 let c = [
                     b[0] << 3 | (i & 7) as i64,

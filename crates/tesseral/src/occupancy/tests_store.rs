@@ -153,6 +153,33 @@ fn blocks_take_the_smallest_form() {
     }
     store.put(b, &cells, fixed);
     assert_eq!(kind(&store), Some(Kind::Sparse));
+    // The same cells occupied: a surface, whose values fit two bits, takes a palette
+    // though the sparse form is smaller (5 units against 3, within the slack).
+    for c in cells.iter_mut().step_by(50) {
+        *c = fixed.max;
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(1)));
+    // A surface of two cells, one free and one occupied, with unknown: a 2-bit
+    // palette would take 9 units against the sparse form's 2, past the slack.
+    let mut two = [UNKNOWN; 512];
+    two[7] = fixed.min;
+    two[300] = fixed.max;
+    store.put(b, &two, fixed);
+    assert_eq!(kind(&store), Some(Kind::Sparse));
+    // Twenty such cells (sparse: 4 units): the palette is within the slack.
+    for (k, c) in two.iter_mut().step_by(25).enumerate() {
+        *c = [fixed.min, fixed.max][k % 2];
+    }
+    store.put(b, &two, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(2)));
+    // Five known values, one occupied, and unknown: past two bits, so sparse again.
+    for (k, c) in cells.iter_mut().step_by(50).enumerate() {
+        *c = [fixed.min, fixed.miss, fixed.hit, fixed.max, fixed.min + 1][k % 5];
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Sparse));
+    store.assert_valid(fixed);
     // Half the cells known, two values and unknown: 2-bit palette.
     for (i, c) in cells.iter_mut().enumerate() {
         *c = [UNKNOWN, fixed.min, fixed.max][i % 3];
@@ -234,7 +261,8 @@ fn blocks_that_list_an_occupied_value_move_to_their_own_arena() {
     store.update(c, &none, &one, fixed);
     store.update(d, &one, &none, fixed);
     store.assert_valid(fixed);
-    assert_eq!(store.entry(c).map(|e| e.kind()), Some(Kind::Sparse));
+    // One occupied cell and unknown: a surface, so a 1-bit palette, not sparse.
+    assert_eq!(store.entry(c).map(|e| e.kind()), Some(Kind::Palette(1)));
     assert_eq!(store.in_occupied_arena(c), Some(true));
     assert_eq!(store.in_occupied_arena(d), Some(false));
     // Random updates: `assert_valid` checks every block's arena after each.

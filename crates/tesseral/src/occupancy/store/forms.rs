@@ -199,18 +199,38 @@ impl Census {
     }
 }
 
-/// The form a block takes: its tag and its units (0 for none and uniform).
-pub(crate) fn choose(known: usize, values: usize, known_values: usize) -> (u32, usize) {
+/// Units a surface's palette of width 1 or 2 may take beyond the sparse form's and
+/// still be chosen (see [`choose`]).
+pub(crate) const SURFACE_SLACK: usize = 6;
+
+/// The form a block takes: its tag and its units (0 for none and uniform). The
+/// smallest, except that a *surface* (a block that lists an occupied value) whose
+/// values fit a palette of width 1 or 2 takes that palette unless the sparse form
+/// is more than [`SURFACE_SLACK`] units (96 bytes) smaller. Lookups land mostly on
+/// surfaces, and a palette is read without the sparse form's compares and without
+/// a mispredicted branch between the two forms; the slack keeps the few-cell
+/// surfaces of a thinly seen map sparse, so that the surfaces' arena still fits
+/// the caches (ARCHITECTURE.md, "Surfaces in palettes").
+pub(crate) fn choose(
+    known: usize,
+    values: usize,
+    known_values: usize,
+    surface: bool,
+) -> (u32, usize) {
     let mut best = (DENSE, DENSE_UNITS);
+    let mut slack = 0;
     if let Some(w) = width_for(values) {
         let u = palette_units(w, values);
         if u <= best.1 {
             best = (PALETTE + w.trailing_zeros(), u);
+            if surface && w <= 2 {
+                slack = SURFACE_SLACK;
+            }
         }
     }
     if known_values <= SPARSE_VALUES {
         let u = sparse_units(known);
-        if u < best.1 {
+        if u + slack < best.1 {
             best = (SPARSE, u);
         }
     }

@@ -285,7 +285,12 @@ impl Store {
             }
         }
         let occupied = any_occupied(census.values.iter().copied(), fixed);
-        let (tag, units) = choose(census.known, census.values.len(), census.known_values());
+        let (tag, units) = choose(
+            census.known,
+            census.values.len(),
+            census.known_values(),
+            occupied,
+        );
         match tag {
             SPARSE => {
                 let mut list = std::mem::take(&mut self.scratch);

@@ -68,9 +68,9 @@ impl Store {
         }
         let n = out.len();
         let values_all = if n < BLOCK_CELLS { k + 1 } else { k };
-        let (tag, units) = choose(n, values_all, k);
+        let occupied = any_occupied(values[..k].iter().map(|&v| v as i16), fixed);
+        let (tag, units) = choose(n, values_all, k, occupied);
         if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
-            let occupied = any_occupied(values[..k].iter().map(|&v| v as i16), fixed);
             if let Some(words) = self.place(s, SPARSE, units, occupied) {
                 write_sparse(words, &out);
             }
