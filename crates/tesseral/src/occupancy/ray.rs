@@ -173,10 +173,13 @@ impl Scratch {
     #[inline(always)]
     fn near_jump(&self, b: BlockKey) -> (Option<usize>, bool) {
         let near = cube_index(self.near_lo, NEAR_SIDE_LOG2, b);
-        (
-            near,
-            near.is_some_and(|at| self.jump[at >> 6] >> (at & 63) & 1 != 0),
-        )
+        (near, near.is_some_and(|at| self.jumps(at)))
+    }
+
+    /// Whether rays cross the block at `at` in the dense index in one jump.
+    #[inline(always)]
+    fn jumps(&self, at: usize) -> bool {
+        self.jump[at >> 6] >> (at & 63) & 1 != 0
     }
 
     /// Marks the block at `at` in the dense index all missed.
@@ -196,7 +199,7 @@ impl Scratch {
             if i == NO_SLOT {
                 // A block with no slot is in `jump` only as clamped by the map (a
                 // block full of misses has a slot).
-                let clamped = self.jump[at >> 6] >> (at & 63) & 1 != 0;
+                let clamped = self.jumps(at);
                 i = if clamped { CLAMPED } else { n + 1 };
                 self.near[at] = i;
             }

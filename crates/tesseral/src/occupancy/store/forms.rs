@@ -35,6 +35,13 @@ pub(crate) const fn bits_words(w: u32) -> usize {
     32 * w as usize
 }
 
+/// Where a palette block of width `w` lists its values: after its cells and the
+/// list's length.
+#[inline]
+pub(crate) const fn list_at(w: u32) -> usize {
+    bits_words(w) + 1
+}
+
 /// Words of a palette block's value list (its length first) holding `k` values.
 #[inline]
 fn list_words(w: u32, k: usize) -> usize {
@@ -143,7 +150,7 @@ pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
         }
         _ => {
             let w = 1 << (tag - PALETTE);
-            let list = &words[bits_words(w) + 1..];
+            let list = &words[list_at(w)..];
             for (i, o) in out.iter_mut().enumerate() {
                 *o = list[palette_index(words, w, i)] as i16;
             }
@@ -430,5 +437,5 @@ pub(crate) fn palette_single(words: &[u16], w: u32) -> Option<i16> {
     words[..bits_words(w)]
         .iter()
         .all(|&x| x == pattern)
-        .then(|| words[bits_words(w) + 1 + first] as i16)
+        .then(|| words[list_at(w) + first] as i16)
 }

@@ -3,7 +3,7 @@
 //! index ([`super::flat`]) while it is live, else the directory and the tables.
 
 use super::arena::UNIT;
-use super::forms::{bits_words, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
+use super::forms::{list_at, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
 use super::probe::{sparse_value, LANES};
 use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
 use crate::occupancy::prefetch;
@@ -30,7 +30,7 @@ const PALETTES: [u32; 4] = {
     let mut k = 0;
     while k < 4 {
         let w = 1 << k;
-        p[k] = (bits_words(w) as u32 + 1) << 8 | ((1 << w) - 1);
+        p[k] = (list_at(w) as u32) << 8 | ((1 << w) - 1);
         k += 1;
     }
     p
@@ -181,7 +181,7 @@ impl Store {
             DENSE => (at + i, at + i),
             t => {
                 let w = 1 << (t - PALETTE);
-                (at + ((i * w) >> 4), at + bits_words(w as u32) + 1)
+                (at + ((i * w) >> 4), at + list_at(w as u32))
             }
         };
         let words = &self.arenas[e.arena()].words;

@@ -2,8 +2,8 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, lists_occupied, palette_index, sparse_units, units_of, DENSE, EMPTY, PALETTE,
-    SPARSE, SPARSE_VALUES, UNIFORM,
+    bits_words, list_at, lists_occupied, palette_index, sparse_units, units_of, DENSE, EMPTY,
+    PALETTE, SPARSE, SPARSE_VALUES, UNIFORM,
 };
 use super::{block_of, Store, BLOCK_CELLS, OCCUPIED, TABLE};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
@@ -144,7 +144,7 @@ impl Store {
                         (1..=1usize << w).contains(&k),
                         "palette block {b:?}: {k} values for width {w}"
                     );
-                    let values = &words[bits_words(w) + 1..bits_words(w) + 1 + k];
+                    let values = &words[list_at(w)..list_at(w) + k];
                     for (j, &v) in values.iter().enumerate() {
                         assert!(
                             !values[..j].contains(&v),
