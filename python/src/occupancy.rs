@@ -192,9 +192,10 @@ impl OccupancyMap {
     /// Counts: occupied, free, leaves, blocks, bytes.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
-        d.set_item("occupied", self.map.occupied_count())?;
-        d.set_item("free", self.map.free_count())?;
-        d.set_item("leaves", self.map.leaf_count())?;
+        let n = self.map.counts();
+        d.set_item("occupied", n.occupied)?;
+        d.set_item("free", n.free)?;
+        d.set_item("leaves", n.leaves)?;
         d.set_item("blocks", self.map.block_count())?;
         d.set_item("bytes", self.map.bytes())?;
         Ok(d)

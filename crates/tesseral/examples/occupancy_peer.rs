@@ -160,13 +160,14 @@ fn main() -> std::io::Result<()> {
             let known_many = out.iter().filter(|v| v.is_some()).count();
             let (many, many_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
             assert_eq!(known_many, known, "batched and single lookups agree");
+            let counts = map.counts();
             println!(
                 "RESULT tesseral scans {} rays {rays} insert_s {wall:.3} cpu_s {cpu:.3} rays_per_s {:.4e} bytes {} occupied {} free {} lookup_ns {:.1} known {known} lookup_cpu_ns {:.1} lookup_many_ns {:.1} lookup_many_cpu_ns {:.1} {loops}",
                 sc.len(),
                 rays as f64 / wall,
                 map.bytes(),
-                map.occupied_count(),
-                map.free_count(),
+                counts.occupied,
+                counts.free,
                 lookup * 1e3,
                 lookup_cpu * 1e3,
                 many * 1e3,

@@ -196,14 +196,15 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         0.0
     };
+    let counts = map.counts();
     if args.json {
         let v = serde_json::json!({
             "scans": t.scans,
             "points": t.points,
             "rays": t.rays,
-            "occupied": map.occupied_count(),
-            "free": map.free_count(),
-            "leaves": map.leaf_count(),
+            "occupied": counts.occupied,
+            "free": counts.free,
+            "leaves": counts.leaves,
             "bytes": map.bytes(),
             "seconds": t.seconds,
             "rays_per_second": rate,
@@ -218,9 +219,9 @@ pub fn run(args: Args) -> Result<()> {
             t.rays,
             t.seconds,
             rate / 1e6,
-            map.occupied_count(),
-            map.free_count(),
-            map.leaf_count(),
+            counts.occupied,
+            counts.free,
+            counts.leaves,
             map.bytes()
         );
         if super::output::is_stdio(&args.output) {

@@ -114,6 +114,19 @@ pub struct ScanStats {
     pub misses: u64,
 }
 
+/// The cells a map knows, by state, and its stored entries
+/// ([`OccupancyMap::counts`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct CellCounts {
+    /// Known cells at or above the threshold.
+    pub occupied: u64,
+    /// Known cells below the threshold.
+    pub free: u64,
+    /// Entries: one per uniform block, one per known cell of another block (see
+    /// [`OccupancyMap::leaf_count`]).
+    pub leaves: u64,
+}
+
 /// A cell's state.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum CellState {
@@ -266,25 +279,36 @@ impl OccupancyMap {
         self.store.set(cell, v, self.fixed);
     }
 
+    /// The numbers of occupied and free cells and of stored entries, counted in
+    /// one pass over the map (each of [`occupied_count`](Self::occupied_count),
+    /// [`free_count`](Self::free_count) and [`leaf_count`](Self::leaf_count)
+    /// makes that pass for one of them).
+    ///
+    /// # Runtime
+    /// O(b + k) for b blocks stored and k cells in blocks that are not uniform; no
+    /// block is decoded (a palette's cells are counted by popcounts).
+    #[must_use]
+    pub fn counts(&self) -> CellCounts {
+        self.store.census(self.fixed.threshold)
+    }
+
     /// The number of occupied cells.
     #[must_use]
     pub fn occupied_count(&self) -> u64 {
-        let t = self.fixed.threshold;
-        self.store.count(|v| v != UNKNOWN && v >= t)
+        self.counts().occupied
     }
 
     /// The number of free cells.
     #[must_use]
     pub fn free_count(&self) -> u64 {
-        let t = self.fixed.threshold;
-        self.store.count(|v| v != UNKNOWN && v < t)
+        self.counts().free
     }
 
     /// The number of stored entries: one per uniform block, one per known cell of a
     /// sparse or dense block (what OctoMap's leaf count is after pruning, at block grain).
     #[must_use]
     pub fn leaf_count(&self) -> u64 {
-        self.store.leaf_count()
+        self.counts().leaves
     }
 
     /// The number of 8×8×8 blocks stored (uniform, sparse and dense).

@@ -28,7 +28,9 @@ fn cell_of(b: [i64; 3], i: usize) -> [i64; 3] {
     ]
 }
 
-fn check(store: &Store, model: &HashMap<[i64; 3], i16>, what: &str) {
+/// Every cell of the model, the store's cells against it, and the store's census
+/// (counted form by form, without decoding) against counts of the model.
+fn check(store: &Store, model: &HashMap<[i64; 3], i16>, fixed: Fixed, what: &str) {
     for (&c, &v) in model {
         assert_eq!(store.get(c), v, "{what}: cell {c:?}");
     }
@@ -38,6 +40,37 @@ fn check(store: &Store, model: &HashMap<[i64; 3], i16>, what: &str) {
         assert_eq!(model.get(&c), Some(&v), "{what}: cell {c:?}");
     });
     assert_eq!(n, model.len(), "{what}: cells");
+    let occupied = model.values().filter(|&&v| v >= fixed.threshold).count() as u64;
+    // One entry per uniform block, one per known cell of the others.
+    let uniform: Vec<[i64; 3]> = BLOCKS
+        .into_iter()
+        .filter(|&b| matches!(store.entry(b).map(|e| e.kind()), Some(Kind::Uniform(_))))
+        .collect();
+    let in_uniform = |c: &[i64; 3]| uniform.contains(&c.map(|x| x >> 3));
+    let leaves = uniform.len() as u64 + model.keys().filter(|c| !in_uniform(c)).count() as u64;
+    let got = store.census(fixed.threshold);
+    assert_eq!(
+        (got.occupied, got.free, got.leaves),
+        (occupied, model.len() as u64 - occupied, leaves),
+        "{what}: census"
+    );
+}
+
+/// The forms of the blocks stored: uniform, sparse, palettes of 1, 2, 4, 8 bits,
+/// dense.
+fn forms_of(store: &Store) -> [bool; 7] {
+    let mut forms = [false; 7];
+    for b in BLOCKS {
+        let f = match store.entry(b).map(|e| e.kind()) {
+            Some(Kind::Uniform(_)) => 0,
+            Some(Kind::Sparse) => 1,
+            Some(Kind::Palette(w)) => 2 + w.trailing_zeros() as usize,
+            Some(Kind::Dense) => 6,
+            None => continue,
+        };
+        forms[f] = true;
+    }
+    forms
 }
 
 #[test]
@@ -45,8 +78,10 @@ fn blocks_change_form_and_keep_their_cells() {
     let fixed = Fixed::new(&SensorModel::octomap());
     let few = [fixed.min, fixed.max, fixed.miss, fixed.hit, 0];
     let mut compactions = 0;
-    // Forms seen: uniform, sparse, palettes of 1, 2, 4, 8 bits, dense.
+    // Forms seen: uniform, sparse, palettes of 1, 2, 4, 8 bits, dense; and those
+    // seen by the whole-store checks (the census among them).
     let mut forms = [0usize; 7];
+    let mut checked = [false; 7];
     for seed in 0..8u64 {
         let mut rng = Pcg64::seed_from_u64(seed);
         let mut store = Store::default();
@@ -117,26 +152,24 @@ fn blocks_change_form_and_keep_their_cells() {
                 let want = model.get(&c).copied().unwrap_or(UNKNOWN);
                 assert_eq!(store.get(c), want, "seed {seed} op {op}: cell {c:?}");
             }
+            let now = forms_of(&store);
             if op % 97 == 0 {
-                check(&store, &model, &format!("seed {seed} op {op}"));
+                check(&store, &model, fixed, &format!("seed {seed} op {op}"));
+                for (c, n) in checked.iter_mut().zip(now) {
+                    *c |= n;
+                }
             }
-            for b in BLOCKS {
-                let f = match store.entry(b).map(|e| e.kind()) {
-                    Some(Kind::Uniform(_)) => 0,
-                    Some(Kind::Sparse) => 1,
-                    Some(Kind::Palette(w)) => 2 + w.trailing_zeros() as usize,
-                    Some(Kind::Dense) => 6,
-                    None => continue,
-                };
-                forms[f] += 1;
+            for (f, n) in forms.iter_mut().zip(now) {
+                *f += usize::from(n);
             }
         }
-        check(&store, &model, &format!("seed {seed}"));
+        check(&store, &model, fixed, &format!("seed {seed}"));
         let blocks = BLOCKS.iter().filter(|&&b| store.entry(b).is_some()).count();
         assert_eq!(store.block_count(), blocks, "seed {seed}: block count");
         compactions += store.compactions();
     }
     assert!(forms.iter().all(|&f| f > 0), "forms seen {forms:?}");
+    assert!(checked.iter().all(|&c| c), "forms checked {checked:?}");
     assert!(compactions > 0, "the arena was compacted");
 }
 
