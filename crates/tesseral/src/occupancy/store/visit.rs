@@ -2,26 +2,25 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, decode, list_at, palette_index, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
+    bits_words, decode, list_at, palette_index, DENSE, EMPTY, PALETTE, SPARSE, SPARSE_VALUES,
+    UNIFORM,
 };
 use super::{join, BlockKey, Store, BLOCK_CELLS, TABLE};
 use crate::occupancy::sensor::UNKNOWN;
 use crate::occupancy::CellCounts;
 
-/// Values a sparse block lists at most (words 2 to 7 of its head).
-const SPARSE_VALUES: usize = 6;
-
 impl CellCounts {
-    /// Counts `n` cells of value `v` (none when unknown).
+    /// Counts `n` cells of value `v`, stored as `entries` entries (none when
+    /// unknown).
     #[inline]
-    fn add(&mut self, v: i16, n: u64, threshold: i16) {
+    fn add(&mut self, v: i16, n: u64, entries: u64, threshold: i16) {
         if v != UNKNOWN {
             if v >= threshold {
                 self.occupied += n;
             } else {
                 self.free += n;
             }
-            self.leaves += n;
+            self.leaves += entries;
         }
     }
 }
@@ -98,17 +97,17 @@ impl Store {
         let mut tally = CellCounts::default();
         let mut n = [0u64; 256];
         for &e in &self.tables {
-            let numbers = match e.tag() {
+            let (values, k) = match e.tag() {
                 EMPTY => continue,
                 UNIFORM => {
-                    tally.add((e.0 >> 16) as u16 as i16, BLOCK_CELLS as u64, threshold);
                     // One entry for the whole block.
-                    tally.leaves -= BLOCK_CELLS as u64 - 1;
+                    let v = (e.0 >> 16) as u16 as i16;
+                    tally.add(v, BLOCK_CELLS as u64, 1, threshold);
                     continue;
                 }
                 DENSE => {
                     for &v in &self.words_of(e)[..BLOCK_CELLS] {
-                        tally.add(v as i16, 1, threshold);
+                        tally.add(v as i16, 1, 1, threshold);
                     }
                     continue;
                 }
@@ -129,9 +128,8 @@ impl Store {
                     (&words[list_at(w)..], k)
                 }
             };
-            let (values, k) = numbers;
             for (j, &v) in values[..k].iter().enumerate() {
-                tally.add(v as i16, n[j], threshold);
+                tally.add(v as i16, n[j], n[j], threshold);
             }
         }
         tally
