@@ -143,10 +143,53 @@ pub(super) fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
     drop(codes);
     let mut out = Vec::new();
     for mut b in buckets {
-        b.par_sort_unstable();
+        radix_sort(&mut b);
         out.extend(b.into_iter().map(|(_, p)| p));
     }
     out
+}
+
+/// Fewer pairs than this are sorted by comparison.
+const RADIX_MIN: usize = 256;
+
+/// Sorts pairs by code, keeping pairs of one code in the order given (a bucket's
+/// pairs come in scratch order): a least-significant-digit radix sort, one pass per
+/// byte in which the codes differ. A bucket's codes differ in their low bytes only
+/// (a scene a few hundred blocks wide: three or four passes), so this moves each
+/// pair a few times where a comparison sort moves it log₂ n times.
+fn radix_sort(pairs: &mut Vec<(u64, Place)>) {
+    if pairs.len() < RADIX_MIN {
+        // Places are distinct and come in order: the same order as a stable sort.
+        pairs.sort_unstable();
+        return;
+    }
+    let mut counts = [[0usize; 256]; 8];
+    for &(c, _) in pairs.iter() {
+        for (d, count) in counts.iter_mut().enumerate() {
+            count[(c >> (8 * d)) as usize & 255] += 1;
+        }
+    }
+    let mut from = pairs.clone();
+    let mut to = std::mem::take(pairs);
+    for (d, count) in counts.iter().enumerate() {
+        if count.contains(&from.len()) {
+            // Every code has the same byte here: nothing moves.
+            continue;
+        }
+        let mut at = [0usize; 256];
+        let mut sum = 0;
+        for (a, &n) in at.iter_mut().zip(count) {
+            *a = sum;
+            sum += n;
+        }
+        for &(c, p) in &from {
+            let k = (c >> (8 * d)) as usize & 255;
+            to[at[k]] = (c, p);
+            at[k] += 1;
+        }
+        std::mem::swap(&mut from, &mut to);
+    }
+    *pairs = from;
 }
 
 #[cfg(test)]
@@ -161,7 +204,7 @@ mod tests {
     #[test]
     fn blocks_come_in_tesseral_order_duplicates_side_by_side() {
         let mut rng = Pcg64::seed_from_u64(5);
-        for (round, span) in [40i64, 1 << 20, 1 << 41, 3].into_iter().enumerate() {
+        for (round, span) in [40i64, 1 << 20, 1 << 41, 3, 12].into_iter().enumerate() {
             let scratches: Vec<Vec<BlockKey>> = (0..3)
                 .map(|_| {
                     let mut seen = std::collections::HashSet::new();

@@ -9,6 +9,7 @@
 //! - *dense*: 512 `i16`.
 
 use super::arena::UNIT;
+use super::census::Census;
 use super::BLOCK_CELLS;
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
@@ -158,54 +159,6 @@ pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
     }
 }
 
-/// What a block's values are, and the form that stores them in the fewest units.
-pub(crate) struct Census {
-    /// Distinct values, in order of first appearance (`UNKNOWN` included).
-    pub values: Vec<i16>,
-    /// Each cell's number in `values`.
-    pub index: [u16; BLOCK_CELLS],
-    /// Known cells.
-    pub known: usize,
-}
-
-impl Census {
-    pub fn of(cells: &[i16; BLOCK_CELLS]) -> Self {
-        // A small open-addressed table from value to number.
-        let mut slots = [u16::MAX; 1024];
-        let mut values = Vec::new();
-        let mut index = [0u16; BLOCK_CELLS];
-        let mut known = 0;
-        for (i, &v) in cells.iter().enumerate() {
-            known += usize::from(v != UNKNOWN);
-            let mut h = (u32::from(v as u16).wrapping_mul(0x9E37_79B1) >> 22) as usize;
-            loop {
-                let s = slots[h];
-                if s == u16::MAX {
-                    slots[h] = values.len() as u16;
-                    index[i] = values.len() as u16;
-                    values.push(v);
-                    break;
-                }
-                if values[s as usize] == v {
-                    index[i] = s;
-                    break;
-                }
-                h = (h + 1) & 1023;
-            }
-        }
-        Self {
-            values,
-            index,
-            known,
-        }
-    }
-
-    /// Distinct known values.
-    pub fn known_values(&self) -> usize {
-        self.values.len() - usize::from(self.values.contains(&UNKNOWN))
-    }
-}
-
 /// Units a surface's palette of width 1 or 2 may take beyond the sparse form's and
 /// still be chosen (see [`choose`]).
 pub(crate) const SURFACE_SLACK: usize = 6;
@@ -271,15 +224,29 @@ pub(crate) fn write_sparse(words: &mut [u16], cells: &[u32]) {
 
 /// Writes a palette block of width `w` over `words` (its whole chunk).
 pub(crate) fn write_palette(words: &mut [u16], w: u32, census: &Census) {
-    words.fill(0);
-    for (i, &j) in census.index.iter().enumerate() {
-        let bit = i * w as usize;
-        words[bit >> 4] |= j << (bit & 15);
-    }
     let at = bits_words(w);
+    match w {
+        1 => pack::<1>(&mut words[..at], &census.index),
+        2 => pack::<2>(&mut words[..at], &census.index),
+        4 => pack::<4>(&mut words[..at], &census.index),
+        _ => pack::<8>(&mut words[..at], &census.index),
+    }
+    words[at..].fill(0);
     words[at] = census.values.len() as u16;
     for (o, &v) in words[at + 1..].iter_mut().zip(&census.values) {
         *o = v as u16;
+    }
+}
+
+/// Packs 512 value numbers of `W` bits into `words`, one word at a time (each
+/// word built in a register: no store waits on the one before it to the same word).
+#[inline]
+fn pack<const W: usize>(words: &mut [u16], index: &[u16; BLOCK_CELLS]) {
+    for (o, cells) in words.iter_mut().zip(index.chunks_exact(16 / W)) {
+        *o = cells
+            .iter()
+            .enumerate()
+            .fold(0, |a, (c, &j)| a | j << (c * W));
     }
 }
 

@@ -13,6 +13,7 @@
 //! pages, instead of scattered one to a page over the whole arena.
 
 mod arena;
+mod census;
 mod dir;
 mod flat;
 mod forms;
@@ -21,17 +22,19 @@ mod lookup;
 mod place;
 mod probe;
 mod sparse;
+#[cfg(test)]
+mod tests_forms;
 mod valid;
 mod visit;
 
 use super::sensor::{Fixed, UNKNOWN};
 use arena::{Arena, UNIT};
+use census::Census;
 use dir::Directory;
 use flat::Flat;
 use forms::{
     any_occupied, apply_masks, choose, decode, lists_occupied, palette_single, palette_update,
-    units_of, write_dense, write_palette, write_sparse, Census, DENSE, EMPTY, PALETTE, SPARSE,
-    UNIFORM,
+    units_of, write_dense, write_palette, write_sparse, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
 };
 pub(crate) use lookup::BATCH;
 
@@ -273,7 +276,11 @@ impl Store {
     }
 
     fn put_slot(&mut self, s: usize, cells: &Cells, fixed: Fixed) {
-        let census = Census::of(cells);
+        self.put_census(s, cells, &Census::of(cells), fixed);
+    }
+
+    /// [`put`](Self::put) in slot `s` of `cells`, whose census is `census`.
+    fn put_census(&mut self, s: usize, cells: &Cells, census: &Census, fixed: Fixed) {
         if census.known == 0 {
             self.clear(s);
             return;
@@ -314,7 +321,7 @@ impl Store {
             }
             t => {
                 if let Some(words) = self.place(s, t, units, occupied) {
-                    write_palette(words, 1 << (t - PALETTE), &census);
+                    write_palette(words, 1 << (t - PALETTE), census);
                 }
             }
         }

@@ -1,6 +1,7 @@
 //! Updating a sparse (or empty) block: its sorted cells merged with a scan's masks.
 
 use super::arena::UNIT;
+use super::census::Census;
 use super::forms::{any_occupied, choose, write_sparse, SPARSE, SPARSE_VALUES};
 use super::{Entry, Store, BLOCK_CELLS};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
@@ -80,8 +81,9 @@ impl Store {
             for &c in &out {
                 cells[(c >> 16) as usize] = c as u16 as i16;
             }
+            let census = Census::of_list(&out);
             self.scratch = out;
-            self.put_slot(s, &cells, fixed);
+            self.put_census(s, &cells, &census, fixed);
         }
     }
 }
