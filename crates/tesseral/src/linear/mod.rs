@@ -23,7 +23,7 @@ mod merge;
 mod node_list;
 mod ops;
 mod resample;
-mod sort;
+pub(crate) mod sort;
 mod transform;
 
 pub use crate::code::Axis;

@@ -14,20 +14,30 @@ const RADIX_MIN_LEN: usize = 256;
 /// # Runtime
 /// O(n · b / 8) for keys of at most b significant bits.
 pub(crate) fn sort_u64(keys: &mut Vec<u64>) {
-    if keys.len() < RADIX_MIN_LEN {
-        keys.sort_unstable();
+    sort_by_u64(keys, |&k| k);
+}
+
+/// Sorts `items` by a 64-bit key, stably: items of one key keep their order (so that
+/// pairs sort as `(key, position)` would).
+///
+/// # Runtime
+/// O(n · b / 8) for keys of at most b significant bits, and one copy of `items`.
+pub(crate) fn sort_by_u64<T: Copy>(items: &mut Vec<T>, key: impl Fn(&T) -> u64) {
+    if items.len() < RADIX_MIN_LEN {
+        items.sort_by_key(&key);
         return;
     }
-    let all = keys.iter().fold(0u64, |acc, &k| acc | k);
+    let all = items.iter().fold(0u64, |acc, t| acc | key(t));
     let bits = 64 - all.leading_zeros();
-    let mut buf = vec![0u64; keys.len()];
+    let mut buf = items.clone();
     let mut shift = 0;
     while shift < bits {
+        let digit = |t: &T| ((key(t) >> shift) & 0xff) as usize;
         let mut count = [0usize; 256];
-        for &k in keys.iter() {
-            count[((k >> shift) & 0xff) as usize] += 1;
+        for t in items.iter() {
+            count[digit(t)] += 1;
         }
-        if count.contains(&keys.len()) {
+        if count.contains(&items.len()) {
             shift += 8;
             continue;
         }
@@ -37,12 +47,12 @@ pub(crate) fn sort_u64(keys: &mut Vec<u64>) {
             *c = sum;
             sum += n;
         }
-        for &k in keys.iter() {
-            let d = ((k >> shift) & 0xff) as usize;
-            buf[count[d]] = k;
+        for t in items.iter() {
+            let d = digit(t);
+            buf[count[d]] = *t;
             count[d] += 1;
         }
-        std::mem::swap(keys, &mut buf);
+        std::mem::swap(items, &mut buf);
         shift += 8;
     }
 }
@@ -79,6 +89,31 @@ mod tests {
             want.sort_unstable();
             sort_u64(&mut v);
             assert_eq!(v, want, "seed {seed}");
+        }
+    }
+
+    /// Items of one key keep their order: pairs of a few keys and their positions
+    /// sort by key alone as they sort whole.
+    #[test]
+    fn sorting_by_a_key_is_stable() {
+        for (n, mask) in [
+            (10_000usize, 0x0f0f_u64),
+            (3000, u64::MAX << 56 | 3),
+            (100, 7),
+        ] {
+            let mut s = n as u64;
+            let mut v: Vec<(u64, usize)> = (0..n)
+                .map(|i| {
+                    s ^= s << 13;
+                    s ^= s >> 7;
+                    s ^= s << 17;
+                    (s & mask, i)
+                })
+                .collect();
+            let mut want = v.clone();
+            want.sort_unstable();
+            sort_by_u64(&mut v, |p| p.0);
+            assert_eq!(v, want, "{n} items");
         }
     }
 }

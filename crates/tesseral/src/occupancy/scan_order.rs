@@ -6,6 +6,7 @@ use rayon::prelude::*;
 
 use super::store::BlockKey;
 use crate::code::encode_wide;
+use crate::linear::sort::sort_by_u64;
 
 /// Direction cells per face side of the cube round the origin (a power of two).
 const FACE_SIDE: u32 = 32;
@@ -143,53 +144,14 @@ pub(super) fn tesseral_order(blocks: &[&[BlockKey]]) -> Vec<Place> {
     drop(codes);
     let mut out = Vec::new();
     for mut b in buckets {
-        radix_sort(&mut b);
+        // Stable: a block in several scratches keeps their order. A bucket's codes
+        // differ in their low bytes only (a scene a few hundred blocks wide: three or
+        // four passes), so this moves each pair a few times where a comparison sort
+        // moves it log₂ n times.
+        sort_by_u64(&mut b, |p| p.0);
         out.extend(b.into_iter().map(|(_, p)| p));
     }
     out
-}
-
-/// Fewer pairs than this are sorted by comparison.
-const RADIX_MIN: usize = 256;
-
-/// Sorts pairs by code, keeping pairs of one code in the order given (a bucket's
-/// pairs come in scratch order): a least-significant-digit radix sort, one pass per
-/// byte in which the codes differ. A bucket's codes differ in their low bytes only
-/// (a scene a few hundred blocks wide: three or four passes), so this moves each
-/// pair a few times where a comparison sort moves it log₂ n times.
-fn radix_sort(pairs: &mut Vec<(u64, Place)>) {
-    if pairs.len() < RADIX_MIN {
-        // Places are distinct and come in order: the same order as a stable sort.
-        pairs.sort_unstable();
-        return;
-    }
-    let mut counts = [[0usize; 256]; 8];
-    for &(c, _) in pairs.iter() {
-        for (d, count) in counts.iter_mut().enumerate() {
-            count[(c >> (8 * d)) as usize & 255] += 1;
-        }
-    }
-    let mut from = pairs.clone();
-    let mut to = std::mem::take(pairs);
-    for (d, count) in counts.iter().enumerate() {
-        if count.contains(&from.len()) {
-            // Every code has the same byte here: nothing moves.
-            continue;
-        }
-        let mut at = [0usize; 256];
-        let mut sum = 0;
-        for (a, &n) in at.iter_mut().zip(count) {
-            *a = sum;
-            sum += n;
-        }
-        for &(c, p) in &from {
-            let k = (c >> (8 * d)) as usize & 255;
-            to[at[k]] = (c, p);
-            at[k] += 1;
-        }
-        std::mem::swap(&mut from, &mut to);
-    }
-    *pairs = from;
 }
 
 #[cfg(test)]
