@@ -383,6 +383,7 @@ fn disjoint<T>(regions: &[(T, LinearOctree)]) -> bool {
         .iter()
         .flat_map(|(_, t)| t.leaves().iter().map(|l| (l.code(), l.end())))
         .collect();
-    spans.sort_unstable();
+    // Each region's leaves are one sorted run: a stable sort merges the runs.
+    spans.sort();
     spans.windows(2).all(|w| w[0].1 <= w[1].0)
 }

@@ -74,10 +74,19 @@ fn to_key_space(model: &Model) -> Result<KeyModel, String> {
 }
 
 /// Cuts `leaf` into maximal cells each inside one leaf of `index` or outside all,
-/// calling `out` with each cell and its value.
-fn split<T: Copy>(leaf: Leaf, index: &[(Leaf, T)], out: &mut impl FnMut(Leaf, Option<T>)) {
-    let i = index.partition_point(|(r, _)| r.end() <= leaf.code());
-    match index.get(i) {
+/// calling `out` with each cell and its value. `at` is where the search in `index`
+/// starts, moved on as it goes: the leaves of one tree are cut in tesseral order,
+/// so the region a leaf meets is never before the one the leaf before it met, and
+/// is found by a search from there (mostly one compare) rather than a binary search
+/// of the whole index.
+fn split<T: Copy>(
+    leaf: Leaf,
+    index: &[(Leaf, T)],
+    at: &mut usize,
+    out: &mut impl FnMut(Leaf, Option<T>),
+) {
+    *at += first_false(&index[*at..], |(r, _)| r.end() <= leaf.code());
+    match index.get(*at) {
         None => out(leaf, None),
         Some((r, _)) if r.code() >= leaf.end() => out(leaf, None),
         Some((r, x)) if r.code() <= leaf.code() && r.end() >= leaf.end() => out(leaf, Some(*x)),
@@ -86,10 +95,22 @@ fn split<T: Copy>(leaf: Leaf, index: &[(Leaf, T)], out: &mut impl FnMut(Leaf, Op
             let k = leaf.size_log2() - 1;
             for c in 0..8u64 {
                 let child = Leaf::new(leaf.code() + (c << (3 * u32::from(k))), k);
-                split(child, index, out);
+                split(child, index, at, out);
             }
         }
     }
+}
+
+/// The length of the prefix of `s` on which `pred` holds (`pred` holds on a prefix),
+/// by an exponential search from the start: O(log d) for a prefix of length d.
+fn first_false<T>(s: &[T], pred: impl Fn(&T) -> bool) -> usize {
+    let mut hi = 1;
+    while hi <= s.len() && pred(&s[hi - 1]) {
+        hi *= 2;
+    }
+    // `pred` holds on `s[..lo]` (its last element was tested).
+    let lo = hi / 2;
+    lo + s[lo..hi.min(s.len())].partition_point(pred)
 }
 
 /// The model's known cells as pieces in tesseral order.
@@ -103,10 +124,11 @@ fn pieces(km: &KeyModel) -> Vec<Piece> {
         .into_iter()
         .chain(km.free.iter().map(|f| (f, false)));
     for (tree, occupied) in parts {
+        let (mut color_at, mut odds_at) = (0, 0);
         for &leaf in tree.leaves() {
-            split(leaf, &colors, &mut |l, c: Option<Rgba>| {
+            split(leaf, &colors, &mut color_at, &mut |l, c: Option<Rgba>| {
                 let rgb = c.unwrap_or(default_rgb);
-                split(l, &odds, &mut |l, v| {
+                split(l, &odds, &mut odds_at, &mut |l, v| {
                     let fallback = if occupied {
                         OCCUPIED_LOG_ODDS
                     } else {
@@ -122,7 +144,9 @@ fn pieces(km: &KeyModel) -> Vec<Piece> {
             });
         }
     }
-    out.sort_unstable_by_key(|p| p.leaf.code());
+    // Two runs in order (the occupied pieces, then the free): a stable sort finds
+    // them and merges them in one pass.
+    out.sort_by_key(|p| p.leaf.code());
     out
 }
 
@@ -299,4 +323,27 @@ fn write_ot_node(
         out[at + 4..at + 7].copy_from_slice(&rgb);
     }
     (value, rgb)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_false;
+
+    /// The exponential search finds the prefix a binary search finds, for every
+    /// prefix length of slices of every length up to 70.
+    #[test]
+    fn the_search_from_the_start_finds_the_prefix() {
+        for len in 0..70usize {
+            let s: Vec<usize> = (0..len).collect();
+            for cut in 0..=len {
+                let pred = |&x: &usize| x < cut;
+                assert_eq!(
+                    first_false(&s, pred),
+                    s.partition_point(pred),
+                    "{len} {cut}"
+                );
+                assert_eq!(first_false(&s, pred), cut);
+            }
+        }
+    }
 }
