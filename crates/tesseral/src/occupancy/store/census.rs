@@ -17,6 +17,7 @@ pub(crate) struct Census {
 }
 
 impl Census {
+    /// The census of a block's 512 cells: one probe of a small hash table a cell.
     pub fn of(cells: &[i16; BLOCK_CELLS]) -> Self {
         // A small open-addressed table from value to number.
         let mut slots = [u16::MAX; 1024];
