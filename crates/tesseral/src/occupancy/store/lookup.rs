@@ -23,6 +23,14 @@ fn words_at(words: &[u16], k: usize) -> u16 {
     unsafe { *words.get_unchecked(k) }
 }
 
+/// Prefetches word `k` of an arena's words, as [`words_at`] would read it.
+#[inline(always)]
+fn prefetch_word(words: &[u16], k: usize) {
+    debug_assert!(k < words.len(), "word {k} of {}", words.len());
+    // SAFETY: as in `words_at`: the word is one that a lookup then reads.
+    prefetch(unsafe { words.get_unchecked(k) });
+}
+
 /// Palettes of width 1, 2, 4 and 8 (by `tag − PALETTE`): where the value list
 /// starts (after the cells and the count), above the mask of a cell's bits.
 const PALETTES: [u32; 4] = {
@@ -44,16 +52,28 @@ impl Store {
     #[inline(always)]
     pub fn get(&self, cell: [i64; 3]) -> i16 {
         let (b, i) = split(cell);
-        let e = match self.flat.index(b) {
-            Some(at) => self.flat.entry(at),
-            // A retired index has no box: every block goes through the directory.
-            None if !self.flat.live() => match self.find(b) {
-                Some(at) => self.tables[at],
-                None => return UNKNOWN,
-            },
-            None => return UNKNOWN,
-        };
-        self.value(e, i)
+        match self.flat.index(b) {
+            Some(at) => self.value(self.flat.entry(at), i),
+            None => self.get_outside(cell[0], cell[1], cell[2]),
+        }
+    }
+
+    /// [`get`](Self::get) of a cell whose block is outside the read index's box:
+    /// unknown while the index is live, else found through the directory. Out of
+    /// line, so that a loop of lookups keeps its registers for the index's path; the
+    /// cell comes as three scalars, in registers (an array would go through memory,
+    /// a store and a reload on every lookup).
+    #[inline(never)]
+    fn get_outside(&self, x: i64, y: i64, z: i64) -> i16 {
+        if self.flat.live() {
+            return UNKNOWN;
+        }
+        // A retired index has no box: every block goes through the directory.
+        let (b, i) = split([x, y, z]);
+        match self.find(b) {
+            Some(at) => self.value(self.tables[at], i),
+            None => UNKNOWN,
+        }
     }
 
     /// Where block `b`'s entry is read: the read index while it is live (the
@@ -119,13 +139,26 @@ impl Store {
         // Palettes of width w = 1, 2, 4 or 8 (tags 3 to 6) first: most lookups land
         // on surfaces, stored as palettes. No branch on the width.
         if tag.wrapping_sub(PALETTE) < 4 {
+            let p = PALETTES[tag as usize - PALETTE as usize];
+            let list = at + (p >> 8) as usize;
+            // The list lies a line or more past the cell's word: fetch both at once
+            // rather than one after the other.
+            prefetch_word(words, list);
             let bit = i << (tag - PALETTE);
             let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
-            let p = PALETTES[tag as usize - PALETTE as usize];
             let j = usize::from(x) & (p as usize & 0xff);
-            return words_at(words, at + (p >> 8) as usize + j) as i16;
+            return words_at(words, list + j) as i16;
         }
-        match tag {
+        self.value_other(e, i)
+    }
+
+    /// [`value`](Self::value) of a block not a palette. Out of line, as
+    /// [`get_outside`](Self::get_outside).
+    #[inline(never)]
+    fn value_other(&self, e: Entry, i: usize) -> i16 {
+        let words = &self.arenas[e.arena()].words;
+        let at = e.offset() as usize * UNIT;
+        match e.tag() {
             EMPTY => UNKNOWN,
             UNIFORM => (e.0 >> 16) as u16 as i16,
             // Compares, not a binary search (see `probe`).
