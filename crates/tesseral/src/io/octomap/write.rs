@@ -167,12 +167,26 @@ pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
 }
 
 /// The pieces inside the cell `[code, code + 8^k)`, split among its eight children.
+/// Each child's pieces are found by an exponential search from where the last
+/// child's ended (O(log d) for d pieces, not O(log n) over the whole cell's), and
+/// the last child takes what is left.
 fn children(pieces: &[Piece], code: u64, k: u8) -> [(u64, &[Piece]); 8] {
     let child_cells = 1u64 << (3 * u32::from(k - 1));
+    debug_assert!(
+        pieces.first().is_none_or(|p| p.leaf.code() >= code)
+            && pieces
+                .last()
+                .is_none_or(|p| p.leaf.code() < code + 8 * child_cells),
+        "pieces outside the cell"
+    );
     let mut rest = pieces;
     std::array::from_fn(|i| {
         let c = code + i as u64 * child_cells;
-        let n = rest.partition_point(|p| p.leaf.code() < c + child_cells);
+        let n = if i == 7 {
+            rest.len()
+        } else {
+            first_false(rest, |p| p.leaf.code() < c + child_cells)
+        };
         let (mine, tail) = rest.split_at(n);
         rest = tail;
         (c, mine)
