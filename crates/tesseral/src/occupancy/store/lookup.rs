@@ -130,12 +130,18 @@ impl Store {
         bits
     }
 
+    /// The words of entry `e`'s arena and where its block starts in them (the
+    /// entry must not be empty or uniform for the position to mean anything).
+    #[inline(always)]
+    fn block_at(&self, e: Entry) -> (&[u16], usize) {
+        (&self.arenas[e.arena()].words, e.offset() as usize * UNIT)
+    }
+
     /// The value of cell `i` of the block of entry `e`.
     #[inline(always)]
     fn value(&self, e: Entry, i: usize) -> i16 {
         let tag = e.tag();
-        let words = &self.arenas[e.arena()].words;
-        let at = e.offset() as usize * UNIT;
+        let (words, at) = self.block_at(e);
         // Palettes of width w = 1, 2, 4 or 8 (tags 3 to 6) first: most lookups land
         // on surfaces, stored as palettes. No branch on the width.
         if tag.wrapping_sub(PALETTE) < 4 {
@@ -156,8 +162,7 @@ impl Store {
     /// [`get_outside`](Self::get_outside).
     #[inline(never)]
     fn value_other(&self, e: Entry, i: usize) -> i16 {
-        let words = &self.arenas[e.arena()].words;
-        let at = e.offset() as usize * UNIT;
+        let (words, at) = self.block_at(e);
         match e.tag() {
             EMPTY => UNKNOWN,
             UNIFORM => (e.0 >> 16) as u16 as i16,
@@ -205,7 +210,7 @@ impl Store {
         if tag <= UNIFORM {
             return;
         }
-        let at = e.offset() as usize * UNIT;
+        let (words, at) = self.block_at(e);
         let (a, b) = match tag {
             // The header and the cells that `sparse_value` compares at once: the
             // first and last of its lines (the middle one is most often fetched
@@ -217,7 +222,6 @@ impl Store {
                 (at + ((i * w) >> 4), at + list_at(w as u32))
             }
         };
-        let words = &self.arenas[e.arena()].words;
         for k in [a, b] {
             if let Some(x) = words.get(k) {
                 prefetch(x);
