@@ -242,6 +242,13 @@ pub fn run(args: Args) -> Result<()> {
     print(&args, &info, bbox)
 }
 
+/// A world coordinate for people: rounded to 12 significant digits, so that a
+/// product such as 14 × 0.1 prints as 1.4, not 1.4000000000000001 (`--json` keeps
+/// the exact value).
+fn short(x: f64) -> f64 {
+    format!("{x:.11e}").parse().unwrap_or(x)
+}
+
 fn print(args: &Args, info: &Info, bbox: Option<BBox>) -> Result<()> {
     let frame = tesseral::model::Frame::new(info.voxel_size, info.translate);
     if args.json {
@@ -269,12 +276,12 @@ fn print(args: &Args, info: &Info, bbox: Option<BBox>) -> Result<()> {
     if let (Some(lo), Some(hi)) = (info.world_min, info.world_max) {
         crate::outln!(
             "world    ({}, {}, {}) to ({}, {}, {})",
-            lo[0],
-            lo[1],
-            lo[2],
-            hi[0],
-            hi[1],
-            hi[2]
+            short(lo[0]),
+            short(lo[1]),
+            short(lo[2]),
+            short(hi[0]),
+            short(hi[1]),
+            short(hi[2])
         )?;
     }
     if let Some(n) = info.colors {
@@ -301,4 +308,22 @@ fn print(args: &Args, info: &Info, bbox: Option<BBox>) -> Result<()> {
     };
     crate::outln!("bytes    {} ({per_voxel:.3} per voxel)", info.bytes)?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::short;
+
+    #[test]
+    fn world_coordinates_print_without_float_noise() {
+        assert_eq!(short(14.0 * 0.1).to_string(), "1.4");
+        assert_eq!(short(-39.0 * 0.1).to_string(), "-3.9");
+        assert_eq!(short(0.7000000000000001).to_string(), "0.7");
+        // Twelve significant digits kept, tiny and huge values untouched in kind.
+        assert_eq!(short(1234.56789012345).to_string(), "1234.56789012");
+        assert_eq!(short(2.5e-7).to_string(), "0.00000025");
+        assert_eq!(short(-0.0).to_string(), "-0");
+        assert!(short(f64::NAN).is_nan());
+        assert_eq!(short(f64::INFINITY), f64::INFINITY);
+    }
 }
