@@ -144,6 +144,18 @@ pub fn write_atomic(
     write_atomic_inner(path, body).map_err(|source| FormatError::Io(source).with_path(path))
 }
 
+/// The error of making a temporary file or folder in `dir`, without the temporary
+/// name (which the user never asked for): `cannot create a file in DIR: REASON`.
+pub(crate) fn in_folder(e: io::Error, dir: &Path) -> io::Error {
+    // tempfile's message ends with the temporary path: ` at path "…"`.
+    let text = e.to_string();
+    let reason = text.rfind(" at path ").map_or(&*text, |k| &text[..k]);
+    io::Error::new(
+        e.kind(),
+        format!("cannot create a file in {}: {reason}", dir.display()),
+    )
+}
+
 fn write_atomic_inner(
     path: &Path,
     body: impl FnOnce(&mut dyn Write) -> io::Result<()>,
@@ -164,7 +176,7 @@ fn write_atomic_inner(
         // file gets (the umask still applies at creation).
         builder.permissions(fs::Permissions::from_mode(0o666));
     }
-    let tmp = builder.tempfile_in(dir)?;
+    let tmp = builder.tempfile_in(dir).map_err(|e| in_folder(e, dir))?;
     // Registered right after creation, before any byte is written; the guard is
     // dropped (unregistered) after the rename or after `tmp` removed the file.
     let registered = Registered::new(tmp.path().to_owned());
@@ -213,6 +225,22 @@ mod tests {
         assert!(err.to_string().contains("a.txt"), "{err}");
         assert_eq!(fs::read(&path).unwrap(), b"old");
         assert_eq!(names(dir.path()), ["a.txt"]);
+    }
+
+    #[test]
+    fn a_missing_folder_is_named_not_the_temporary() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("no").join("a.txt");
+        let err = write_atomic(&path, |w| w.write_all(b"x")).unwrap_err();
+        let text = err.to_string();
+        assert!(text.contains("a.txt"), "{text}");
+        assert!(text.contains("cannot create a file in"), "{text}");
+        assert!(!text.contains(".a.txt."), "{text}");
+        let err = crate::io::StagedDir::beside(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("cannot create a file in") && !err.contains(".a.txt."),
+            "{err}"
+        );
     }
 
     #[cfg(unix)]

@@ -76,7 +76,7 @@ pub fn stage_dir(target: &Path) -> Result<PathBuf, FormatError> {
     }
     let dir = builder
         .tempdir_in(parent)
-        .map_err(|e| FormatError::io(e).with_path(target))?;
+        .map_err(|e| FormatError::io(super::atomic::in_folder(e, parent)).with_path(target))?;
     fs::write(dir.path().join(MARKER), marker_text(&Writer::this()))
         .map_err(|e| FormatError::io(e).with_path(target))?;
     Ok(dir.keep())
