@@ -12,7 +12,9 @@
 //!
 //! With `--json` one object is printed with exactly the keys `scans`, `points`,
 //! `rays`, `occupied`, `free`, `leaves`, `bytes`, `seconds` (the insertion time,
-//! reading and writing excluded, as `graph2tree` reports it) and `rays_per_second`.
+//! reading and writing excluded, as `graph2tree` reports it), `rays_per_second`,
+//! and `skipped` (points with a NaN or infinite coordinate, not cast: `points` is
+//! `rays + skipped`).
 
 use std::borrow::Cow;
 use std::io::IsTerminal;
@@ -103,6 +105,7 @@ struct Totals {
     scans: u64,
     points: u64,
     rays: u64,
+    skipped: u64,
     seconds: f64,
 }
 
@@ -178,6 +181,7 @@ pub fn run(args: Args) -> Result<()> {
             t.scans += 1;
             t.points += stats.points;
             t.rays += stats.rays;
+            t.skipped += stats.skipped;
             map.check_capacity().with_context(|| at(i))?;
             i += 1;
             bar.inc(1);
@@ -208,11 +212,17 @@ pub fn run(args: Args) -> Result<()> {
             "bytes": map.bytes(),
             "seconds": t.seconds,
             "rays_per_second": rate,
+            "skipped": t.skipped,
         });
         crate::outln!("{v}")?;
     } else {
+        let skipped = if t.skipped > 0 {
+            format!(" ({} skipped: NaN or infinite)", t.skipped)
+        } else {
+            String::new()
+        };
         let line = format!(
-            "wrote {}: {} scans, {} points, {} rays in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {} leaves, {} bytes",
+            "wrote {}: {} scans, {} points{skipped}, {} rays in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {} leaves, {} bytes",
             args.output.display(),
             t.scans,
             t.points,

@@ -215,3 +215,76 @@ fn origin_and_pose_place_a_cloud() {
         "cannot be used with",
     );
 }
+
+#[test]
+fn missing_returns_are_skipped_and_counted_in_every_cloud_format() {
+    let dir = setup();
+    let d = dir.path();
+    ok(
+        d,
+        &[
+            "map",
+            "cloud.xyz",
+            "-o",
+            "clean.tess",
+            "--resolution",
+            "0.1",
+        ],
+    );
+    let clean = fs::read(d.join("clean.tess")).unwrap();
+    // The same cloud with a NaN point, an infinite one and a NaN coordinate among
+    // finite ones, as sensors write missing returns.
+    let mut cloud = two_scans()[0].points.clone();
+    let n = cloud.len();
+    cloud.insert(3, [f64::NAN; 3]);
+    cloud.insert(10, [1.0, f64::INFINITY, 0.0]);
+    cloud.push([0.5, 0.5, f64::NAN]);
+    let text = |p: &[f64; 3]| {
+        let s = |x: f64| {
+            if x.is_nan() {
+                "nan".to_string()
+            } else {
+                x.to_string()
+            }
+        };
+        format!("{} {} {}\n", s(p[0]), s(p[1]), s(p[2]))
+    };
+    let ascii: String = cloud.iter().map(text).collect();
+    fs::write(d.join("holes.xyz"), &ascii).unwrap();
+    let head = |format: &str| {
+        format!(
+            "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+            cloud.len()
+        )
+    };
+    fs::write(d.join("holes-ascii.ply"), head("ascii") + &ascii).unwrap();
+    let mut ply = head("binary_little_endian").into_bytes();
+    let mut pcd = format!(
+        "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {m}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {m}\nDATA binary\n",
+        m = cloud.len()
+    )
+    .into_bytes();
+    for p in &cloud {
+        for x in p {
+            ply.extend_from_slice(&(*x as f32).to_le_bytes());
+            pcd.extend_from_slice(&(*x as f32).to_le_bytes());
+        }
+    }
+    fs::write(d.join("holes.ply"), ply).unwrap();
+    fs::write(d.join("holes.pcd"), pcd).unwrap();
+    for f in ["holes.xyz", "holes-ascii.ply", "holes.ply", "holes.pcd"] {
+        let out = format!("{f}.tess");
+        let v = json(d, &["map", f, "-o", &out, "--resolution", "0.1", "--json"]);
+        assert_eq!(v["points"], n + 3, "{f}: {v}");
+        assert_eq!(v["rays"], n, "{f}: {v}");
+        assert_eq!(v["skipped"], 3, "{f}: {v}");
+        assert_eq!(fs::read(d.join(&out)).unwrap(), clean, "{f}");
+    }
+    let text = ok(
+        d,
+        &["map", "holes.ply", "-o", "h.bt", "--resolution", "0.1"],
+    );
+    assert!(text.contains("(3 skipped: NaN or infinite)"), "{text}");
+    // A mesh is still refused with a NaN vertex: it is not a cloud.
+    fails(d, &["convert", "holes.ply", "h.stl"], "not finite");
+}

@@ -103,7 +103,7 @@ fn setup() -> tempfile::TempDir {
     dir
 }
 
-const KEYS: [&str; 9] = [
+const KEYS: [&str; 10] = [
     "scans",
     "points",
     "rays",
@@ -113,4 +113,5 @@ const KEYS: [&str; 9] = [
     "bytes",
     "seconds",
     "rays_per_second",
+    "skipped",
 ];

@@ -6,6 +6,7 @@
 mod read;
 mod write;
 
+pub(crate) use read::parse_ply_points;
 pub use read::{parse, parse_obj, parse_ply, parse_stl, read, MAX_MESH_ELEMENTS};
 pub use write::{write_file, write_glb, write_obj, write_ply, write_stl, MESH_EXTENSIONS};
 

@@ -61,12 +61,15 @@ pub fn parse_xyz(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
 
 /// Parses the `vertex` element of a PLY file (ASCII, binary little- or big-endian)
 /// with the mesh reader, [`crate::io::mesh::parse_ply`]; faces, if any, are ignored.
+/// NaN or infinite coordinates (a sensor's missing returns) are kept, for the map
+/// to skip and count, as in `.xyz` and `.pcd`.
 ///
 /// # Errors
-/// As [`crate::io::mesh::parse_ply`] (line for ASCII, byte offset for binary);
-/// [`FormatError::Corrupt`] for a file without vertices.
+/// As [`crate::io::mesh::parse_ply`] (line and column for ASCII, byte offset for
+/// binary) but for non-finite coordinates; [`FormatError::Corrupt`] for a file
+/// without vertices.
 pub fn parse_ply(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
-    let mesh = crate::io::mesh::parse_ply(bytes)?;
+    let mesh = crate::io::mesh::parse_ply_points(bytes)?;
     check_budget(mesh.positions.len())?;
     Ok(ScanRecord {
         points: mesh.positions,

@@ -346,3 +346,22 @@ fn random_bytes_never_panic() {
         }
     }
 }
+
+#[test]
+fn ascii_ply_errors_name_line_and_column_and_clouds_keep_missing_returns() {
+    let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+    let (l, c, m) = syntax_at(cloud::parse_ply(
+        format!("{head}1 2 3\n4.0 5.0 abc\n7 8 9\n").as_bytes(),
+    ));
+    assert_eq!((l, c), (9, 9), "{m}");
+    assert!(m.contains("abc"), "{m}");
+    // A cloud keeps NaN and infinite points (the map skips and counts them)...
+    let r = cloud::parse_ply(format!("{head}1 2 3\nnan nan nan\n1 inf 1\n").as_bytes()).unwrap();
+    assert_eq!(r.points.len(), 3);
+    assert!(r.points[1].iter().all(|x| x.is_nan()) && r.points[2][1].is_infinite());
+    // ...a mesh refuses them, naming where.
+    let (l, c, m) = syntax_at(crate::io::mesh::parse_ply(
+        format!("{head}1 2 3\nnan nan nan\n1 1 1\n").as_bytes(),
+    ));
+    assert_eq!((l, c), (9, 1), "{m}");
+}

@@ -17,6 +17,7 @@ mod tests;
 
 pub use obj::parse_obj;
 pub use ply::parse_ply;
+pub(crate) use ply::parse_ply_points;
 pub use stl::parse_stl;
 
 /// The most vertices or triangles a mesh file may hold.

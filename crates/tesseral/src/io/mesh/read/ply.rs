@@ -68,14 +68,25 @@ struct PlyBody<'a> {
     pos: usize,
     format: PlyFormat,
     line: usize,
+    /// Where the current line starts (ASCII), for error columns.
+    line_start: usize,
+    /// Where the last value read starts (ASCII).
+    token: usize,
+    /// Whether a NaN or infinite value is an error (a mesh), or passed on (a point
+    /// cloud, whose reader skips and counts such points).
+    finite: bool,
 }
 
 impl PlyBody<'_> {
-    fn value(&mut self, ty: Scalar) -> Result<f64, FormatError> {
+    /// The next value; `finite` asks for a finite one whatever the body allows (list
+    /// lengths and vertex indices).
+    fn value(&mut self, ty: Scalar, finite: bool) -> Result<f64, FormatError> {
+        let finite = finite || self.finite;
         if self.format == PlyFormat::Ascii {
             while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
                 if self.bytes[self.pos] == b'\n' {
                     self.line += 1;
+                    self.line_start = self.pos + 1;
                 }
                 self.pos += 1;
             }
@@ -83,13 +94,16 @@ impl PlyBody<'_> {
             while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
                 self.pos += 1;
             }
+            self.token = start;
+            let column = start - self.line_start + 1;
             if start == self.pos {
-                return Err(syntax(self.line, 1, "file ends inside an element"));
+                return Err(syntax(self.line, column, "file ends inside an element"));
             }
             let w = String::from_utf8_lossy(&self.bytes[start..self.pos]);
             return match w.parse::<f64>() {
-                Ok(x) if x.is_finite() => Ok(x),
-                _ => Err(syntax(self.line, 1, format!("`{w}` is not a number"))),
+                Ok(x) if x.is_finite() || !finite => Ok(x),
+                Ok(_) => Err(syntax(self.line, column, format!("`{w}` is not finite"))),
+                _ => Err(syntax(self.line, column, format!("`{w}` is not a number"))),
             };
         }
         let n = ty.size();
@@ -115,7 +129,7 @@ impl PlyBody<'_> {
             Scalar::F32 => f64::from(f32::from_le_bytes([b[0], b[1], b[2], b[3]])),
             Scalar::F64 => f64::from_le_bytes(b),
         };
-        if !v.is_finite() {
+        if finite && !v.is_finite() {
             return Err(FormatError::corrupt(format!(
                 "value at byte {} is not finite",
                 self.pos - n
@@ -132,6 +146,19 @@ impl PlyBody<'_> {
 /// # Errors
 /// As [`read`](super::read).
 pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
+    parse(bytes, true)
+}
+
+/// [`parse_ply`] for a point cloud: vertex coordinates may be NaN or infinite (a
+/// sensor's missing returns), passed on for the scan reader to skip and count.
+///
+/// # Errors
+/// As [`parse_ply`], but for non-finite coordinates.
+pub(crate) fn parse_ply_points(bytes: &[u8]) -> Result<TriMesh, FormatError> {
+    parse(bytes, false)
+}
+
+fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
     let end = bytes
         .windows(11)
         .position(|w| w == b"end_header\n" || w == b"end_header\r")
@@ -217,6 +244,9 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
         pos: body_start.min(bytes.len()),
         format,
         line: header_lines + 2,
+        line_start: body_start.min(bytes.len()),
+        token: 0,
+        finite,
     };
     let mut m = TriMesh::default();
     for el in &elements {
@@ -267,7 +297,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
             for (pi, prop) in el.props.iter().enumerate() {
                 match prop.list {
                     None => {
-                        let v = body.value(prop.ty)?;
+                        let v = body.value(prop.ty, !is_vertex)?;
                         if is_vertex {
                             for a in 0..3 {
                                 if xyz[a] == Some(pi) {
@@ -277,7 +307,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
                         }
                     }
                     Some(ct) => {
-                        let n = body.value(ct)?;
+                        let n = body.value(ct, true)?;
                         if !(0.0..=1e9).contains(&n) || n.fract() != 0.0 {
                             return Err(FormatError::corrupt(format!(
                                 "element {index}: bad list length {n}"
@@ -286,7 +316,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
                         let take = is_face && faces == Some(pi);
                         poly.clear();
                         for _ in 0..n as u64 {
-                            let v = body.value(prop.ty)?;
+                            let v = body.value(prop.ty, true)?;
                             if take {
                                 // A vertex index is a whole number from 0: `1.5` or `-2`
                                 // is an error that says so, not a face to guess at.
@@ -300,7 +330,7 @@ pub fn parse_ply(bytes: &[u8]) -> Result<TriMesh, FormatError> {
                                 if let Some(why) = why {
                                     let msg = format!("face {index}: vertex index {v} {why}");
                                     return Err(if body.format == PlyFormat::Ascii {
-                                        syntax(body.line, 1, msg)
+                                        syntax(body.line, body.token - body.line_start + 1, msg)
                                     } else {
                                         FormatError::corrupt(format!("{msg} (byte {})", body.pos))
                                     });
