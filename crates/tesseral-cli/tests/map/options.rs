@@ -121,7 +121,7 @@ fn bad_scans_are_errors_naming_file_and_place() {
     fails(
         d,
         &["map", "z.pcd", "-o", "m.bt", "--resolution", "0.1"],
-        "line 7: PCD `DATA binary_compressed` is not supported",
+        "z.pcd: byte 91: `binary_compressed` data needs its two sizes (8 bytes)",
     );
     fails(
         d,

@@ -145,8 +145,8 @@ impl ScanFormat {
 ///
 /// # Errors
 /// [`FormatError::Syntax`] (line and column) for text, [`FormatError::Corrupt`]
-/// naming the byte offset for binary data, [`FormatError::TooLarge`] past
-/// [`MAX_SCAN_POINTS`], [`FormatError::Unsupported`] for PCD's `binary_compressed`.
+/// naming the byte offset for binary data (and PCD's compressed data), and
+/// [`FormatError::TooLarge`] past [`MAX_SCAN_POINTS`].
 pub fn parse(bytes: &[u8], format: ScanFormat) -> Result<Vec<ScanRecord>, FormatError> {
     match format {
         ScanFormat::Graph => graph::decode(bytes),

@@ -1,6 +1,9 @@
 //! PCL's point cloud files (`.pcd`, versions 0.6 and 0.7): a text header, then the
-//! points as text (`DATA ascii`) or packed little-endian records (`DATA binary`).
-//! `DATA binary_compressed` is refused as unsupported.
+//! points as text (`DATA ascii`), packed little-endian records (`DATA binary`), or
+//! LZF-compressed fields (`DATA binary_compressed`: the compressed and uncompressed
+//! sizes as two `u32`, then the compressed bytes of each field's values for every
+//! point, one field after another, as PCL's `PCDWriter::writeBinaryCompressed`
+//! writes them).
 //!
 //! The header's `FIELDS` must include `x`, `y` and `z`; `SIZE`, `TYPE` (`I`, `U`,
 //! `F`) and `COUNT` describe each field (a field with `COUNT` > 1 contributes its
@@ -45,13 +48,96 @@ impl Field {
     }
 }
 
+/// How the points follow the header.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Data {
+    Ascii,
+    Binary,
+    Compressed,
+}
+
+/// The most bytes LZF gives back per compressed byte: a back reference of three
+/// bytes copies at most 264.
+const LZF_RATIO: usize = 88;
+
+/// The points of `DATA binary_compressed` (`body`, starting at byte `at` of the
+/// file), decompressed and put back into records of all fields, as `DATA binary`
+/// holds them. Every size is checked before anything is allocated: the
+/// uncompressed size must be the declared points' and at most what the compressed
+/// bytes can give.
+fn decompress(
+    body: &[u8],
+    at: usize,
+    declared: u64,
+    fields: &[Field],
+) -> Result<Vec<u8>, FormatError> {
+    let corrupt = |m: String| FormatError::corrupt(format!("byte {at}: {m}"));
+    let word = |k: usize| {
+        body.get(k..k + 4)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
+    };
+    let (Some(packed), Some(size)) = (word(0), word(4)) else {
+        return Err(corrupt(
+            "`binary_compressed` data needs its two sizes (8 bytes)".into(),
+        ));
+    };
+    let record: usize = fields.iter().map(|f| f.size * f.count).sum();
+    let want = usize::try_from(declared)
+        .ok()
+        .and_then(|n| n.checked_mul(record));
+    if want != Some(size) {
+        return Err(corrupt(format!(
+            "{declared} points of {record} bytes make {} bytes, but the data says {size} uncompressed",
+            want.map_or_else(|| "too many".to_string(), |w| w.to_string())
+        )));
+    }
+    if packed > body.len() - 8 {
+        return Err(corrupt(format!(
+            "{packed} compressed bytes declared; {} follow",
+            body.len() - 8
+        )));
+    }
+    if size == 0 {
+        return Ok(Vec::new());
+    }
+    check_budget(declared as usize)?;
+    if size > packed.saturating_mul(LZF_RATIO) + 64 {
+        return Err(corrupt(format!(
+            "{packed} compressed bytes cannot hold {size}"
+        )));
+    }
+    let columns = lzf::decompress(&body[8..8 + packed], size)
+        .map_err(|e| corrupt(format!("the compressed data is damaged ({e:?})")))?;
+    if columns.len() != size {
+        return Err(corrupt(format!(
+            "the data decompresses to {} bytes, not {size}",
+            columns.len()
+        )));
+    }
+    // Field f's values for every point lie together; a record takes each in turn.
+    let n = declared as usize;
+    let mut records = vec![0u8; size];
+    let (mut column, mut offset) = (0, 0);
+    for f in fields {
+        let w = f.size * f.count;
+        let values = &columns[column..column + n * w];
+        for (p, v) in values.chunks_exact(w).enumerate() {
+            records[p * record + offset..][..w].copy_from_slice(v);
+        }
+        column += n * w;
+        offset += w;
+    }
+    Ok(records)
+}
+
 /// Parses a PCD file.
 ///
 /// # Errors
 /// [`FormatError::Syntax`] naming the header or data line at fault;
 /// [`FormatError::Corrupt`] naming the byte offset where binary data ends early or a
-/// point count the bytes cannot hold; [`FormatError::Unsupported`] for
-/// `binary_compressed`; [`FormatError::TooLarge`] past [`super::MAX_SCAN_POINTS`].
+/// point count the bytes cannot hold, or compressed data that does not decompress
+/// to the declared points; [`FormatError::TooLarge`] past
+/// [`super::MAX_SCAN_POINTS`].
 pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
     let mut pos = 0usize;
     let mut line_no = 0usize;
@@ -160,13 +246,9 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
                     return Err(err(col, "`DATA` needs ascii or binary".into()));
                 };
                 break match w {
-                    "ascii" => true,
-                    "binary" => false,
-                    "binary_compressed" => {
-                        return Err(FormatError::unsupported(format!(
-                            "line {line_no}: PCD `DATA binary_compressed` is not supported; save the cloud as `binary` or `ascii`"
-                        )))
-                    }
+                    "ascii" => Data::Ascii,
+                    "binary" => Data::Binary,
+                    "binary_compressed" => Data::Compressed,
                     _ => return Err(err(c, format!("unknown data format `{w}`"))),
                 };
             }
@@ -228,7 +310,7 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
     };
     let left = bytes.len() - pos;
     let mut out = Vec::new();
-    if data {
+    if data == Data::Ascii {
         // A point takes at least two bytes per value (a digit and a separator).
         let values: usize = fields.iter().map(|f| f.count).sum();
         if declared > (left / (2 * values).max(1)) as u64 + 1 {
@@ -270,14 +352,30 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
             let mut p = [0.0; 3];
             for (a, &i) in want.iter().enumerate() {
                 let (c, w) = ws[i];
-                p[a] = w
+                let v = w
                     .parse::<f64>()
                     .map_err(|_| syntax(line_no, c, format!("`{w}` is not a number")))?;
+                // A 4-byte float field holds an `f32`, as PCL reads it and as the
+                // same cloud saved as `binary` holds it.
+                let f = &fields[xyz[a]];
+                p[a] = if f.kind == Kind::Float && f.size == 4 {
+                    f64::from(v as f32)
+                } else {
+                    v
+                };
             }
             out.push(p);
         }
     } else {
         let record: usize = fields.iter().map(|f| f.size * f.count).sum();
+        let unpacked;
+        let (bytes, pos) = if data == Data::Compressed {
+            unpacked = decompress(&bytes[pos..], pos, declared, &fields)?;
+            (unpacked.as_slice(), 0)
+        } else {
+            (bytes, pos)
+        };
+        let left = bytes.len() - pos;
         if declared > (left / record) as u64 {
             return Err(FormatError::corrupt(format!(
                 "byte {pos}: the header declares {declared} points of {record} bytes; {left} bytes follow"
