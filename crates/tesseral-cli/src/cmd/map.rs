@@ -164,6 +164,7 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         indicatif::ProgressBar::hidden()
     };
+    let octomap = octomap_output(&args);
     let mut t = Totals::default();
     for path in &args.scans {
         let scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -171,6 +172,10 @@ pub fn run(args: Args) -> Result<()> {
         // Every scan's work is checked against --max-cells before any is cast.
         for (i, s) in scans.iter().enumerate() {
             check_work(&map, s, &args).with_context(|| at(i))?;
+        }
+        // And, for .bt and .ot, that no ray leaves OctoMap's key range.
+        if octomap {
+            check_key_range(&map, &scans, &args, at)?;
         }
         bar.inc_length(scans.len() as u64);
         bar.set_message(path.display().to_string());
@@ -238,6 +243,56 @@ pub fn run(args: Args) -> Result<()> {
             eprintln!("{line}");
         } else {
             crate::outln!("{line}")?;
+        }
+    }
+    Ok(())
+}
+
+/// Whether the map is written as OctoMap's `.bt` or `.ot`, whose keys reach cells
+/// −32768..32767 on each axis.
+fn octomap_output(args: &Args) -> bool {
+    let ext = if super::output::is_stdio(&args.output) {
+        args.out.format.clone().unwrap_or_default()
+    } else {
+        tesseral::io::extension(&args.output)
+    };
+    matches!(ext.as_str(), "bt" | "ot")
+}
+
+/// Refuses, before a file's scans are cast, a scan whose rays would reach a cell
+/// outside OctoMap's key range: its sensor, or a point (cut at `--max-range`). A ray
+/// lies between the two, and the key range is a box, so the ends suffice.
+fn check_key_range(
+    map: &OccupancyMap,
+    scans: &[ScanRecord],
+    args: &Args,
+    at: impl Fn(usize) -> String,
+) -> Result<()> {
+    const KEYS: std::ops::RangeInclusive<i64> = -32768..=32767;
+    for (i, (origin, points)) in placed(scans, args).enumerate() {
+        let end = |p: &[f64; 3]| {
+            let d = [0, 1, 2].map(|a| p[a] - origin[a]);
+            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+            match args.max_range {
+                Some(r) if len > r => [0, 1, 2].map(|a| origin[a] + d[a] * (r / len)),
+                _ => *p,
+            }
+        };
+        let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
+        let outside = std::iter::once(origin)
+            .chain(finite.map(end))
+            .map(|p| map.cell_of(p))
+            .find(|c| c.iter().any(|k| !KEYS.contains(k)));
+        if let Some(c) = outside {
+            bail!(
+                "{}: a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{} m at resolution {}): write .tess, which keeps the full range, or cut rays with --max-range",
+                at(i),
+                c[0],
+                c[1],
+                c[2],
+                32768.0 * args.resolution,
+                args.resolution
+            );
         }
     }
     Ok(())

@@ -152,15 +152,66 @@ fn a_map_beyond_octomap_keys_is_refused_in_bt_and_kept_in_tess() {
     let d = dir.path();
     // 2,000 m at 1 cm is 200,000 cells from the origin: past OctoMap's 32,768.
     fs::write(d.join("far.log"), "NODE 0 0 0 0 0 0\n2000 0 0\n").unwrap();
+    // Refused before the scan is cast, naming the scan and the cell.
     fails(
         d,
         &["map", "far.log", "-o", "far.bt", "--resolution", "0.01"],
-        "−32768..32767",
+        "far.log: scan 1 of 1: a ray reaches cell (200000, 0, 0), outside OctoMap's key range (cells −32768..32767",
     );
     fails(
         d,
         &["map", "far.log", "-o", "far.ot", "--resolution", "0.01"],
         "−32768..32767",
+    );
+    fails(
+        d,
+        &[
+            "map",
+            "far.log",
+            "-o",
+            "-",
+            "--format",
+            "bt",
+            "--resolution",
+            "0.01",
+        ],
+        "−32768..32767",
+    );
+    assert!(!d.join("far.bt").exists() && !d.join("far.ot").exists());
+    // Cut at 300 m (30,000 cells) the rays stay inside: written.
+    let v = json(
+        d,
+        &[
+            "map",
+            "far.log",
+            "-o",
+            "cut.bt",
+            "--resolution",
+            "0.01",
+            "--max-range",
+            "300",
+            "--json",
+        ],
+    );
+    assert_eq!(
+        (v["occupied"].as_u64(), v["free"].as_u64()),
+        (Some(0), Some(30_000))
+    );
+    // A sensor outside the range is refused whatever the range of its rays.
+    fs::write(d.join("off.log"), "NODE 400 0 0 0 0 0\n1 0 0\n").unwrap();
+    fails(
+        d,
+        &[
+            "map",
+            "off.log",
+            "-o",
+            "off.bt",
+            "--resolution",
+            "0.01",
+            "--max-range",
+            "1",
+        ],
+        "reaches cell (40000, 0, 0)",
     );
     let v = json(
         d,
