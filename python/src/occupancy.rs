@@ -7,6 +7,7 @@ use pyo3::types::PyDict;
 use tesseral::occupancy::{CellState, OccupancyMap as Map, ScanStats, SensorModel};
 
 use crate::arrays::rows;
+use crate::octree::Octree;
 
 /// An unbounded occupancy map (unknown / free / occupied cells with log-odds), built
 /// from range scans with OctoMap's `insertPointCloud` semantics and sensor model.
@@ -189,6 +190,39 @@ impl OccupancyMap {
         self.map.resolution()
     }
 
+    /// The map as an `Octree`, as `tesseral map` writes it: occupied cells as the
+    /// voxels, frame of voxel size `resolution` at the world origin, free cells and
+    /// every known cell's log-odds beside them. `write("map.bt")` or `.ot` gives
+    /// OctoMap's files; `render`, `collide` and `info` take it as any octree.
+    fn to_octree(&self, py: Python<'_>) -> PyResult<Octree> {
+        let m = &self.map;
+        py.allow_threads(|| m.to_model())
+            .map(Octree::new)
+            .map_err(crate::errors::octree)
+    }
+
+    /// A map from an `Octree` (as `tesseral.Octree.read("map.ot")` gives one): the
+    /// frame's voxel size is the resolution (voxel (0, 0, 0) must sit at the world
+    /// origin); known cells take their log-odds when the octree has them, else the
+    /// upper clamp (occupied) or the lower clamp (free), as OctoMap reads a `.bt`.
+    #[staticmethod]
+    #[pyo3(signature = (octree, prob_hit = 0.7, prob_miss = 0.4, clamp = (0.1192, 0.971), threshold = 0.5))]
+    fn from_octree(
+        py: Python<'_>,
+        octree: &Octree,
+        prob_hit: f64,
+        prob_miss: f64,
+        clamp: (f64, f64),
+        threshold: f64,
+    ) -> PyResult<Self> {
+        let sensor = SensorModel::from_probabilities(prob_hit, prob_miss, clamp, threshold)
+            .map_err(value_error)?;
+        let model = &octree.model;
+        py.allow_threads(|| Map::from_model_with(model, sensor))
+            .map(|map| Self { map })
+            .map_err(value_error)
+    }
+
     /// Counts: occupied, free, leaves, blocks, bytes.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);
@@ -200,4 +234,56 @@ impl OccupancyMap {
         d.set_item("bytes", self.map.bytes())?;
         Ok(d)
     }
+}
+
+/// A scan as `read_scans` gives it: the sensor origin and N×3 world points.
+type PlacedScan<'py> = ((f64, f64, f64), Bound<'py, numpy::PyArray2<f64>>);
+
+/// Reads a scan file (`.graph`, `.log`, `.xyz`, `.ply`, `.pcd`, as `tesseral map`
+/// does) as a list of `(origin, points)` pairs, the points an N×3 float array in
+/// world coordinates: what `OccupancyMap.insert_scans` takes. A graph's or log's
+/// poses are applied, a PCD's `VIEWPOINT` is its origin. For a cloud, `origin`
+/// gives the sensor position (the points are world coordinates) or `pose` (x, y, z,
+/// roll, pitch, yaw) moves points given in the sensor frame; both are refused for
+/// `.graph` and `.log`, which carry their own poses. NaN points are kept, for
+/// `insert_scans` to skip and count.
+#[pyfunction]
+#[pyo3(signature = (path, origin = None, pose = None))]
+pub fn read_scans(
+    py: Python<'_>,
+    path: std::path::PathBuf,
+    origin: Option<[f64; 3]>,
+    pose: Option<[f64; 6]>,
+) -> PyResult<Vec<PlacedScan<'_>>> {
+    use tesseral::io::scan::{self, PointFrame, ScanFormat};
+    if origin.is_some() && pose.is_some() {
+        return Err(PyValueError::new_err("give origin or pose, not both"));
+    }
+    // The extension decides, as in `scan::read`, which names the file when unknown.
+    let format = ScanFormat::from_extension(&tesseral::io::extension(&path));
+    if (origin.is_some() || pose.is_some()) && format.is_some_and(ScanFormat::has_poses) {
+        return Err(PyValueError::new_err(format!(
+            "{}: a scan graph or log carries its own poses; origin and pose place clouds",
+            path.display()
+        )));
+    }
+    let scans = py
+        .allow_threads(|| scan::read(&path))
+        .map_err(crate::errors::format)?;
+    scans
+        .into_iter()
+        .map(|mut s| {
+            if let Some(o) = origin {
+                s.translation = o;
+                s.frame = PointFrame::World;
+            } else if let Some([x, y, z, roll, pitch, yaw]) = pose {
+                s.translation = [x, y, z];
+                s.rpy = [roll, pitch, yaw];
+                s.frame = PointFrame::Sensor;
+            }
+            let points = py.allow_threads(|| s.world_points());
+            let [x, y, z] = s.translation;
+            Ok(((x, y, z), crate::arrays::to_array(py, points)?))
+        })
+        .collect()
 }

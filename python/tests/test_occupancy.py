@@ -120,3 +120,84 @@ def test_insert_scans_checks_every_scans_work_before_casting_any():
     with pytest.raises(ValueError, match="scan 1: .*max_cells"):
         m.insert_scans([((0.0, 0.0, 0.0), near), ((0.0, 0.0, 0.0), far)])
     assert m.stats()["occupied"] == 0 and m.stats()["free"] == 0
+
+
+def _room_scans():
+    rng = np.random.default_rng(11)
+    scans = []
+    for k in range(3):
+        d = rng.normal(size=(400, 3))
+        d /= np.abs(d).max(axis=1, keepdims=True)  # onto the faces of a cube
+        origin = (0.3 * k, 0.1, 0.2)
+        scans.append((origin, np.asarray(origin) + 2.0 * d))
+    return scans
+
+
+def test_to_octree_is_the_cli_map_and_from_octree_reads_it_back(tmp_path):
+    m = t.OccupancyMap(0.1)
+    m.insert_scans(_room_scans())
+    o = m.to_octree()
+    st = m.stats()
+    assert len(o) == st["occupied"]
+    assert o.frame["voxel_size"] == pytest.approx(0.1)
+    info = o.info()
+    assert info["free_voxels"] == st["free"] and info["log_odds"]
+    # The occupied voxels are the map's occupied cells.
+    occ = o.voxels()
+    assert list(m.state(occ)) == [2] * len(occ)
+    # Through OctoMap's .ot and back: the same states and log-odds everywhere known.
+    o.write(tmp_path / "map.ot")
+    back = t.OccupancyMap.from_octree(t.Octree.read(tmp_path / "map.ot"))
+    assert back.stats()["occupied"] == st["occupied"]
+    assert back.stats()["free"] == st["free"]
+    probe = np.concatenate([occ, m.cells_of(np.array([[0.05, 0.05, 0.05], [9.0, 9.0, 9.0]]))])
+    assert list(back.state(probe)) == list(m.state(probe))
+    a, b = m.log_odds(probe), back.log_odds(probe)
+    known = ~np.isnan(a)
+    assert np.array_equal(np.isnan(a), np.isnan(b))
+    assert np.allclose(a[known], b[known], atol=1e-3)
+    # A .bt keeps states only: occupied cells come back at the upper clamp.
+    o.write(tmp_path / "map.bt")
+    ml = t.OccupancyMap.from_octree(t.Octree.read(tmp_path / "map.bt"))
+    assert list(ml.state(probe)) == list(m.state(probe))
+    upper = np.log(0.971 / (1 - 0.971))
+    assert np.allclose(ml.log_odds(occ), upper, atol=0.01)
+
+
+def test_read_scans_places_clouds_and_logs_as_the_cli_does(tmp_path):
+    scans = _room_scans()
+    # A log: NODE x y z roll pitch yaw, then sensor-frame points.
+    log = []
+    for origin, pts in scans:
+        log.append("NODE %r %r %r 0 0 0.5" % origin)
+        c, s = np.cos(0.5), np.sin(0.5)
+        rot = np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+        local = (pts - np.asarray(origin)) @ rot  # inverse of the yaw
+        log.extend("%r %r %r" % tuple(p) for p in local.astype(np.float32).tolist())
+    (tmp_path / "run.log").write_text("\n".join(log) + "\n")
+    read = t.read_scans(tmp_path / "run.log")
+    assert len(read) == 3
+    for (o, p), (o2, p2) in zip(scans, read):
+        assert o2 == pytest.approx(o, abs=1e-6)
+        assert p2.shape == p.shape and np.allclose(p2, p, atol=1e-5)
+    # A cloud: world points, with origin= (or pose=) placing the sensor; NaN rows kept.
+    pts = np.vstack([scans[0][1], [[np.nan] * 3]])
+    np.savetxt(tmp_path / "c.xyz", pts)
+    [(o, p)] = t.read_scans(tmp_path / "c.xyz", origin=(0.0, 0.1, 0.2))
+    assert o == (0.0, 0.1, 0.2) and p.shape == (401, 3) and np.isnan(p[-1]).all()
+    [(o, p)] = t.read_scans(tmp_path / "c.xyz", pose=(1, 0, 0, 0, 0, 0))
+    assert o == (1.0, 0.0, 0.0) and np.allclose(p[:-1], pts[:-1] + [1, 0, 0])
+    # What it gives is what insert_scans takes.
+    m = t.OccupancyMap(0.1)
+    counts = m.insert_scans(t.read_scans(tmp_path / "c.xyz", origin=(0.0, 0.1, 0.2)))
+    assert counts[0]["skipped"] == 1
+    # Errors name the file.
+    with pytest.raises(ValueError, match="own poses"):
+        t.read_scans(tmp_path / "run.log", origin=(0, 0, 0))
+    with pytest.raises(ValueError, match="not both"):
+        t.read_scans(tmp_path / "c.xyz", origin=(0, 0, 0), pose=(0, 0, 0, 0, 0, 0))
+    (tmp_path / "bad.xyz").write_text("1 2 3\n4 x 6\n")
+    with pytest.raises(t.FormatError, match=r"bad.xyz:2:3"):
+        t.read_scans(tmp_path / "bad.xyz")
+    with pytest.raises(t.FormatError, match="nope.txt"):
+        t.read_scans(tmp_path / "nope.txt")

@@ -9,6 +9,7 @@ from ._tesseral import (
     __version__ as __version__,
     collide as collide,
     plan as plan,
+    read_scans as read_scans,
     render as render,
     rsmc as rsmc,
     simulate as simulate,

@@ -127,7 +127,21 @@ class OccupancyMap:
     @property
     def resolution(self) -> float: ...
     def stats(self) -> dict[str, int]: ...
+    def to_octree(self) -> Octree: ...
+    @staticmethod
+    def from_octree(
+        octree: Octree,
+        prob_hit: float = ...,
+        prob_miss: float = ...,
+        clamp: Tuple[float, float] = ...,
+        threshold: float = ...,
+    ) -> OccupancyMap: ...
 
+def read_scans(
+    path: Path,
+    origin: Optional[Tuple[float, float, float]] = ...,
+    pose: Optional[Tuple[float, float, float, float, float, float]] = ...,
+) -> List[Tuple[Tuple[float, float, float], npt.NDArray[np.float64]]]: ...
 def render(
     obj: Union[Octree, Scene],
     size: Tuple[int, int] = ...,
