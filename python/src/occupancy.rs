@@ -20,6 +20,17 @@ fn value_error(e: impl std::fmt::Display) -> PyErr {
     PyValueError::new_err(e.to_string())
 }
 
+/// The sensor model of the constructors' probabilities (ValueError when they do not
+/// make one).
+fn sensor_model(
+    prob_hit: f64,
+    prob_miss: f64,
+    clamp: (f64, f64),
+    threshold: f64,
+) -> PyResult<SensorModel> {
+    SensorModel::from_probabilities(prob_hit, prob_miss, clamp, threshold).map_err(value_error)
+}
+
 /// The default of `max_cells`: as the CLI's `--max-cells`.
 pub(crate) const DEFAULT_MAX_CELLS: u64 = 10_000_000_000;
 
@@ -70,8 +81,7 @@ impl OccupancyMap {
         clamp: (f64, f64),
         threshold: f64,
     ) -> PyResult<Self> {
-        let sensor = SensorModel::from_probabilities(prob_hit, prob_miss, clamp, threshold)
-            .map_err(value_error)?;
+        let sensor = sensor_model(prob_hit, prob_miss, clamp, threshold)?;
         Ok(Self {
             map: Map::new(resolution, sensor).map_err(value_error)?,
         })
@@ -215,8 +225,7 @@ impl OccupancyMap {
         clamp: (f64, f64),
         threshold: f64,
     ) -> PyResult<Self> {
-        let sensor = SensorModel::from_probabilities(prob_hit, prob_miss, clamp, threshold)
-            .map_err(value_error)?;
+        let sensor = sensor_model(prob_hit, prob_miss, clamp, threshold)?;
         let model = &octree.model;
         py.allow_threads(|| Map::from_model_with(model, sensor))
             .map(|map| Self { map })
