@@ -169,13 +169,13 @@ pub fn run(args: Args) -> Result<()> {
     for path in &args.scans {
         let scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
         let at = |i: usize| format!("{}: scan {} of {}", path.display(), i + 1, scans.len());
-        // Every scan's work is checked against --max-cells before any is cast.
+        // Every scan's work is checked against --max-cells before any is cast, and,
+        // for .bt and .ot, that no ray leaves OctoMap's key range.
         for (i, s) in scans.iter().enumerate() {
-            check_work(&map, s, &args).with_context(|| at(i))?;
-        }
-        // And, for .bt and .ot, that no ray leaves OctoMap's key range.
-        if octomap {
-            check_key_range(&map, &scans, &args, at)?;
+            let longest = check_work(&map, s, &args).with_context(|| at(i))?;
+            if octomap {
+                check_key_range(&map, s, &args, longest).with_context(|| at(i))?;
+            }
         }
         bar.inc_length(scans.len() as u64);
         bar.set_message(path.display().to_string());
@@ -259,53 +259,53 @@ fn octomap_output(args: &Args) -> bool {
     matches!(ext.as_str(), "bt" | "ot")
 }
 
-/// Refuses, before a file's scans are cast, a scan whose rays would reach a cell
-/// outside OctoMap's key range: its sensor, or a point (cut at `--max-range`). A ray
-/// lies between the two, and the key range is a box, so the ends suffice.
-fn check_key_range(
-    map: &OccupancyMap,
-    scans: &[ScanRecord],
-    args: &Args,
-    at: impl Fn(usize) -> String,
-) -> Result<()> {
+/// Refuses, before it is cast, a scan whose rays would reach a cell outside
+/// OctoMap's key range. Every ray lies within `longest` (its length after
+/// `--max-range`) of the sensor, so a box that wide around the sensor inside the
+/// range settles it without moving a point; else each ray's ends are checked (the
+/// sensor, the point cut at `--max-range`: the key range is a box, so the ends
+/// suffice), the points placed in the world.
+fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64) -> Result<()> {
     const KEYS: std::ops::RangeInclusive<i64> = -32768..=32767;
-    for (i, (origin, points)) in placed(scans, args).enumerate() {
-        let end = |p: &[f64; 3]| {
-            let d = [0, 1, 2].map(|a| p[a] - origin[a]);
-            let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-            match args.max_range {
-                Some(r) if len > r => [0, 1, 2].map(|a| origin[a] + d[a] * (r / len)),
-                _ => *p,
-            }
-        };
-        let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
-        let outside = std::iter::once(origin)
-            .chain(finite.map(end))
-            .map(|p| map.cell_of(p))
-            .find(|c| c.iter().any(|k| !KEYS.contains(k)));
-        if let Some(c) = outside {
-            bail!(
-                "{}: a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{} m at resolution {}): write .tess, which keeps the full range, or cut rays with --max-range",
-                at(i),
-                c[0],
-                c[1],
-                c[2],
-                32768.0 * args.resolution,
-                args.resolution
-            );
+    let inside = |p: [f64; 3]| map.cell_of(p).iter().all(|k| KEYS.contains(k));
+    let (sensor, _) = placement(s, args);
+    if inside(sensor.map(|c| c - longest)) && inside(sensor.map(|c| c + longest)) {
+        return Ok(());
+    }
+    let (_, points) = place(s, args);
+    let end = |p: &[f64; 3]| {
+        let d = [0, 1, 2].map(|a| p[a] - sensor[a]);
+        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        match args.max_range {
+            Some(r) if len > r => [0, 1, 2].map(|a| sensor[a] + d[a] * (r / len)),
+            _ => *p,
         }
+    };
+    let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
+    if let Some(c) = std::iter::once(sensor)
+        .chain(finite.map(end))
+        .find(|&p| !inside(p))
+        .map(|p| map.cell_of(p))
+    {
+        bail!(
+            "a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{} m at resolution {}): write .tess, which keeps the full range, or cut rays with --max-range",
+            c[0],
+            c[1],
+            c[2],
+            32768.0 * args.resolution,
+            args.resolution
+        );
     }
     Ok(())
 }
 
 /// Refuses a scan whose rays would cross more than `--max-cells` cells, before any
-/// is cast.
-fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<()> {
+/// is cast; else gives its longest ray's length (after `--max-range`).
+fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
     // A pose moves points rigidly: lengths from the sensor are those in its frame.
-    let origin = match (args.origin, args.pose, s.frame) {
-        (Some(o), _, _) => o,
-        (None, Some(_), _) | (None, None, PointFrame::Sensor) => [0.0; 3],
-        (None, None, PointFrame::World) => s.translation,
+    let origin = match placement(s, args) {
+        (sensor, None) => sensor,
+        (_, Some(_)) => [0.0; 3],
     };
     let work = map.scan_work(origin, &s.points, args.max_range);
     if work.cells > args.max_cells {
@@ -326,31 +326,42 @@ fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<()> {
             args.max_cells
         );
     }
-    Ok(())
+    Ok(work.longest)
 }
 
-/// The scans' sensor origins and points in world coordinates, placed by their own
-/// poses or by `--origin` / `--pose` (points moved by a pose are made as the scans
-/// are read, one at a time).
+/// Where a scan's sensor is, and the pose that moves its points into the world
+/// (`None` when they are world coordinates already): its own pose, or `--origin` /
+/// `--pose`.
+fn placement(s: &ScanRecord, args: &Args) -> ([f64; 3], Option<Pose>) {
+    let pose = |translation: [f64; 3], [roll, pitch, yaw]: [f64; 3]| Pose {
+        translation,
+        roll,
+        pitch,
+        yaw,
+    };
+    match (args.origin, args.pose, s.frame) {
+        (Some(o), _, _) => (o, None),
+        (None, Some([x, y, z, roll, pitch, yaw]), _) => {
+            ([x, y, z], Some(pose([x, y, z], [roll, pitch, yaw])))
+        }
+        (None, None, PointFrame::World) => (s.translation, None),
+        (None, None, PointFrame::Sensor) => (s.translation, Some(pose(s.translation, s.rpy))),
+    }
+}
+
+/// A scan's sensor origin and points in world coordinates ([`placement`]).
+fn place<'a>(s: &'a ScanRecord, args: &Args) -> ([f64; 3], Cow<'a, [[f64; 3]]>) {
+    match placement(s, args) {
+        (sensor, None) => (sensor, Cow::Borrowed(s.points.as_slice())),
+        (sensor, Some(p)) => (sensor, Cow::Owned(p.apply_all(&s.points))),
+    }
+}
+
+/// The scans [`place`]d, one at a time as they are read (points moved by a pose are
+/// made then).
 fn placed<'a>(
     scans: &'a [ScanRecord],
     args: &'a Args,
 ) -> impl Iterator<Item = ([f64; 3], Cow<'a, [[f64; 3]]>)> + 'a {
-    scans.iter().map(move |s| {
-        let (translation, [roll, pitch, yaw]) = match (args.origin, args.pose, s.frame) {
-            (Some(o), _, _) => return (o, Cow::Borrowed(s.points.as_slice())),
-            (None, Some([x, y, z, roll, pitch, yaw]), _) => ([x, y, z], [roll, pitch, yaw]),
-            (None, None, PointFrame::World) => {
-                return (s.translation, Cow::Borrowed(s.points.as_slice()))
-            }
-            (None, None, PointFrame::Sensor) => (s.translation, s.rpy),
-        };
-        let pose = Pose {
-            translation,
-            roll,
-            pitch,
-            yaw,
-        };
-        (translation, Cow::Owned(pose.apply_all(&s.points)))
-    })
+    scans.iter().map(move |s| place(s, args))
 }
