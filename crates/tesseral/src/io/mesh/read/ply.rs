@@ -75,6 +75,9 @@ struct PlyBody<'a> {
     /// Whether a NaN or infinite value is an error (a mesh), or passed on (a point
     /// cloud, whose reader skips and counts such points).
     finite: bool,
+    /// Whether the next value is an element's first (ASCII): only that one may
+    /// start on a later line, as each element takes one line.
+    fresh: bool,
 }
 
 impl PlyBody<'_> {
@@ -85,11 +88,20 @@ impl PlyBody<'_> {
         if self.format == PlyFormat::Ascii {
             while self.pos < self.bytes.len() && self.bytes[self.pos].is_ascii_whitespace() {
                 if self.bytes[self.pos] == b'\n' {
+                    if !self.fresh {
+                        let column = self.pos - self.line_start + 1;
+                        return Err(syntax(
+                            self.line,
+                            column,
+                            "the line ends inside an element (each takes one line)",
+                        ));
+                    }
                     self.line += 1;
                     self.line_start = self.pos + 1;
                 }
                 self.pos += 1;
             }
+            self.fresh = false;
             let start = self.pos;
             while self.pos < self.bytes.len() && !self.bytes[self.pos].is_ascii_whitespace() {
                 self.pos += 1;
@@ -136,6 +148,32 @@ impl PlyBody<'_> {
             )));
         }
         Ok(v)
+    }
+}
+
+impl PlyBody<'_> {
+    /// Ends an element (ASCII): nothing but spaces may follow its last value on its
+    /// line, and the next value starts a new element.
+    fn end_element(&mut self) -> Result<(), FormatError> {
+        if self.format != PlyFormat::Ascii {
+            return Ok(());
+        }
+        while self.pos < self.bytes.len()
+            && self.bytes[self.pos] != b'\n'
+            && self.bytes[self.pos].is_ascii_whitespace()
+        {
+            self.pos += 1;
+        }
+        if self.pos < self.bytes.len() && self.bytes[self.pos] != b'\n' {
+            let column = self.pos - self.line_start + 1;
+            return Err(syntax(
+                self.line,
+                column,
+                "more values on the line than the element's properties",
+            ));
+        }
+        self.fresh = true;
+        Ok(())
     }
 }
 
@@ -247,6 +285,7 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
         line_start: body_start.min(bytes.len()),
         token: 0,
         finite,
+        fresh: true,
     };
     let mut m = TriMesh::default();
     for el in &elements {
@@ -357,6 +396,9 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                         }
                     }
                 }
+            }
+            if !el.props.is_empty() {
+                body.end_element()?;
             }
             if is_vertex {
                 m.positions.push(p);
