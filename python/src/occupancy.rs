@@ -264,13 +264,18 @@ pub fn read_scans(
     origin: Option<[f64; 3]>,
     pose: Option<[f64; 6]>,
 ) -> PyResult<Vec<PlacedScan<'_>>> {
-    use tesseral::io::scan::{self, PointFrame, ScanFormat};
-    if origin.is_some() && pose.is_some() {
-        return Err(PyValueError::new_err("give origin or pose, not both"));
-    }
+    use tesseral::io::scan::{self, Placement, ScanFormat};
+    let placement = match (origin, pose) {
+        (Some(_), Some(_)) => {
+            return Err(PyValueError::new_err("give origin or pose, not both"));
+        }
+        (Some(o), None) => Placement::Origin(o),
+        (None, Some(p)) => Placement::Pose(p),
+        (None, None) => Placement::AsRead,
+    };
     // The extension decides, as in `scan::read`, which names the file when unknown.
     let format = ScanFormat::from_extension(&tesseral::io::extension(&path));
-    if (origin.is_some() || pose.is_some()) && format.is_some_and(ScanFormat::has_poses) {
+    if placement.overrides() && format.is_some_and(ScanFormat::has_poses) {
         return Err(PyValueError::new_err(format!(
             "{}: a scan graph or log carries its own poses; origin and pose place clouds",
             path.display()
@@ -282,15 +287,8 @@ pub fn read_scans(
     scans
         .into_iter()
         .map(|mut s| {
-            if let Some(o) = origin {
-                s.translation = o;
-                s.frame = PointFrame::World;
-            } else if let Some([x, y, z, roll, pitch, yaw]) = pose {
-                s.translation = [x, y, z];
-                s.rpy = [roll, pitch, yaw];
-                s.frame = PointFrame::Sensor;
-            }
-            let points = py.allow_threads(|| s.world_points());
+            s.place(placement);
+            let points = py.allow_threads(|| s.world_points().into_owned());
             let [x, y, z] = s.translation;
             Ok(((x, y, z), crate::arrays::to_array(py, points)?))
         })

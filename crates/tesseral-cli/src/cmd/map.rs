@@ -6,7 +6,9 @@
 //! pose per scan, and from point clouds (`.xyz`, `.ply`, `.pcd`), placed with
 //! `--origin` (the sensor position; the points are world coordinates) or `--pose`
 //! (the points are in the sensor frame, moved by the pose). A PCD's `VIEWPOINT` is
-//! its sensor origin unless either is given. A file's scans go through
+//! its sensor origin unless either is given. Every file is read and every scan
+//! checked (`--max-cells`; for `.bt` and `.ot`, OctoMap's key range) before any is
+//! cast. Then a file's scans go through
 //! `tesseral::occupancy::OccupancyMap::insert_scans_each` (each scan cast while the
 //! one before it is applied), with the store's capacity checked after each.
 //!
@@ -16,14 +18,13 @@
 //! and `skipped` (points with a NaN or infinite coordinate, not cast: `points` is
 //! `rays + skipped`).
 
-use std::borrow::Cow;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
-use tesseral::io::scan::{self, PointFrame, ScanFormat, ScanRecord};
-use tesseral::occupancy::{OccupancyMap, Pose, SensorModel};
+use tesseral::io::scan::{self, Placement, ScanFormat, ScanRecord};
+use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use super::octree::{self, OutArgs};
 
@@ -166,23 +167,39 @@ pub fn run(args: Args) -> Result<()> {
     };
     let octomap = octomap_output(&args);
     let mut t = Totals::default();
+    let placement = match (args.origin, args.pose) {
+        (Some(o), _) => Placement::Origin(o),
+        (None, Some(p)) => Placement::Pose(p),
+        (None, None) => Placement::AsRead,
+    };
+    // Every file is read and checked before any scan is cast, so that a bad file or
+    // scan late in the list is refused at once, not after the work on those before
+    // it. Files are kept for the insertion while they hold at most HELD_POINTS
+    // points together; the others are read (and checked) again then.
+    let mut held = Vec::with_capacity(args.scans.len());
+    let mut kept = 0;
     for path in &args.scans {
-        let scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let at = |i: usize| format!("{}: scan {} of {}", path.display(), i + 1, scans.len());
-        // Every scan's work is checked against --max-cells before any is cast, and,
-        // for .bt and .ot, that no ray leaves OctoMap's key range.
-        for (i, s) in scans.iter().enumerate() {
-            let longest = check_work(&map, s, &args).with_context(|| at(i))?;
-            if octomap {
-                check_key_range(&map, s, &args, longest).with_context(|| at(i))?;
-            }
-        }
+        bar.set_message(format!("reading {}", path.display()));
+        let scans = read_checked(&map, path, placement, &args, octomap)?;
         bar.inc_length(scans.len() as u64);
+        let points: usize = scans.iter().map(|s| s.points.len()).sum();
+        held.push((kept + points <= HELD_POINTS).then(|| {
+            kept += points;
+            scans
+        }));
+    }
+    for (path, held) in args.scans.iter().zip(held) {
+        let scans = match held {
+            Some(scans) => scans,
+            None => read_checked(&map, path, placement, &args, octomap)?,
+        };
+        let at = |i: usize| format!("{}: scan {} of {}", path.display(), i + 1, scans.len());
         bar.set_message(path.display().to_string());
         // Each scan is cast while the one before it is applied (insert_scans).
         let start = Instant::now();
         let mut i = 0;
-        map.insert_scans_each(placed(&scans, &args), args.max_range, |map, stats| {
+        let placed = scans.iter().map(|s| (s.translation, s.world_points()));
+        map.insert_scans_each(placed, args.max_range, |map, stats| {
             t.scans += 1;
             t.points += stats.points;
             t.rays += stats.rays;
@@ -248,6 +265,32 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
+/// The most points that the files read before the insertion keep for it (100 MB);
+/// the rest are read again (see [`run`]).
+const HELD_POINTS: usize = 1 << 22;
+
+/// A scan file's scans, placed, each checked against `--max-cells` and, when the
+/// map is written as `.bt` or `.ot` (`octomap`), OctoMap's key range.
+fn read_checked(
+    map: &OccupancyMap,
+    path: &Path,
+    placement: Placement,
+    args: &Args,
+    octomap: bool,
+) -> Result<Vec<ScanRecord>> {
+    let mut scans = scan::read(path).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let n = scans.len();
+    for (i, s) in scans.iter_mut().enumerate() {
+        let at = || format!("{}: scan {} of {n}", path.display(), i + 1);
+        s.place(placement);
+        let longest = check_work(map, s, args).with_context(at)?;
+        if octomap {
+            check_key_range(map, s, args, longest).with_context(at)?;
+        }
+    }
+    Ok(scans)
+}
+
 /// Whether the map is written as OctoMap's `.bt` or `.ot`, whose keys reach cells
 /// −32768..32767 on each axis.
 fn octomap_output(args: &Args) -> bool {
@@ -268,11 +311,11 @@ fn octomap_output(args: &Args) -> bool {
 fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64) -> Result<()> {
     const KEYS: std::ops::RangeInclusive<i64> = -32768..=32767;
     let inside = |p: [f64; 3]| map.cell_of(p).iter().all(|k| KEYS.contains(k));
-    let (sensor, _) = placement(s, args);
+    let sensor = s.translation;
     if inside(sensor.map(|c| c - longest)) && inside(sensor.map(|c| c + longest)) {
         return Ok(());
     }
-    let (_, points) = place(s, args);
+    let points = s.world_points();
     let end = |p: &[f64; 3]| {
         let d = [0, 1, 2].map(|a| p[a] - sensor[a]);
         let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
@@ -302,12 +345,7 @@ fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64
 /// Refuses a scan whose rays would cross more than `--max-cells` cells, before any
 /// is cast; else gives its longest ray's length (after `--max-range`).
 fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
-    // A pose moves points rigidly: lengths from the sensor are those in its frame.
-    let origin = match placement(s, args) {
-        (sensor, None) => sensor,
-        (_, Some(_)) => [0.0; 3],
-    };
-    let work = map.scan_work(origin, &s.points, args.max_range);
+    let work = map.scan_work(s.sensor_in_points_frame(), &s.points, args.max_range);
     if work.cells > args.max_cells {
         let hint = if args.max_range.is_some() {
             "lower --max-range or raise --max-cells"
@@ -327,41 +365,4 @@ fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
         );
     }
     Ok(work.longest)
-}
-
-/// Where a scan's sensor is, and the pose that moves its points into the world
-/// (`None` when they are world coordinates already): its own pose, or `--origin` /
-/// `--pose`.
-fn placement(s: &ScanRecord, args: &Args) -> ([f64; 3], Option<Pose>) {
-    let pose = |translation: [f64; 3], [roll, pitch, yaw]: [f64; 3]| Pose {
-        translation,
-        roll,
-        pitch,
-        yaw,
-    };
-    match (args.origin, args.pose, s.frame) {
-        (Some(o), _, _) => (o, None),
-        (None, Some([x, y, z, roll, pitch, yaw]), _) => {
-            ([x, y, z], Some(pose([x, y, z], [roll, pitch, yaw])))
-        }
-        (None, None, PointFrame::World) => (s.translation, None),
-        (None, None, PointFrame::Sensor) => (s.translation, Some(pose(s.translation, s.rpy))),
-    }
-}
-
-/// A scan's sensor origin and points in world coordinates ([`placement`]).
-fn place<'a>(s: &'a ScanRecord, args: &Args) -> ([f64; 3], Cow<'a, [[f64; 3]]>) {
-    match placement(s, args) {
-        (sensor, None) => (sensor, Cow::Borrowed(s.points.as_slice())),
-        (sensor, Some(p)) => (sensor, Cow::Owned(p.apply_all(&s.points))),
-    }
-}
-
-/// The scans [`place`]d, one at a time as they are read (points moved by a pose are
-/// made then).
-fn placed<'a>(
-    scans: &'a [ScanRecord],
-    args: &'a Args,
-) -> impl Iterator<Item = ([f64; 3], Cow<'a, [[f64; 3]]>)> + 'a {
-    scans.iter().map(move |s| place(s, args))
 }

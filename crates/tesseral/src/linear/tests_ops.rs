@@ -369,6 +369,8 @@ fn fast_sibling_check_matches_the_reference() {
             if next() % 12 == 0 {
                 code += 1 << (3 * u32::from(kk));
             }
+            // A leaf starts at a multiple of its size (`Leaf::new`'s contract).
+            code = code.next_multiple_of(1 << (3 * u32::from(kk)));
             run.push(Leaf::new(code, kk));
             code += 1 << (3 * u32::from(kk));
         }

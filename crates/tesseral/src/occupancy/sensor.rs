@@ -227,22 +227,13 @@ impl Pose {
     /// The rotation matrix, rows first (OctoMap's `Quaternion(roll, pitch, yaw)`).
     #[must_use]
     pub fn matrix(&self) -> [[f64; 3]; 3] {
-        let (sr, cr) = self.roll.sin_cos();
-        let (sp, cp) = self.pitch.sin_cos();
-        let (sy, cy) = self.yaw.sin_cos();
-        [
-            [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-            [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-            [-sp, cp * sr, cp * cr],
-        ]
+        crate::io::scan::rpy_matrix([self.roll, self.pitch, self.yaw])
     }
 
     /// A point of the sensor frame in the world.
     #[must_use]
     pub fn apply(&self, p: [f64; 3]) -> [f64; 3] {
-        let m = self.matrix();
-        let t = self.translation;
-        [0, 1, 2].map(|i| m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + t[i])
+        crate::io::scan::moved(&self.matrix(), self.translation, p)
     }
 
     /// Points of the sensor frame in the world, as [`apply`](Self::apply) moves
@@ -250,6 +241,10 @@ impl Pose {
     #[must_use]
     pub fn apply_all(&self, points: &[[f64; 3]]) -> Vec<[f64; 3]> {
         use rayon::prelude::*;
-        points.par_iter().map(|p| self.apply(*p)).collect()
+        let (m, t) = (self.matrix(), self.translation);
+        points
+            .par_iter()
+            .map(|&p| crate::io::scan::moved(&m, t, p))
+            .collect()
     }
 }

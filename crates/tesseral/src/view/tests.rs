@@ -214,7 +214,17 @@ fn layer_colours_reach_every_voxel() {
         let coloured: Vec<(Voxel, Rgba)> = set
             .iter()
             .filter(|_| rng.next() % 3 != 0)
-            .map(|&v| (v, [(v[0] % 2) as u8 * 200, 10, (v[2] % 3) as u8 * 50, 255]))
+            .map(|&v| {
+                (
+                    v,
+                    [
+                        v[0].rem_euclid(2) as u8 * 200,
+                        10,
+                        v[2].rem_euclid(3) as u8 * 50,
+                        255,
+                    ],
+                )
+            })
             .collect();
         let layer = Layer::from_voxels(depth, origin, coloured.iter().copied()).unwrap();
         let mut palette = Palette::default();

@@ -22,6 +22,7 @@ pub mod pcd;
 #[cfg(test)]
 mod tests;
 
+use std::borrow::Cow;
 use std::path::Path;
 
 use super::FormatError;
@@ -61,8 +62,43 @@ pub struct ScanRecord {
 }
 
 impl ScanRecord {
-    /// The points in world coordinates: the pose applied to sensor-frame points,
-    /// world-frame points unchanged.
+    /// Places the scan as `placement` says, over what its file said.
+    ///
+    /// ```
+    /// use tesseral::io::scan::{Placement, PointFrame, ScanRecord};
+    /// let mut s = ScanRecord { points: vec![[1.0, 0.0, 0.0]], ..Default::default() };
+    /// s.place(Placement::Origin([0.0, 0.0, 2.0]));
+    /// assert_eq!((s.frame, s.translation), (PointFrame::World, [0.0, 0.0, 2.0]));
+    /// ```
+    pub fn place(&mut self, placement: Placement) {
+        match placement {
+            Placement::AsRead => {}
+            Placement::Origin(o) => {
+                self.translation = o;
+                self.rpy = [0.0; 3];
+                self.frame = PointFrame::World;
+            }
+            Placement::Pose([x, y, z, roll, pitch, yaw]) => {
+                self.translation = [x, y, z];
+                self.rpy = [roll, pitch, yaw];
+                self.frame = PointFrame::Sensor;
+            }
+        }
+    }
+
+    /// The sensor's position in the frame [`points`](Self::points) are given in:
+    /// the translation for world points, the origin for sensor-frame points. A
+    /// pose moves points rigidly, so each ray's length is the distance from here.
+    #[must_use]
+    pub fn sensor_in_points_frame(&self) -> [f64; 3] {
+        match self.frame {
+            PointFrame::World => self.translation,
+            PointFrame::Sensor => [0.0; 3],
+        }
+    }
+
+    /// The points in world coordinates: the pose applied to sensor-frame points
+    /// (in parallel), world-frame points borrowed as they are.
     ///
     /// ```
     /// use tesseral::io::scan::ScanRecord;
@@ -72,22 +108,40 @@ impl ScanRecord {
     /// assert!((w[0][0] - 1.0).abs() < 1e-12 && (w[0][1] - 1.0).abs() < 1e-12);
     /// ```
     #[must_use]
-    pub fn world_points(&self) -> Vec<[f64; 3]> {
+    pub fn world_points(&self) -> Cow<'_, [[f64; 3]]> {
+        use rayon::prelude::*;
         match self.frame {
-            PointFrame::World => self.points.clone(),
+            PointFrame::World => Cow::Borrowed(&self.points),
             PointFrame::Sensor => {
-                let m = rpy_matrix(self.rpy);
-                let t = self.translation;
-                self.points
-                    .iter()
-                    .map(|p| {
-                        std::array::from_fn(|r| {
-                            m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + t[r]
-                        })
-                    })
-                    .collect()
+                let (m, t) = (rpy_matrix(self.rpy), self.translation);
+                Cow::Owned(self.points.par_iter().map(|&p| moved(&m, t, p)).collect())
             }
         }
+    }
+}
+
+/// Where a file's scans are placed, over what the file says: what `tesseral map
+/// --origin` / `--pose` and Python's `read_scans(origin=, pose=)` give. Only point
+/// clouds take an override; a scan graph or log carries a pose per scan
+/// ([`ScanFormat::has_poses`]).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub enum Placement {
+    /// As read: a graph's or log's poses, a PCD's `VIEWPOINT`, else the sensor at
+    /// the origin of the points' frame.
+    #[default]
+    AsRead,
+    /// The sensor at this point; the points are world coordinates.
+    Origin([f64; 3]),
+    /// The points are in the sensor's frame, moved into the world by this pose:
+    /// x, y, z, then roll, pitch, yaw in radians (OctoMap's convention).
+    Pose([f64; 6]),
+}
+
+impl Placement {
+    /// Whether this overrides what a file says (not [`AsRead`](Self::AsRead)).
+    #[must_use]
+    pub fn overrides(self) -> bool {
+        self != Self::AsRead
     }
 }
 
@@ -103,6 +157,12 @@ pub fn rpy_matrix([roll, pitch, yaw]: [f64; 3]) -> [[f64; 3]; 3] {
         [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
         [-sp, cp * sr, cp * cr],
     ]
+}
+
+/// Point `p` rotated by `m` (rows first), then translated by `t`.
+#[inline]
+pub(crate) fn moved(m: &[[f64; 3]; 3], t: [f64; 3], p: [f64; 3]) -> [f64; 3] {
+    std::array::from_fn(|r| m[r][0] * p[0] + m[r][1] * p[1] + m[r][2] * p[2] + t[r])
 }
 
 /// A scan file format.

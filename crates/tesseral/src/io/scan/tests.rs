@@ -45,8 +45,8 @@ fn graph_round_trips_random_scans() {
                 b.rpy,
                 a.rpy
             );
-            for (p, q) in a.world_points().iter().zip(b.world_points()) {
-                assert!(close(*p, q, 1e-4), "seed {seed}");
+            for (p, q) in a.world_points().iter().zip(b.world_points().iter()) {
+                assert!(close(*p, *q, 1e-4), "seed {seed}");
             }
         }
     }
@@ -443,20 +443,29 @@ fn ascii_ply_errors_name_line_and_column_and_clouds_keep_missing_returns() {
 fn ascii_ply_elements_take_one_line_each() {
     let head = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
     // A short line is reported where it ends, not where the file does.
-    let (l, c, m) = syntax_at(cloud::parse_ply(format!("{head}1.5 2.5 3.5\n4 5\n7 8 9\n").as_bytes()));
+    let (l, c, m) = syntax_at(cloud::parse_ply(
+        format!("{head}1.5 2.5 3.5\n4 5\n7 8 9\n").as_bytes(),
+    ));
     assert_eq!((l, c), (9, 4), "{m}");
     assert!(m.contains("line ends inside an element"), "{m}");
     // A long one at its first value too many.
-    let (l, c, m) = syntax_at(cloud::parse_ply(format!("{head}1 2 3\n4 5 6 7\n8 9 10\n").as_bytes()));
+    let (l, c, m) = syntax_at(cloud::parse_ply(
+        format!("{head}1 2 3\n4 5 6 7\n8 9 10\n").as_bytes(),
+    ));
     assert_eq!((l, c), (9, 7), "{m}");
     assert!(m.contains("more values"), "{m}");
     // Spaces, tabs and CRLF after the last value, blank lines between elements, and
     // no newline at the end are all fine.
     let r = cloud::parse_ply(format!("{head}1 2 3 \t\r\n\n4 5 6\r\n  7 8 9").as_bytes()).unwrap();
-    assert_eq!(r.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]);
+    assert_eq!(
+        r.points,
+        vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0], [7.0, 8.0, 9.0]]
+    );
     // The same for a mesh's faces: a face's list may not run onto the next line.
     let mesh = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
-    let (l, c, m) = syntax_at(crate::io::mesh::parse_ply(format!("{mesh}3 0 1\n2\n").as_bytes()));
+    let (l, c, m) = syntax_at(crate::io::mesh::parse_ply(
+        format!("{mesh}3 0 1\n2\n").as_bytes(),
+    ));
     assert_eq!((l, c), (13, 6), "{m}");
     assert!(crate::io::mesh::parse_ply(format!("{mesh}3 0 1 2\n").as_bytes()).is_ok());
 }
