@@ -9,9 +9,11 @@ use crate::Voxel;
 /// `origin`.
 ///
 /// # Runtime
-/// O(n log n) for n leaves when the offset between the two origins is a multiple of
-/// every block's size (each block then maps to one block); otherwise each block is
-/// cut into aligned cubes, O(its surface) each.
+/// O(n) for n leaves when the tree's space is an aligned cube of the new one (the
+/// offset a multiple of the tree's side: every code moves by one constant, order
+/// kept); O(n log n) when the offset is a multiple of every block's size (each
+/// block then maps to one block); otherwise each block is cut into aligned cubes,
+/// O(its surface) each.
 ///
 /// # Errors
 /// [`OctreeError::OutOfBounds`] naming a voxel that does not fit the new space;
@@ -29,6 +31,13 @@ pub fn reframe(tree: &LinearOctree, depth: u8, origin: Voxel) -> Result<LinearOc
         return Ok(tree.clone());
     }
     LinearOctree::empty(depth, origin)?;
+    if let Some(base) = sub_cube(tree, depth, origin) {
+        let moved = tree
+            .leaves()
+            .iter()
+            .map(|l| Leaf::new(base + l.code(), l.size_log2()));
+        return LinearOctree::from_sorted_leaves(depth, origin, moved);
+    }
     let side = 1i64 << depth;
     let mut leaves = Vec::with_capacity(tree.leaf_count());
     for b in tree.blocks() {
@@ -61,6 +70,23 @@ pub fn reframe(tree: &LinearOctree, depth: u8, origin: Voxel) -> Result<LinearOc
     }
     leaves.sort_unstable();
     LinearOctree::from_sorted_leaves(depth, origin, leaves)
+}
+
+/// The code of the tree's lowest voxel in the space of side `2^depth` from
+/// `origin`, when the tree's space is an aligned cube of that one: its offset a
+/// multiple of its side on each axis, inside. Every code of the tree then moves by
+/// that much, and a leaf stays a leaf.
+fn sub_cube(tree: &LinearOctree, depth: u8, origin: Voxel) -> Option<u64> {
+    let side = 1i64 << tree.depth();
+    let mut rel = [0u32; 3];
+    for (a, r) in rel.iter_mut().enumerate() {
+        let d = tree.origin()[a].checked_sub(origin[a])?;
+        if d < 0 || d % side != 0 || d.checked_add(side)? > 1i64 << depth {
+            return None;
+        }
+        *r = u32::try_from(d).ok()?;
+    }
+    Some(code::encode(rel[0], rel[1], rel[2]))
 }
 
 /// Cuts the cube `[lo, lo + s)` per axis into maximal aligned cubes.
@@ -136,6 +162,26 @@ mod tests {
                         || a.iter().all(|v| v[0] >= origin[0] + 8)
                 );
             }
+        }
+    }
+
+    #[test]
+    fn aligned_sub_cubes_move_by_one_code() {
+        for seed in 0..60u64 {
+            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+            let (origin, voxels) = crate::io::random_voxels(&mut rng, 5, 8, 400);
+            let tree = LinearOctree::from_voxels(3, origin, voxels.iter().copied()).unwrap();
+            // Offsets that are multiples of the tree's side: the fast path.
+            let new_origin = origin.map(|c| c - 8 * rng.random_range(0..8i64));
+            assert!(sub_cube(&tree, 6, new_origin).is_some());
+            let moved = reframe(&tree, 6, new_origin).unwrap();
+            moved.assert_valid();
+            let expected = LinearOctree::from_voxels(6, new_origin, tree.voxels()).unwrap();
+            assert_eq!(moved, expected, "seed {seed}");
+            // Not a multiple, or not inside: the general path.
+            assert!(sub_cube(&tree, 6, new_origin.map(|c| c + 4)).is_none());
+            assert!(sub_cube(&tree, 3, origin.map(|c| c - 8)).is_none());
+            assert!(sub_cube(&tree, 6, origin.map(|c| c - 64)).is_none());
         }
     }
 }

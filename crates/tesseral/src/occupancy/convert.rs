@@ -1,11 +1,9 @@
 //! Maps to and from [`Model`]s: the tree is the occupied cells, the free layer the
 //! free ones, and the log-odds layer every known cell's value.
 
-use std::collections::HashMap;
-
 use super::sensor::UNKNOWN;
 use super::{OccupancyError, OccupancyMap, SensorModel};
-use crate::linear::{LinearOctree, MAX_DEPTH};
+use crate::linear::{Leaf, LinearOctree, MAX_DEPTH};
 use crate::model::{Frame, Layer, Model};
 use crate::Voxel;
 
@@ -18,25 +16,8 @@ impl OccupancyMap {
     /// [`OccupancyError::Octree`] when the map spans more than a linear octree can
     /// (2^21 cells per axis).
     pub fn to_model(&self) -> Result<Model, OccupancyError> {
-        let t = self.fixed.threshold;
-        let mut occupied: Vec<Voxel> = Vec::new();
-        let mut free: Vec<Voxel> = Vec::new();
-        let mut by_value: HashMap<i16, Vec<Voxel>> = HashMap::new();
-        let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
-        self.store.for_each(|c, v| {
-            for a in 0..3 {
-                lo[a] = lo[a].min(c[a]);
-                hi[a] = hi[a].max(c[a]);
-            }
-            if v >= t {
-                occupied.push(c);
-            } else {
-                free.push(c);
-            }
-            by_value.entry(v).or_default().push(c);
-        });
         let frame = Frame::new(self.resolution, [0.0; 3]);
-        if occupied.is_empty() && free.is_empty() {
+        let Some((lo, hi)) = self.store.block_bounds() else {
             let empty = LinearOctree::empty(0, [0; 3])?;
             return Ok(Model::from_parts(
                 empty.clone(),
@@ -45,29 +26,40 @@ impl OccupancyMap {
                 Some(empty),
                 Some(Layer::empty(0, [0; 3])),
             )?);
-        }
-        let extent = (0..3).map(|a| hi[a].abs_diff(lo[a]) + 1).max().unwrap_or(1);
-        let depth = u8::try_from(extent.next_power_of_two().trailing_zeros()).unwrap_or(u8::MAX);
-        if depth > MAX_DEPTH {
-            return Err(OccupancyError::Model(format!(
-                "the map spans {extent} cells, more than a model holds (2^{MAX_DEPTH})"
-            )));
-        }
-        let last = (1i64 << depth) - 1;
-        let origin = lo.map(|c| c.min(i64::MAX - last));
-        let tree = LinearOctree::from_voxels(depth, origin, occupied)?;
-        let free = LinearOctree::from_voxels(depth, origin, free)?;
-        let mut regions = Vec::with_capacity(by_value.len());
-        let mut values: Vec<_> = by_value.into_iter().collect();
-        values.sort_unstable_by_key(|(v, _)| *v);
-        for (v, cells) in values {
+        };
+        let (depth, origin) = space(lo.map(|b| b << 3), hi.map(|b| b << 3 | 7))?;
+        // The cells come in tesseral order: each part is built as it goes, and
+        // sibling leaves merge as they arrive.
+        // The cells come in tesseral order: every part is built from sorted leaves,
+        // each value's cells grouped through a table indexed by the value.
+        let t = self.fixed.threshold;
+        let (mut occupied, mut free) = (Vec::new(), Vec::new());
+        let mut group = vec![u32::MAX; 1 << 16];
+        let mut groups: Vec<(i16, Vec<Leaf>)> = Vec::new();
+        self.store.for_each_in_order(origin, depth, |leaf, v| {
             debug_assert_ne!(v, UNKNOWN);
-            regions.push((
-                self.fixed.to_f32(v),
-                LinearOctree::from_voxels(depth, origin, cells)?,
-            ));
-        }
-        let layer = Layer::from_regions(depth, origin, regions)?;
+            if v >= t {
+                occupied.push(leaf);
+            } else {
+                free.push(leaf);
+            }
+            let g = &mut group[usize::from(v as u16)];
+            if *g == u32::MAX {
+                *g = groups.len() as u32;
+                groups.push((v, Vec::new()));
+            }
+            groups[*g as usize].1.push(leaf);
+        });
+        let tree = LinearOctree::from_sorted_leaves(depth, origin, occupied)?;
+        let free = LinearOctree::from_sorted_leaves(depth, origin, free)?;
+        let regions = groups
+            .into_iter()
+            .map(|(v, leaves)| {
+                let region = LinearOctree::from_sorted_leaves(depth, origin, leaves)?;
+                Ok((self.fixed.to_f32(v), region))
+            })
+            .collect::<Result<Vec<_>, OccupancyError>>()?;
+        let layer = Layer::from_regions_unchecked(depth, origin, regions);
         Ok(Model::from_parts(
             tree,
             frame,
@@ -133,4 +125,35 @@ impl OccupancyMap {
         map.store.settle();
         Ok(map)
     }
+}
+
+/// The space of a map's model, for whole blocks of cells `lo..=hi` (`lo` a multiple
+/// of 8, `hi` one less; so the space is at least a block): the smallest cube whose corner
+/// is a multiple of its side on each axis (a node of the octree of every power-of-two
+/// grid through the origin, OctoMap's among them), or OctoMap's whole key cube
+/// (cells −32768..32767, depth 16) for a map across 0 inside it. Writing `.bt` or
+/// `.ot` then moves each leaf's code by a constant ([`crate::io::reframe`]'s fast
+/// path), where a space from `lo` would cut leaves and sort them again. A map
+/// beyond OctoMap's keys takes the smallest cube from `lo`.
+fn space(lo: [i64; 3], hi: [i64; 3]) -> Result<(u8, [i64; 3]), OccupancyError> {
+    use crate::io::octomap::{KEY_ORIGIN, OCTOMAP_DEPTH};
+    debug_assert!((0..3).all(|a| lo[a].rem_euclid(8) == 0 && hi[a].rem_euclid(8) == 7));
+    let extent = (0..3).map(|a| hi[a].abs_diff(lo[a]) + 1).max().unwrap_or(8);
+    let least = u8::try_from(extent.next_power_of_two().trailing_zeros()).unwrap_or(u8::MAX);
+    if least > MAX_DEPTH {
+        return Err(OccupancyError::Model(format!(
+            "the map spans {extent} cells, more than a model holds (2^{MAX_DEPTH})"
+        )));
+    }
+    for d in least..OCTOMAP_DEPTH {
+        if (0..3).all(|a| lo[a] >> d == hi[a] >> d) {
+            return Ok((d, lo.map(|c| c >> d << d)));
+        }
+    }
+    let keys = KEY_ORIGIN..=-KEY_ORIGIN - 1;
+    if (0..3).all(|a| keys.contains(&lo[a]) && keys.contains(&hi[a])) {
+        return Ok((OCTOMAP_DEPTH, [KEY_ORIGIN; 3]));
+    }
+    let last = (1i64 << least) - 1;
+    Ok((least, lo.map(|c| c.min(i64::MAX - last))))
 }

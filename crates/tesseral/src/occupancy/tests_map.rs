@@ -177,6 +177,78 @@ fn models_round_trip() {
     let _ = UNKNOWN;
 }
 
+/// `to_model` against the map cell by cell (state and log-odds), in each kind of
+/// space it picks: an aligned cube inside OctoMap's keys, OctoMap's root for a map
+/// across 0, and a cube from the lowest block beyond OctoMap's keys; with blocks
+/// clamped whole (stored uniform, emitted as one leaf) and blocks of single cells.
+#[test]
+fn models_hold_every_cell_in_every_space() {
+    let mut rng = Pcg64::seed_from_u64(31);
+    for (centre, aligned) in [
+        ([0.4, 0.4, 0.4], true),
+        ([13.2, 7.6, 2.0], true),
+        ([-25.2, 4.4, -8.4], true),
+        ([3300.4, 3.6, -1.2], false),
+    ] {
+        let mut map = OccupancyMap::new(0.1, SensorModel::octomap()).unwrap();
+        for _ in 0..12 {
+            // Dense rays to a shell clamp the blocks round the sensor free, whole;
+            // a few to random points add cells of other values.
+            let pts: Vec<[f64; 3]> = (0..6000)
+                .map(|i| {
+                    let d = [0, 1, 2].map(|_| rng.random_range(-1.0..1.0f64));
+                    let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt().max(1e-3);
+                    let r = if i < 5940 {
+                        1.6
+                    } else {
+                        rng.random_range(1.0..2.5)
+                    };
+                    [0, 1, 2].map(|a| centre[a] + d[a] / len * r)
+                })
+                .collect();
+            map.insert_scan(centre, &pts, None);
+        }
+        let m = map.to_model().unwrap();
+        m.assert_valid();
+        let (depth, origin) = (m.tree.depth(), m.tree.origin());
+        let root = depth == 16 && origin == [-32768; 3];
+        let cube = origin.iter().all(|&o| o.rem_euclid(1 << depth) == 0);
+        assert_eq!(
+            root || cube,
+            aligned,
+            "{centre:?}: depth {depth} from {origin:?}"
+        );
+        let cells = map.cells();
+        let free = m.free.as_ref().unwrap();
+        let layer = m.log_odds.as_ref().unwrap();
+        let t = map.fixed.to_f32(map.fixed.threshold);
+        for &(c, v) in &cells {
+            assert_eq!(m.tree.contains(c), v >= t, "{c:?} {v}");
+            assert_eq!(free.contains(c), v < t, "{c:?} {v}");
+            assert_eq!(layer.get(c), Some(v), "{c:?}");
+        }
+        let n = cells.len() as u64;
+        assert_eq!(m.tree.voxel_count() + free.voxel_count(), n);
+        assert_eq!(layer.voxel_count(), n);
+        let blocks: HashSet<[i64; 3]> = cells.iter().map(|(c, _)| c.map(|x| x >> 3)).collect();
+        let uniform = blocks
+            .iter()
+            .filter(|&&b| {
+                matches!(
+                    map.store.entry(b).map(|e| e.kind()),
+                    Some(store::Kind::Uniform(_))
+                )
+            })
+            .count();
+        assert!(
+            uniform > 0 && uniform < blocks.len(),
+            "{centre:?}: {uniform} of {} blocks uniform",
+            blocks.len()
+        );
+        assert_eq!(OccupancyMap::from_model(&m).unwrap().cells(), cells);
+    }
+}
+
 /// The scan half of the 10^8-operation soak (issue 19 §4): scans from wandering
 /// origins until 10^8 cell updates are made, `assert_valid` after each, and every
 /// 25th scan checked against the naive model on a sample of its rays.

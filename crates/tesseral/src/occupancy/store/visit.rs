@@ -5,7 +5,10 @@ use super::forms::{
     bits_words, decode, list_at, palette_index, DENSE, EMPTY, PALETTE, SPARSE, SPARSE_VALUES,
     UNIFORM,
 };
-use super::{join, BlockKey, Store, BLOCK_CELLS, TABLE};
+use super::{join, BlockKey, Entry, Store, BLOCK_CELLS, BLOCK_LOG2, TABLE};
+use crate::code;
+use crate::linear::sort::sort_by_u64;
+use crate::linear::Leaf;
 use crate::occupancy::sensor::UNKNOWN;
 use crate::occupancy::CellCounts;
 
@@ -137,6 +140,71 @@ impl Store {
 
     pub fn block_count(&self) -> usize {
         self.blocks
+    }
+
+    /// The lowest and highest corners of the stored blocks' bounding box, in
+    /// blocks (`None` when no block is stored).
+    pub fn block_bounds(&self) -> Option<(BlockKey, BlockKey)> {
+        let mut bounds: Option<(BlockKey, BlockKey)> = None;
+        for (t, &key) in self.keys.iter().enumerate() {
+            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
+                if e != Entry::EMPTY {
+                    let b = join(key, l);
+                    let (lo, hi) = bounds.get_or_insert((b, b));
+                    for a in 0..3 {
+                        lo[a] = lo[a].min(b[a]);
+                        hi[a] = hi[a].max(b[a]);
+                    }
+                }
+            }
+        }
+        bounds
+    }
+
+    /// Calls `f` on every known cell as a leaf of the space of side `2^depth` from
+    /// `origin` (a multiple of 8 on each axis, `depth` at least 3, holding every
+    /// block), in tesseral order: a uniform block as one leaf of 8³ cells, another
+    /// block's known cells one by one. Every leaf is then in place for
+    /// [`LinearOctree::from_sorted_leaves`](crate::linear::LinearOctree::from_sorted_leaves),
+    /// with no sort of the cells.
+    ///
+    /// # Runtime
+    /// O(b log b + k) for b blocks (sorted by code) and k cells of blocks not uniform.
+    pub fn for_each_in_order(&self, origin: [i64; 3], depth: u8, mut f: impl FnMut(Leaf, i16)) {
+        debug_assert!(depth >= 3 && origin.iter().all(|c| c.rem_euclid(8) == 0));
+        let lo = origin.map(|c| c >> BLOCK_LOG2);
+        let mut blocks: Vec<(u64, Entry)> = Vec::with_capacity(self.blocks);
+        for (t, &key) in self.keys.iter().enumerate() {
+            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
+                if e != Entry::EMPTY {
+                    let b = join(key, l);
+                    let r = [0, 1, 2].map(|a| (b[a] - lo[a]) as u32);
+                    debug_assert!(r.iter().all(|&r| u64::from(r) < 1 << (depth - 3)));
+                    blocks.push((code::encode(r[0], r[1], r[2]), e));
+                }
+            }
+        }
+        sort_by_u64(&mut blocks, |&(c, _)| c);
+        // The cells of a block in tesseral order: its codes 0..512, each a local index.
+        let order: [u16; BLOCK_CELLS] = std::array::from_fn(|m| {
+            let [x, y, z] = code::decode(m as u64);
+            (x | y << 3 | z << 6) as u16
+        });
+        let mut cells = [UNKNOWN; BLOCK_CELLS];
+        for (c, e) in blocks {
+            let at = c << 9;
+            if e.tag() == UNIFORM {
+                f(Leaf::new(at, 3), (e.0 >> 16) as u16 as i16);
+                continue;
+            }
+            decode(e.tag(), self.words_of(e), &mut cells);
+            for (m, &i) in order.iter().enumerate() {
+                let v = cells[usize::from(i)];
+                if v != UNKNOWN {
+                    f(Leaf::new(at | m as u64, 0), v);
+                }
+            }
+        }
     }
 
     /// Calls `f` on every known cell, in no order.
