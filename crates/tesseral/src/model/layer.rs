@@ -147,7 +147,8 @@ impl<T: LayerValue> Layer<T> {
             .iter()
             .flat_map(|(x, t)| t.leaves().iter().map(move |l| (*l, *x)))
             .collect();
-        out.sort_unstable_by_key(|(l, _)| l.code());
+        // Each region's leaves are one sorted run: a stable sort merges the runs.
+        out.sort_by_key(|(l, _)| l.code());
         out
     }
 
