@@ -175,15 +175,17 @@ pub fn run(args: Args) -> Result<()> {
     // Every file is read and checked before any scan is cast, so that a bad file or
     // scan late in the list is refused at once, not after the work on those before
     // it. Files are kept for the insertion while they hold at most HELD_POINTS
-    // points together; the others are read (and checked) again then.
+    // points together, and the last one read whatever its size (so one file is
+    // read once); the others are read (and checked) again then.
     let mut held = Vec::with_capacity(args.scans.len());
     let mut kept = 0;
-    for path in &args.scans {
+    for (k, path) in args.scans.iter().enumerate() {
         bar.set_message(format!("reading {}", path.display()));
         let scans = read_checked(&map, path, placement, &args, octomap)?;
         bar.inc_length(scans.len() as u64);
         let points: usize = scans.iter().map(|s| s.points.len()).sum();
-        held.push((kept + points <= HELD_POINTS).then(|| {
+        let last = k + 1 == args.scans.len();
+        held.push((last || kept + points <= HELD_POINTS).then(|| {
             kept += points;
             scans
         }));
@@ -265,8 +267,8 @@ pub fn run(args: Args) -> Result<()> {
     Ok(())
 }
 
-/// The most points that the files read before the insertion keep for it (100 MB);
-/// the rest are read again (see [`run`]).
+/// The most points that the files read before the insertion keep for it (100 MB),
+/// besides the last file; the rest are read again (see [`run`]).
 const HELD_POINTS: usize = 1 << 22;
 
 /// A scan file's scans, placed, each checked against `--max-cells` and, when the
