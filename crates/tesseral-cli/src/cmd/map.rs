@@ -112,6 +112,11 @@ struct Totals {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
+    run_holding(args, HELD_POINTS)
+}
+
+/// [`run`], keeping at most `budget` points of the files read before the insertion.
+fn run_holding(args: Args, budget: usize) -> Result<()> {
     let inputs: Vec<&Path> = args.scans.iter().map(PathBuf::as_path).collect();
     octree::guard(&args.output, &inputs, &args.out)?;
     if super::output::is_stdio(&args.output) && args.json {
@@ -185,7 +190,7 @@ pub fn run(args: Args) -> Result<()> {
         bar.inc_length(scans.len() as u64);
         let points: usize = scans.iter().map(|s| s.points.len()).sum();
         let last = k + 1 == args.scans.len();
-        held.push((last || kept + points <= HELD_POINTS).then(|| {
+        held.push((last || kept + points <= budget).then(|| {
             kept += points;
             scans
         }));
@@ -367,4 +372,70 @@ fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
         );
     }
     Ok(work.longest)
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: super::Args,
+    }
+
+    /// Files read again for the insertion (none kept but the last) give the map
+    /// that files kept give, byte for byte; a bad file is refused either way.
+    #[test]
+    fn files_read_again_give_the_same_map() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut files = Vec::new();
+        for k in 0..3 {
+            let path = dir.path().join(format!("c{k}.xyz"));
+            let text: String = (0..400)
+                .map(|i| {
+                    let a = f64::from(i) * 0.37 + f64::from(k);
+                    format!(
+                        "{:.3} {:.3} {:.3}\n",
+                        2.0 * a.cos(),
+                        2.0 * a.sin(),
+                        0.01 * f64::from(i % 50)
+                    )
+                })
+                .collect();
+            std::fs::write(&path, text).unwrap();
+            files.push(path.display().to_string());
+        }
+        let map = |budget: usize, out: &str, files: &[String]| {
+            let out = dir.path().join(out);
+            let mut argv = vec!["map".to_string()];
+            argv.extend(files.iter().cloned());
+            argv.extend(
+                [
+                    "-o",
+                    out.to_str().unwrap(),
+                    "--resolution",
+                    "0.1",
+                    "--origin",
+                    "0,0,1",
+                ]
+                .map(String::from),
+            );
+            super::run_holding(Cli::parse_from(argv).args, budget)
+                .map(|()| std::fs::read(out).unwrap())
+        };
+        let kept = map(usize::MAX, "kept.ot", &files).unwrap();
+        let again = map(0, "again.ot", &files).unwrap();
+        assert!(kept.len() > 1000);
+        assert_eq!(kept, again);
+        let bad = dir.path().join("bad.xyz");
+        std::fs::write(&bad, "1 2 3\n4 5 x\n").unwrap();
+        let mut with_bad = files.clone();
+        with_bad.insert(1, bad.display().to_string());
+        for budget in [0, usize::MAX] {
+            let e = map(budget, "bad.ot", &with_bad).unwrap_err().to_string();
+            assert!(e.contains("bad.xyz:2:5"), "{e}");
+            assert!(!dir.path().join("bad.ot").exists());
+        }
+    }
 }
