@@ -10,7 +10,14 @@ use crate::Voxel;
 impl OccupancyMap {
     /// The map as a model: frame of voxel size `resolution` with voxel `(0, 0, 0)` at
     /// the world origin; tree = occupied cells; `free` = free cells; `log_odds` =
-    /// every known cell's log-odds.
+    /// every known cell's log-odds. The space is an aligned cube holding the map's
+    /// blocks (OctoMap's key cube, depth 16 from −32768, for a map across 0 inside
+    /// OctoMap's range; see `space`).
+    ///
+    /// # Runtime
+    /// O(b log b + k) for b blocks and k cells of blocks not uniform: the cells come
+    /// in tesseral order (the store's `for_each_in_order`), so no
+    /// cell is sorted.
     ///
     /// # Errors
     /// [`OccupancyError::Octree`] when the map spans more than a linear octree can
@@ -28,8 +35,6 @@ impl OccupancyMap {
             )?);
         };
         let (depth, origin) = space(lo.map(|b| b << 3), hi.map(|b| b << 3 | 7))?;
-        // The cells come in tesseral order: each part is built as it goes, and
-        // sibling leaves merge as they arrive.
         // The cells come in tesseral order: every part is built from sorted leaves,
         // each value's cells grouped through a table indexed by the value.
         let t = self.fixed.threshold;
@@ -128,13 +133,14 @@ impl OccupancyMap {
 }
 
 /// The space of a map's model, for whole blocks of cells `lo..=hi` (`lo` a multiple
-/// of 8, `hi` one less; so the space is at least a block): the smallest cube whose corner
-/// is a multiple of its side on each axis (a node of the octree of every power-of-two
-/// grid through the origin, OctoMap's among them), or OctoMap's whole key cube
-/// (cells −32768..32767, depth 16) for a map across 0 inside it. Writing `.bt` or
-/// `.ot` then moves each leaf's code by a constant ([`crate::io::reframe`]'s fast
-/// path), where a space from `lo` would cut leaves and sort them again. A map
-/// beyond OctoMap's keys takes the smallest cube from `lo`.
+/// of 8 on each axis, `hi` 7 more than one; so the space is at least a block): the
+/// smallest cube whose corner is a multiple of its side on each axis (a node of the
+/// octree of every power-of-two grid through the origin, OctoMap's among them), or
+/// OctoMap's whole key cube (cells −32768..32767, depth 16) for a map across 0
+/// inside it. Writing `.bt` or `.ot` then moves each leaf's code by a constant
+/// ([`crate::io::reframe`]'s fast path), where a space from `lo` would cut leaves
+/// and sort them again. A map beyond OctoMap's keys takes the smallest cube from
+/// `lo`.
 fn space(lo: [i64; 3], hi: [i64; 3]) -> Result<(u8, [i64; 3]), OccupancyError> {
     use crate::io::octomap::{KEY_ORIGIN, OCTOMAP_DEPTH};
     debug_assert!((0..3).all(|a| lo[a].rem_euclid(8) == 0 && hi[a].rem_euclid(8) == 7));
