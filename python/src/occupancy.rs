@@ -265,14 +265,8 @@ pub fn read_scans(
     pose: Option<[f64; 6]>,
 ) -> PyResult<Vec<PlacedScan<'_>>> {
     use tesseral::io::scan::{self, Placement, ScanFormat};
-    let placement = match (origin, pose) {
-        (Some(_), Some(_)) => {
-            return Err(PyValueError::new_err("give origin or pose, not both"));
-        }
-        (Some(o), None) => Placement::Origin(o),
-        (None, Some(p)) => Placement::Pose(p),
-        (None, None) => Placement::AsRead,
-    };
+    let placement = Placement::of(origin, pose)
+        .ok_or_else(|| PyValueError::new_err("give origin or pose, not both"))?;
     // The extension decides, as in `scan::read`, which names the file when unknown.
     let format = ScanFormat::from_extension(&tesseral::io::extension(&path));
     if placement.overrides() && format.is_some_and(ScanFormat::has_poses) {
@@ -288,8 +282,8 @@ pub fn read_scans(
         .into_iter()
         .map(|mut s| {
             s.place(placement);
-            let points = py.allow_threads(|| s.world_points().into_owned());
             let [x, y, z] = s.translation;
+            let points = py.allow_threads(|| s.into_world_points());
             Ok(((x, y, z), crate::arrays::to_array(py, points)?))
         })
         .collect()

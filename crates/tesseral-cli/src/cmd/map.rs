@@ -122,7 +122,8 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     if super::output::is_stdio(&args.output) && args.json {
         bail!("--json: standard output already holds the map (-o -)");
     }
-    let mut formats = Vec::with_capacity(args.scans.len());
+    // clap refuses --origin with --pose.
+    let placement = Placement::of(args.origin, args.pose).context("--origin with --pose")?;
     for path in &args.scans {
         let Some(f) = ScanFormat::from_extension(&tesseral::io::extension(path)) else {
             bail!(
@@ -131,7 +132,7 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
                 scan::SCAN_EXTENSIONS
             );
         };
-        if f.has_poses() && (args.origin.is_some() || args.pose.is_some()) {
+        if f.has_poses() && placement.overrides() {
             let flag = if args.origin.is_some() {
                 "--origin"
             } else {
@@ -142,7 +143,6 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
                 path.display()
             );
         }
-        formats.push(f);
     }
     if !(args.resolution.is_finite() && args.resolution > 0.0) {
         bail!(
@@ -172,11 +172,6 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     };
     let octomap = octomap_output(&args);
     let mut t = Totals::default();
-    let placement = match (args.origin, args.pose) {
-        (Some(o), _) => Placement::Origin(o),
-        (None, Some(p)) => Placement::Pose(p),
-        (None, None) => Placement::AsRead,
-    };
     // Every file is read and checked before any scan is cast, so that a bad file or
     // scan late in the list is refused at once, not after the work on those before
     // it. Files are kept for the insertion while they hold at most HELD_POINTS

@@ -118,6 +118,16 @@ impl ScanRecord {
             }
         }
     }
+
+    /// [`world_points`](Self::world_points), taking the scan: world points are
+    /// handed over, not copied.
+    #[must_use]
+    pub fn into_world_points(self) -> Vec<[f64; 3]> {
+        match self.frame {
+            PointFrame::World => self.points,
+            PointFrame::Sensor => self.world_points().into_owned(),
+        }
+    }
 }
 
 /// Where a file's scans are placed, over what the file says: what `tesseral map
@@ -138,6 +148,19 @@ pub enum Placement {
 }
 
 impl Placement {
+    /// The placement of an optional sensor origin and an optional pose (x, y, z,
+    /// roll, pitch, yaw), as the CLI's `--origin`/`--pose` and Python's `origin=`/
+    /// `pose=` give them; `None` when both are given.
+    #[must_use]
+    pub fn of(origin: Option<[f64; 3]>, pose: Option<[f64; 6]>) -> Option<Self> {
+        match (origin, pose) {
+            (Some(_), Some(_)) => None,
+            (Some(o), None) => Some(Self::Origin(o)),
+            (None, Some(p)) => Some(Self::Pose(p)),
+            (None, None) => Some(Self::AsRead),
+        }
+    }
+
     /// Whether this overrides what a file says (not [`AsRead`](Self::AsRead)).
     #[must_use]
     pub fn overrides(self) -> bool {

@@ -26,7 +26,7 @@
 //!   50 ns, so scans that keep growing the box spend a few percent of their time
 //!   on rebuilds at most.
 
-use super::{join, BlockKey, Entry, Store, TABLE};
+use super::{stored, BlockKey, Entry, Store};
 
 /// Bytes the index may always take, whatever the store's size (16 KiB).
 const FLAT_MIN: usize = 16 << 10;
@@ -223,12 +223,8 @@ impl Store {
         self.work = 0;
         let (keys, tables) = (&self.keys, &self.tables);
         self.flat.rebuild(plan, |flat| {
-            for (t, &key) in keys.iter().enumerate() {
-                for (l, &e) in tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
-                    if e != Entry::EMPTY {
-                        flat.set(join(key, l), e);
-                    }
-                }
+            for (b, e) in stored(keys, tables) {
+                flat.set(b, e);
             }
         });
     }

@@ -84,6 +84,19 @@ fn block_of(keys: &[BlockKey], s: usize) -> BlockKey {
     join(keys[s / TABLE], s % TABLE)
 }
 
+/// Every stored block and its entry (entries not empty), in the tables' order, for
+/// the superblocks' `keys` and their `tables`.
+fn stored<'a>(
+    keys: &'a [BlockKey],
+    tables: &'a [Entry],
+) -> impl Iterator<Item = (BlockKey, Entry)> + 'a {
+    tables
+        .iter()
+        .enumerate()
+        .filter(|(_, &e)| e != Entry::EMPTY)
+        .map(|(s, &e)| (block_of(keys, s), e))
+}
+
 /// The cell at index `i` of block `b` (or the block at index `i` of superblock `b`).
 #[inline]
 pub(crate) fn join(b: BlockKey, i: usize) -> [i64; 3] {

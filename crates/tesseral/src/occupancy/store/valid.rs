@@ -5,7 +5,7 @@ use super::forms::{
     bits_words, list_at, lists_occupied, palette_index, sparse_units, units_of, DENSE, EMPTY,
     PALETTE, SPARSE, SPARSE_VALUES, UNIFORM,
 };
-use super::{block_of, Store, BLOCK_CELLS, OCCUPIED, TABLE};
+use super::{block_of, stored, Store, BLOCK_CELLS, OCCUPIED, TABLE};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
 impl Store {
@@ -23,13 +23,7 @@ impl Store {
     /// When an invariant is broken.
     pub fn assert_valid(&self, fixed: Fixed) {
         self.dir.assert_valid(&self.keys);
-        self.flat.assert_valid(
-            self.tables
-                .iter()
-                .enumerate()
-                .filter(|(_, &e)| e != super::Entry::EMPTY)
-                .map(|(s, &e)| (block_of(&self.keys, s), e)),
-        );
+        self.flat.assert_valid(stored(&self.keys, &self.tables));
         assert_eq!(self.tables.len(), self.keys.len() * TABLE, "tables' length");
         let (len, cap) = (self.tables.len(), self.tables.capacity());
         assert!(

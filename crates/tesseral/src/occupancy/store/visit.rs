@@ -5,7 +5,7 @@ use super::forms::{
     bits_words, decode, list_at, palette_index, DENSE, EMPTY, PALETTE, SPARSE, SPARSE_VALUES,
     UNIFORM,
 };
-use super::{join, BlockKey, Entry, Store, BLOCK_CELLS, BLOCK_LOG2, TABLE};
+use super::{join, stored, BlockKey, Entry, Store, BLOCK_CELLS, BLOCK_LOG2};
 use crate::code;
 use crate::linear::sort::sort_by_u64;
 use crate::linear::Leaf;
@@ -68,18 +68,14 @@ impl Store {
     /// with `None` and the value of a uniform block.
     fn visit(&self, mut f: impl FnMut(BlockKey, Option<usize>, i16)) {
         let mut cells = [UNKNOWN; BLOCK_CELLS];
-        for (t, &key) in self.keys.iter().enumerate() {
-            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
-                let b = join(key, l);
-                match e.tag() {
-                    EMPTY => {}
-                    UNIFORM => f(b, None, (e.0 >> 16) as u16 as i16),
-                    tag => {
-                        decode(tag, self.words_of(e), &mut cells);
-                        for (i, &v) in cells.iter().enumerate() {
-                            if v != UNKNOWN {
-                                f(b, Some(i), v);
-                            }
+        for (b, e) in stored(&self.keys, &self.tables) {
+            match e.tag() {
+                UNIFORM => f(b, None, (e.0 >> 16) as u16 as i16),
+                tag => {
+                    decode(tag, self.words_of(e), &mut cells);
+                    for (i, &v) in cells.iter().enumerate() {
+                        if v != UNKNOWN {
+                            f(b, Some(i), v);
                         }
                     }
                 }
@@ -146,16 +142,11 @@ impl Store {
     /// blocks (`None` when no block is stored).
     pub fn block_bounds(&self) -> Option<(BlockKey, BlockKey)> {
         let mut bounds: Option<(BlockKey, BlockKey)> = None;
-        for (t, &key) in self.keys.iter().enumerate() {
-            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
-                if e != Entry::EMPTY {
-                    let b = join(key, l);
-                    let (lo, hi) = bounds.get_or_insert((b, b));
-                    for a in 0..3 {
-                        lo[a] = lo[a].min(b[a]);
-                        hi[a] = hi[a].max(b[a]);
-                    }
-                }
+        for (b, _) in stored(&self.keys, &self.tables) {
+            let (lo, hi) = bounds.get_or_insert((b, b));
+            for a in 0..3 {
+                lo[a] = lo[a].min(b[a]);
+                hi[a] = hi[a].max(b[a]);
             }
         }
         bounds
@@ -173,17 +164,13 @@ impl Store {
     pub fn for_each_in_order(&self, origin: [i64; 3], depth: u8, mut f: impl FnMut(Leaf, i16)) {
         debug_assert!(depth >= 3 && origin.iter().all(|c| c.rem_euclid(8) == 0));
         let lo = origin.map(|c| c >> BLOCK_LOG2);
-        let mut blocks: Vec<(u64, Entry)> = Vec::with_capacity(self.blocks);
-        for (t, &key) in self.keys.iter().enumerate() {
-            for (l, &e) in self.tables[t * TABLE..(t + 1) * TABLE].iter().enumerate() {
-                if e != Entry::EMPTY {
-                    let b = join(key, l);
-                    let r = [0, 1, 2].map(|a| (b[a] - lo[a]) as u32);
-                    debug_assert!(r.iter().all(|&r| u64::from(r) < 1 << (depth - 3)));
-                    blocks.push((code::encode(r[0], r[1], r[2]), e));
-                }
-            }
-        }
+        let mut blocks: Vec<(u64, Entry)> = stored(&self.keys, &self.tables)
+            .map(|(b, e)| {
+                let r = [0, 1, 2].map(|a| (b[a] - lo[a]) as u32);
+                debug_assert!(r.iter().all(|&r| u64::from(r) < 1 << (depth - 3)));
+                (code::encode(r[0], r[1], r[2]), e)
+            })
+            .collect();
         sort_by_u64(&mut blocks, |&(c, _)| c);
         // The cells of a block in tesseral order: its codes 0..512, each a local index.
         let order: [u16; BLOCK_CELLS] = std::array::from_fn(|m| {
