@@ -1,5 +1,7 @@
 //! `tesseral.OccupancyMap`: an occupancy map fed whole scans (N×3 float arrays).
 
+use std::path::PathBuf;
+
 use numpy::{IntoPyArray, PyArray1, PyReadonlyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
@@ -209,6 +211,15 @@ impl OccupancyMap {
         py.allow_threads(|| m.to_model())
             .map(Octree::new)
             .map_err(crate::errors::octree)
+    }
+
+    /// Writes the map, atomically, in the format named by the extension: `.bt`
+    /// and `.ot` straight from its cells (the bytes of `to_octree().write(path)`,
+    /// without building the octree), any other format through `to_octree()`.
+    fn write(&self, py: Python<'_>, path: PathBuf) -> PyResult<()> {
+        let m = &self.map;
+        py.allow_threads(|| m.write_file(&path))
+            .map_err(crate::errors::format)
     }
 
     /// A map from an `Octree` (as `tesseral.Octree.read("map.ot")` gives one): the

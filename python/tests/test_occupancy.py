@@ -201,3 +201,21 @@ def test_read_scans_places_clouds_and_logs_as_the_cli_does(tmp_path):
         t.read_scans(tmp_path / "bad.xyz")
     with pytest.raises(t.FormatError, match="nope.txt"):
         t.read_scans(tmp_path / "nope.txt")
+
+
+def test_write_gives_the_bytes_of_the_octree_and_refuses_past_the_keys(tmp_path):
+    m = t.OccupancyMap(0.1)
+    m.insert_scans(_room_scans())
+    for ext in ("bt", "ot"):
+        m.write(tmp_path / f"direct.{ext}")
+        m.to_octree().write(tmp_path / f"model.{ext}")
+        direct = (tmp_path / f"direct.{ext}").read_bytes()
+        assert direct == (tmp_path / f"model.{ext}").read_bytes()
+    m.write(tmp_path / "map.tess")
+    assert len(t.Octree.read(tmp_path / "map.tess")) == m.stats()["occupied"]
+    far = t.OccupancyMap(0.1)
+    far.insert_scan((4000.0, 0.0, 0.0), np.array([[4001.0, 0.0, 0.0]]))
+    with pytest.raises(Exception, match="far.bt.*OctoMap"):
+        far.write(tmp_path / "far.bt")
+    assert not (tmp_path / "far.bt").exists()
+    far.write(tmp_path / "far.tess")

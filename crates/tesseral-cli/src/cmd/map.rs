@@ -215,10 +215,7 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     }
     bar.finish_and_clear();
 
-    let model = map
-        .to_model()
-        .with_context(|| format!("{}: the map cannot be made a model", args.output.display()))?;
-    octree::save(&args.output, &model, &args.out, &Default::default())?;
+    write_map(&map, &args.output, &args.out)?;
     let rate = if t.seconds > 0.0 {
         t.rays as f64 / t.seconds
     } else {
@@ -265,6 +262,24 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Writes the map: `.bt` and `.ot` straight from its blocks (no model in between;
+/// the same bytes), any other format through its model.
+fn write_map(map: &OccupancyMap, path: &Path, out: &OutArgs) -> Result<()> {
+    let context = || format!("{}: the map cannot be written", path.display());
+    let ext = out.format_of(path);
+    if ext != "bt" && ext != "ot" {
+        let model = map.to_model().with_context(context)?;
+        return octree::save(path, &model, out, &Default::default());
+    }
+    let bytes = if ext == "bt" {
+        map.encode_bt()
+    } else {
+        map.encode_ot()
+    }
+    .with_context(context)?;
+    octree::save_encoded(path, &ext, &bytes, out)
 }
 
 /// The most points that the files read before the insertion keep for it (100 MB),

@@ -112,6 +112,20 @@ pub fn save(
     }
 }
 
+/// Writes bytes already encoded in format `ext` to `path` (or standard output for
+/// `-`), atomically, after checking their size against `--max-output`.
+pub fn save_encoded(path: &Path, ext: &str, bytes: &[u8], out: &OutArgs) -> Result<()> {
+    output::check_size(path, bytes.len() as u64, out.limits.max_output)?;
+    let write = |p: &Path| {
+        tesseral::io::write_atomic(p, |w| w.write_all(bytes)).map_err(|e| anyhow::anyhow!("{e}"))
+    };
+    if output::is_stdio(path) {
+        stdio::to_stdout(ext, write)
+    } else {
+        write(path)
+    }
+}
+
 /// How a command that writes an octree reports: a line of text, or with `--json` an
 /// object with the keys `output`, `voxels`, `leaves`, `depth`, `origin`, `bbox_min`,
 /// `bbox_max` (null when empty), plus the command's own keys in `extra`.

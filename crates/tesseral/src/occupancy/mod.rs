@@ -37,6 +37,7 @@
 mod convert;
 mod dda;
 mod far;
+mod octomap;
 mod ray;
 mod scan;
 mod scan_order;
@@ -95,6 +96,17 @@ pub enum OccupancyError {
     /// The octree operation failed.
     #[error(transparent)]
     Octree(#[from] crate::linear::OctreeError),
+    /// The map reaches past OctoMap's keys, so it has no `.bt` or `.ot`.
+    #[error(
+        "the map's blocks reach cells {lo:?} to {hi:?}, past OctoMap's keys \
+         (cells −32768..32767 on each axis); .tess keeps the full range"
+    )]
+    KeyRange {
+        /// The lowest cell of the map's blocks.
+        lo: [i64; 3],
+        /// The highest.
+        hi: [i64; 3],
+    },
 }
 
 /// What one scan did.

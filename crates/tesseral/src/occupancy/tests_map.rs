@@ -180,7 +180,8 @@ fn models_round_trip() {
 /// `to_model` against the map cell by cell (state and log-odds), in each kind of
 /// space it picks: an aligned cube inside OctoMap's keys, OctoMap's root for a map
 /// across 0, and a cube from the lowest block beyond OctoMap's keys; with blocks
-/// clamped whole (stored uniform, emitted as one leaf) and blocks of single cells.
+/// clamped whole (stored uniform, emitted as one leaf) and blocks of single cells;
+/// and the map's own `.bt` and `.ot` writer against the model's.
 #[test]
 fn models_hold_every_cell_in_every_space() {
     let mut rng = Pcg64::seed_from_u64(31);
@@ -246,6 +247,17 @@ fn models_hold_every_cell_in_every_space() {
             blocks.len()
         );
         assert_eq!(OccupancyMap::from_model(&m).unwrap().cells(), cells);
+        // Written straight from the blocks, the OctoMap files are the model's.
+        use crate::io::octomap;
+        if aligned {
+            assert_eq!(map.encode_bt().unwrap(), octomap::encode_bt(&m).unwrap());
+            assert_eq!(map.encode_ot().unwrap(), octomap::encode_ot(&m).unwrap());
+        } else {
+            assert!(octomap::encode_bt(&m).is_err());
+            for e in [map.encode_bt().unwrap_err(), map.encode_ot().unwrap_err()] {
+                assert!(matches!(e, OccupancyError::KeyRange { hi, .. } if hi[0] > 32767));
+            }
+        }
     }
 }
 

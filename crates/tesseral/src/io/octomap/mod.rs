@@ -28,10 +28,14 @@ use std::path::Path;
 
 #[cfg(test)]
 mod range_tests;
+pub(crate) mod stream;
+#[cfg(test)]
+mod stream_tests;
 #[cfg(test)]
 mod tests;
 mod write;
 
+pub(crate) use write::{bt_file, ot_file};
 pub use write::{encode_bt, encode_ot, write_file, FREE_LOG_ODDS};
 
 use super::{FormatError, MAX_COLORED_VOXELS};

@@ -4,7 +4,7 @@ use super::*;
 use rand::{Rng, SeedableRng};
 use std::collections::HashSet;
 
-fn random_model(seed: u64) -> Model {
+pub(super) fn random_model(seed: u64) -> Model {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
     let origin = [
         rng.random_range(-40..40),

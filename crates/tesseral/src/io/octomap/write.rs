@@ -3,6 +3,7 @@
 
 use std::path::Path;
 
+use super::stream::{encode_pieces, Kind, Piece, UNSET_RGB};
 use super::{BT_HEADER, KEY_ORIGIN, OCCUPIED_LOG_ODDS, OCTOMAP_DEPTH, OT_HEADER};
 use crate::io::{reframe, FormatError};
 use crate::linear::{Leaf, LinearOctree};
@@ -13,26 +14,17 @@ use crate::model::{Layer, LayerValue, Model, Rgba};
 pub const FREE_LOG_ODDS: f32 = -1.992_430_1;
 
 /// A model's parts in OctoMap's key space.
-struct KeyModel {
+pub(super) struct KeyModel {
     occupied: LinearOctree,
     free: Option<LinearOctree>,
-    colors: Option<Layer<Rgba>>,
+    pub(super) colors: Option<Layer<Rgba>>,
     log_odds: Option<Layer<f32>>,
     res: f64,
 }
 
-/// A maximal cell of one state, colour and log-odds.
-#[derive(Debug, Clone, Copy)]
-struct Piece {
-    leaf: Leaf,
-    occupied: bool,
-    value: f32,
-    rgb: [u8; 3],
-}
-
 /// Moves a model into OctoMap's key space. OctoMap keys cannot hold a fraction of a
 /// voxel, so the frame's translate must be a whole number of voxels.
-fn to_key_space(model: &Model) -> Result<KeyModel, String> {
+pub(super) fn to_key_space(model: &Model) -> Result<KeyModel, String> {
     let shift = model
         .frame
         .world_to_voxels(model.frame.translate)
@@ -117,12 +109,17 @@ fn first_false<T>(s: &[T], pred: impl Fn(&T) -> bool) -> usize {
     lo + s[lo..hi.min(s.len())].partition_point(pred)
 }
 
-/// The model's known cells as pieces in tesseral order.
-fn pieces(km: &KeyModel) -> Vec<Piece> {
-    let colors = km.colors.as_ref().map(Layer::leaves).unwrap_or_default();
-    let odds = km.log_odds.as_ref().map(Layer::leaves).unwrap_or_default();
-    // OctoMap's "no colour set" is white; its inner nodes average only set colours.
-    let default_rgb = [255, 255, 255, 255];
+/// The model's known cells as pieces in tesseral order: cut at its colours' and
+/// log-odds' regions when `values` (for `.ot`), by state alone when not (`.bt`).
+pub(super) fn pieces(km: &KeyModel, values: bool) -> Vec<Piece> {
+    fn layer<T: LayerValue>(l: &Option<Layer<T>>, values: bool) -> Vec<(Leaf, T)> {
+        match l {
+            Some(l) if values => l.leaves(),
+            _ => Vec::new(),
+        }
+    }
+    let colors = layer(&km.colors, values);
+    let odds = layer(&km.log_odds, values);
     let mut out = Vec::new();
     let parts = [(&km.occupied, true)]
         .into_iter()
@@ -131,7 +128,7 @@ fn pieces(km: &KeyModel) -> Vec<Piece> {
         let (mut color_at, mut odds_at) = (0, 0);
         for &leaf in tree.leaves() {
             split(leaf, &colors, &mut color_at, &mut |l, c: Option<Rgba>| {
-                let rgb = c.unwrap_or(default_rgb);
+                let rgb = c.map_or(UNSET_RGB, |c| [c[0], c[1], c[2]]);
                 split(l, &odds, &mut odds_at, &mut |l, v| {
                     let fallback = if occupied {
                         OCCUPIED_LOG_ODDS
@@ -142,7 +139,7 @@ fn pieces(km: &KeyModel) -> Vec<Piece> {
                         leaf: l,
                         occupied,
                         value: v.unwrap_or(fallback),
-                        rgb: [rgb[0], rgb[1], rgb[2]],
+                        rgb,
                     });
                 });
             });
@@ -170,41 +167,6 @@ pub fn write_file(path: &Path, model: &Model) -> Result<(), FormatError> {
     crate::io::write_atomic(path, |w| std::io::Write::write_all(w, &bytes))
 }
 
-/// The pieces inside the cell `[code, code + 8^k)`, split among its eight children.
-/// Each child's pieces are found by an exponential search from where the last
-/// child's ended (O(log d) for d pieces, not O(log n) over the whole cell's), and
-/// the last child takes what is left.
-fn children(pieces: &[Piece], code: u64, k: u8) -> [(u64, &[Piece]); 8] {
-    let child_cells = 1u64 << (3 * u32::from(k - 1));
-    debug_assert!(
-        pieces.first().is_none_or(|p| p.leaf.code() >= code)
-            && pieces
-                .last()
-                .is_none_or(|p| p.leaf.code() < code + 8 * child_cells),
-        "pieces outside the cell"
-    );
-    let mut rest = pieces;
-    std::array::from_fn(|i| {
-        let c = code + i as u64 * child_cells;
-        let n = if i == 7 {
-            rest.len()
-        } else {
-            first_false(rest, |p| p.leaf.code() < c + child_cells)
-        };
-        let (mine, tail) = rest.split_at(n);
-        rest = tail;
-        (c, mine)
-    })
-}
-
-/// Whether `pieces` is one piece covering the cell of size `2^k`.
-fn covers(pieces: &[Piece], k: u8) -> Option<Piece> {
-    match pieces {
-        [p] if p.leaf.size_log2() >= k => Some(*p),
-        _ => None,
-    }
-}
-
 /// Encodes `model` as `.bt` bytes: black leaves occupied, free leaves free, the rest
 /// unknown.
 ///
@@ -225,42 +187,18 @@ fn covers(pieces: &[Piece], k: u8) -> Option<Piece> {
 /// ```
 pub fn encode_bt(model: &Model) -> Result<Vec<u8>, String> {
     let km = to_key_space(model)?;
-    let pieces = pieces(&km);
-    let mut data = Vec::with_capacity(2 * pieces.len() + 16);
-    let mut nodes = 0u64;
-    if !pieces.is_empty() {
-        nodes = 1;
-        write_bt_node(&pieces, 0, OCTOMAP_DEPTH, &mut data, &mut nodes);
-    }
-    let mut out = format!(
-        "{BT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid OcTree\nsize {nodes}\nres {}\ndata\n",
-        km.res
-    )
-    .into_bytes();
-    out.extend_from_slice(&data);
-    Ok(out)
+    let (data, nodes) = encode_pieces(Kind::Bt, pieces(&km, false));
+    Ok(bt_file(km.res, nodes, &data))
 }
 
-fn write_bt_node(pieces: &[Piece], code: u64, k: u8, out: &mut Vec<u8>, nodes: &mut u64) {
-    let mut bits = 0u16;
-    let mut inner = Vec::with_capacity(8);
-    // A piece covering the whole root: eight covered children.
-    let whole = covers(pieces, k);
-    for (i, (c, mine)) in children(pieces, code, k).into_iter().enumerate() {
-        let leaf = whole.or_else(|| covers(mine, k - 1));
-        if let Some(p) = leaf {
-            bits |= if p.occupied { 0b10 } else { 0b01 } << (2 * i);
-            *nodes += 1;
-        } else if !mine.is_empty() {
-            bits |= 0b11 << (2 * i);
-            *nodes += 1;
-            inner.push((c, mine));
-        }
-    }
-    out.extend_from_slice(&bits.to_le_bytes());
-    for (c, mine) in inner {
-        write_bt_node(mine, c, k - 1, out, nodes);
-    }
+/// A `.bt` file: the header, then `data` (of `nodes` nodes).
+pub(crate) fn bt_file(res: f64, nodes: u64, data: &[u8]) -> Vec<u8> {
+    let mut out = format!(
+        "{BT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid OcTree\nsize {nodes}\nres {res}\ndata\n"
+    )
+    .into_bytes();
+    out.extend_from_slice(data);
+    out
 }
 
 /// Encodes `model` as `.ot` bytes: an `OcTree`, or a `ColorOcTree` when the model has
@@ -273,74 +211,21 @@ fn write_bt_node(pieces: &[Piece], code: u64, k: u8, out: &mut Vec<u8>, nodes: &
 /// As [`encode_bt`].
 pub fn encode_ot(model: &Model) -> Result<Vec<u8>, String> {
     let km = to_key_space(model)?;
-    let pieces = pieces(&km);
     let colour = km.colors.is_some();
-    let mut data = Vec::new();
-    let mut nodes = 0u64;
-    if !pieces.is_empty() {
-        write_ot_node(&pieces, 0, OCTOMAP_DEPTH, colour, &mut data, &mut nodes);
-    }
-    let id = if colour { "ColorOcTree" } else { "OcTree" };
-    let mut out = format!(
-        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid {id}\nsize {nodes}\nres {}\ndata\n",
-        km.res
-    )
-    .into_bytes();
-    out.extend_from_slice(&data);
-    Ok(out)
+    let (data, nodes) = encode_pieces(Kind::Ot { colour }, pieces(&km, true));
+    Ok(ot_file(colour, km.res, nodes, &data))
 }
 
-/// Writes the cell at `code` of size `2^k` (which holds some known cell) in `.ot`
-/// preorder; returns its log-odds and colour.
-fn write_ot_node(
-    pieces: &[Piece],
-    code: u64,
-    k: u8,
-    colour: bool,
-    out: &mut Vec<u8>,
-    nodes: &mut u64,
-) -> (f32, [u8; 3]) {
-    *nodes += 1;
-    let at = out.len();
-    let extra = if colour { 3 } else { 0 };
-    out.extend(std::iter::repeat_n(0u8, 4 + extra + 1));
-    let (value, rgb) = if let Some(p) = covers(pieces, k) {
-        (p.value, p.rgb)
-    } else {
-        let mut mask = 0u8;
-        let mut max = f32::NEG_INFINITY;
-        let mut sum = [0u32; 3];
-        let mut n = 0u32;
-        const UNSET: [u8; 3] = [255, 255, 255];
-        for (i, (c, mine)) in children(pieces, code, k).into_iter().enumerate() {
-            if mine.is_empty() {
-                continue;
-            }
-            mask |= 1 << i;
-            let (v, rgb) = write_ot_node(mine, c, k - 1, colour, out, nodes);
-            max = max.max(v);
-            if rgb != UNSET {
-                for j in 0..3 {
-                    sum[j] += u32::from(rgb[j]);
-                }
-                n += 1;
-            }
-        }
-        out[at + 4 + extra] = mask;
-        // As OctoMap's `getAverageChildColor`: the mean of the children whose colour
-        // is set, or unset (white) when none is.
-        let rgb = if n == 0 {
-            UNSET
-        } else {
-            sum.map(|s| (s / n) as u8)
-        };
-        (max, rgb)
-    };
-    out[at..at + 4].copy_from_slice(&value.to_le_bytes());
-    if colour {
-        out[at + 4..at + 7].copy_from_slice(&rgb);
-    }
-    (value, rgb)
+/// An `.ot` file (of a `ColorOcTree` when `colour`): the header, then `data` (of
+/// `nodes` nodes).
+pub(crate) fn ot_file(colour: bool, res: f64, nodes: u64, data: &[u8]) -> Vec<u8> {
+    let id = if colour { "ColorOcTree" } else { "OcTree" };
+    let mut out = format!(
+        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid {id}\nsize {nodes}\nres {res}\ndata\n"
+    )
+    .into_bytes();
+    out.extend_from_slice(data);
+    out
 }
 
 #[cfg(test)]

@@ -1,0 +1,95 @@
+//! Maps straight to OctoMap files: the store's blocks in key order, streamed into
+//! the `.bt`/`.ot` writer (`io::octomap::stream`), with no model in between.
+
+use std::path::Path;
+
+use super::{OccupancyError, OccupancyMap};
+use crate::io::octomap::stream::{Encoder, Kind, Merger, Piece, UNSET_RGB};
+use crate::io::octomap::{bt_file, ot_file, KEY_ORIGIN, OCTOMAP_DEPTH};
+use crate::io::FormatError;
+
+impl OccupancyMap {
+    /// The map as a `.bt` file's bytes: every known cell occupied or free, as
+    /// OctoMap's `writeBinary` (maximum likelihood, pruned by state). The same bytes
+    /// as [`crate::io::octomap::encode_bt`] of [`to_model`](Self::to_model), without
+    /// building the model.
+    ///
+    /// # Runtime
+    /// O(b log b + k) for b blocks and k cells of blocks not uniform.
+    ///
+    /// # Errors
+    /// [`OccupancyError::KeyRange`] for a map past OctoMap's keys (cells
+    /// −32768..32767 on each axis).
+    pub fn encode_bt(&self) -> Result<Vec<u8>, OccupancyError> {
+        let (data, nodes) = self.encode(Kind::Bt)?;
+        Ok(bt_file(self.resolution, nodes, &data))
+    }
+
+    /// The map as an `.ot` file's bytes: every known cell's log-odds, inner nodes
+    /// the maximum of their children's, pruned where eight children hold one value
+    /// (as OctoMap's tree after `insertPointCloud`). The same bytes as
+    /// [`crate::io::octomap::encode_ot`] of [`to_model`](Self::to_model).
+    ///
+    /// # Runtime
+    /// As [`encode_bt`](Self::encode_bt).
+    ///
+    /// # Errors
+    /// As [`encode_bt`](Self::encode_bt).
+    pub fn encode_ot(&self) -> Result<Vec<u8>, OccupancyError> {
+        let (data, nodes) = self.encode(Kind::Ot { colour: false })?;
+        Ok(ot_file(false, self.resolution, nodes, &data))
+    }
+
+    /// Writes the map, atomically, in the format named by the extension: `.bt` and
+    /// `.ot` straight from its blocks ([`encode_bt`](Self::encode_bt),
+    /// [`encode_ot`](Self::encode_ot)), any other through
+    /// [`to_model`](Self::to_model).
+    ///
+    /// # Errors
+    /// [`FormatError::Unsupported`] for a map the format cannot hold (past
+    /// OctoMap's keys; past a model's extent), named with the path; the errors of
+    /// [`crate::io::write_model`].
+    pub fn write_file(&self, path: &Path) -> Result<(), FormatError> {
+        let cannot = |e: OccupancyError| FormatError::unsupported(e.to_string()).with_path(path);
+        let bytes = match crate::io::extension(path).as_str() {
+            "bt" => self.encode_bt(),
+            "ot" => self.encode_ot(),
+            _ => return crate::io::write_model(path, &self.to_model().map_err(cannot)?),
+        }
+        .map_err(cannot)?;
+        crate::io::write_atomic(path, |w| w.write_all(&bytes))
+    }
+
+    /// The data section of a `kind` file and its node count.
+    fn encode(&self, kind: Kind) -> Result<(Vec<u8>, u64), OccupancyError> {
+        let mut enc = Encoder::new(kind);
+        let Some((lo, hi)) = self.store.block_bounds() else {
+            return Ok(enc.finish());
+        };
+        let (lo, hi) = (lo.map(|b| b << 3), hi.map(|b| b << 3 | 7));
+        let keys = KEY_ORIGIN..=-KEY_ORIGIN - 1;
+        if !(0..3).all(|a| keys.contains(&lo[a]) && keys.contains(&hi[a])) {
+            return Err(OccupancyError::KeyRange { lo, hi });
+        }
+        let t = self.fixed.threshold;
+        let fixed = self.fixed;
+        let mut emit = |p| enc.push(p);
+        let piece = |leaf, v: i16| Piece {
+            leaf,
+            occupied: v >= t,
+            value: fixed.to_f32(v),
+            rgb: UNSET_RGB,
+        };
+        let same = if kind == Kind::Bt {
+            Piece::same_state
+        } else {
+            Piece::same_node
+        };
+        let mut m = Merger::new(same);
+        let (origin, depth) = ([KEY_ORIGIN; 3], OCTOMAP_DEPTH);
+        self.store
+            .for_each_in_order(origin, depth, |leaf, v| m.push(piece(leaf, v), &mut emit));
+        m.flush(&mut emit);
+        Ok(enc.finish())
+    }
+}
