@@ -4,7 +4,7 @@
 use std::path::Path;
 
 use super::{OccupancyError, OccupancyMap};
-use crate::io::octomap::stream::{Encoder, Kind, Merger, Piece, UNSET_RGB};
+use crate::io::octomap::stream::{Kind, Piece, Writer, UNSET_RGB};
 use crate::io::octomap::{bt_file, ot_file, KEY_ORIGIN, OCTOMAP_DEPTH};
 use crate::io::FormatError;
 
@@ -62,34 +62,26 @@ impl OccupancyMap {
 
     /// The data section of a `kind` file and its node count.
     fn encode(&self, kind: Kind) -> Result<(Vec<u8>, u64), OccupancyError> {
-        let mut enc = Encoder::new(kind);
+        let mut w = Writer::new(kind);
         let Some((lo, hi)) = self.store.block_bounds() else {
-            return Ok(enc.finish());
+            return Ok(w.finish());
         };
         let (lo, hi) = (lo.map(|b| b << 3), hi.map(|b| b << 3 | 7));
         let keys = KEY_ORIGIN..=-KEY_ORIGIN - 1;
         if !(0..3).all(|a| keys.contains(&lo[a]) && keys.contains(&hi[a])) {
             return Err(OccupancyError::KeyRange { lo, hi });
         }
-        let t = self.fixed.threshold;
-        let fixed = self.fixed;
-        let mut emit = |p| enc.push(p);
-        let piece = |leaf, v: i16| Piece {
-            leaf,
-            occupied: v >= t,
-            value: fixed.to_f32(v),
-            rgb: UNSET_RGB,
-        };
-        let same = if kind == Kind::Bt {
-            Piece::same_state
-        } else {
-            Piece::same_node
-        };
-        let mut m = Merger::new(same);
-        let (origin, depth) = ([KEY_ORIGIN; 3], OCTOMAP_DEPTH);
+        let (t, fixed) = (self.fixed.threshold, self.fixed);
+        let origin = [KEY_ORIGIN; 3];
         self.store
-            .for_each_in_order(origin, depth, |leaf, v| m.push(piece(leaf, v), &mut emit));
-        m.flush(&mut emit);
-        Ok(enc.finish())
+            .for_each_in_order(origin, OCTOMAP_DEPTH, |leaf, v| {
+                w.push(Piece {
+                    leaf,
+                    occupied: v >= t,
+                    value: fixed.to_f32(v),
+                    rgb: UNSET_RGB,
+                });
+            });
+        Ok(w.finish())
     }
 }

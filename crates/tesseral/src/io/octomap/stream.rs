@@ -218,11 +218,7 @@ impl Encoder {
 
     /// Opens inner node `leaf`: room for its bytes, filled in when it closes.
     fn open_node(&mut self, leaf: Leaf) {
-        if !self.open.is_empty() {
-            self.nodes += 1;
-        } else {
-            self.nodes = 1;
-        }
+        self.nodes += 1;
         let at = self.out.len();
         let bytes = match self.kind {
             Kind::Bt => 2,
@@ -295,19 +291,45 @@ impl Encoder {
     }
 }
 
-/// Writes pieces in tesseral order (not necessarily maximal) as the data section of
-/// a `kind` stream, joining them as OctoMap prunes (by state for `.bt`; by state,
-/// log-odds and colour for `.ot`). Gives the data and its node count.
+/// A [`Merger`] into an [`Encoder`]: takes pieces in tesseral order, not
+/// necessarily maximal, and joins them as OctoMap prunes (by state for `.bt`; by
+/// state, log-odds and colour for `.ot`) before writing them.
+pub(crate) struct Writer {
+    merger: Merger<fn(&Piece, &Piece) -> bool>,
+    encoder: Encoder,
+}
+
+impl Writer {
+    pub fn new(kind: Kind) -> Self {
+        let same = if kind == Kind::Bt {
+            Piece::same_state
+        } else {
+            Piece::same_node
+        };
+        Writer {
+            merger: Merger::new(same),
+            encoder: Encoder::new(kind),
+        }
+    }
+
+    /// Takes the next piece (after every piece given before).
+    pub fn push(&mut self, p: Piece) {
+        let encoder = &mut self.encoder;
+        self.merger.push(p, &mut |q| encoder.push(q));
+    }
+
+    /// The data section and its node count.
+    pub fn finish(mut self) -> (Vec<u8>, u64) {
+        let encoder = &mut self.encoder;
+        self.merger.flush(&mut |q| encoder.push(q));
+        self.encoder.finish()
+    }
+}
+
+/// The data section of a `kind` stream of `pieces` (see [`Writer`]), and its node
+/// count.
 pub(crate) fn encode_pieces(kind: Kind, pieces: impl IntoIterator<Item = Piece>) -> (Vec<u8>, u64) {
-    let mut enc = Encoder::new(kind);
-    let mut emit = |p| enc.push(p);
-    let same = if kind == Kind::Bt {
-        Piece::same_state
-    } else {
-        Piece::same_node
-    };
-    let mut m = Merger::new(same);
-    pieces.into_iter().for_each(|p| m.push(p, &mut emit));
-    m.flush(&mut emit);
-    enc.finish()
+    let mut w = Writer::new(kind);
+    pieces.into_iter().for_each(|p| w.push(p));
+    w.finish()
 }
