@@ -234,9 +234,10 @@ impl OccupancyMap {
     }
 
     /// The log-odds of many cells, as [`log_odds`](Self::log_odds) gives them one by
-    /// one, into `out`. Faster than a loop of `log_odds` on a map bigger than the
-    /// CPU's caches: the cells are looked up in batches whose memory accesses are
-    /// prefetched together, so that their cache misses overlap.
+    /// one, into `out`. On a map bigger than the CPU's caches (more than 32 MiB) the
+    /// cells are looked up in batches whose memory accesses are prefetched
+    /// together, so that their cache misses overlap; on a smaller one, where that
+    /// costs more than it saves, it is that loop.
     ///
     /// # Runtime
     /// O(n), with the cost of one lookup as [`state`](Self::state).
@@ -256,9 +257,10 @@ impl OccupancyMap {
     pub fn log_odds_many(&self, cells: &[[i64; 3]], out: &mut [Option<f32>]) {
         assert_eq!(cells.len(), out.len(), "as many values as cells");
         let mut values = [UNKNOWN; store::BATCH];
+        let passes = self.store.prefetches();
         for (cells, out) in cells.chunks(store::BATCH).zip(out.chunks_mut(store::BATCH)) {
             let values = &mut values[..cells.len()];
-            self.store.get_many(cells, values);
+            self.store.get_many(cells, values, passes);
             for (o, &v) in out.iter_mut().zip(values.iter()) {
                 *o = (v != UNKNOWN).then(|| self.fixed.to_f32(v));
             }

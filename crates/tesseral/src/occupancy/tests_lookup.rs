@@ -73,8 +73,8 @@ fn probes(rng: &mut Pcg64, model: &HashMap<[i64; 3], i16>, blocks: &[[i64; 3]]) 
     out
 }
 
-/// Every probe through `get` and `get_many` (in slices of odd lengths) agrees with
-/// the model.
+/// Every probe through `get` and `get_many` (in slices of odd lengths, with and
+/// without its prefetching passes) agrees with the model.
 pub(super) fn check_lookups(
     store: &Store,
     model: &HashMap<[i64; 3], i16>,
@@ -89,11 +89,17 @@ pub(super) fn check_lookups(
         assert_eq!(store.get(*c), w, "{what}: get {c:?}");
     }
     let mut got = vec![0i16; probes.len()];
-    for len in [1, 31, 32, 33, 1000] {
-        for (c, g) in probes.chunks(len).zip(got.chunks_mut(len)) {
-            store.get_many(c, g);
+    for passes in [false, true] {
+        for len in [1, 31, 32, 33, 1000] {
+            got.fill(0);
+            for (c, g) in probes.chunks(len).zip(got.chunks_mut(len)) {
+                store.get_many(c, g, passes);
+            }
+            assert_eq!(
+                got, want,
+                "{what}: get_many in slices of {len}, passes {passes}"
+            );
         }
-        assert_eq!(got, want, "{what}: get_many in slices of {len}");
     }
 }
 
