@@ -269,17 +269,13 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
 fn write_map(map: &OccupancyMap, path: &Path, out: &OutArgs) -> Result<()> {
     let context = || format!("{}: the map cannot be written", path.display());
     let ext = out.format_of(path);
-    if ext != "bt" && ext != "ot" {
-        let model = map.to_model().with_context(context)?;
-        return octree::save(path, &model, out, &Default::default());
+    match map.encode_octomap(&ext) {
+        Some(bytes) => octree::save_encoded(path, &ext, &bytes.with_context(context)?, out),
+        None => {
+            let model = map.to_model().with_context(context)?;
+            octree::save(path, &model, out, &Default::default())
+        }
     }
-    let bytes = if ext == "bt" {
-        map.encode_bt()
-    } else {
-        map.encode_ot()
-    }
-    .with_context(context)?;
-    octree::save_encoded(path, &ext, &bytes, out)
 }
 
 /// The most points that the files read before the insertion keep for it (100 MB),
@@ -311,12 +307,7 @@ fn read_checked(
 /// Whether the map is written as OctoMap's `.bt` or `.ot`, whose keys reach cells
 /// −32768..32767 on each axis.
 fn octomap_output(args: &Args) -> bool {
-    let ext = if super::output::is_stdio(&args.output) {
-        args.out.format.clone().unwrap_or_default()
-    } else {
-        tesseral::io::extension(&args.output)
-    };
-    matches!(ext.as_str(), "bt" | "ot")
+    matches!(args.out.format_of(&args.output).as_str(), "bt" | "ot")
 }
 
 /// Refuses, before it is cast, a scan whose rays would reach a cell outside
@@ -326,8 +317,7 @@ fn octomap_output(args: &Args) -> bool {
 /// sensor, the point cut at `--max-range`: the key range is a box, so the ends
 /// suffice), the points placed in the world.
 fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64) -> Result<()> {
-    const KEYS: std::ops::RangeInclusive<i64> = -32768..=32767;
-    let inside = |p: [f64; 3]| map.cell_of(p).iter().all(|k| KEYS.contains(k));
+    let inside = |p: [f64; 3]| tesseral::io::octomap::in_key_range(map.cell_of(p));
     let sensor = s.translation;
     if inside(sensor.map(|c| c - longest)) && inside(sensor.map(|c| c + longest)) {
         return Ok(());

@@ -140,12 +140,18 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use std::collections::HashSet;
 
+    /// A random tree of depth 3 (seeded), its origin, and the generator after it.
+    fn random_tree(seed: u64) -> (rand_pcg::Pcg64, Voxel, LinearOctree) {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
+        let (origin, voxels) = crate::io::random_voxels(&mut rng, 5, 8, 400);
+        let tree = LinearOctree::from_voxels(3, origin, voxels).unwrap();
+        (rng, origin, tree)
+    }
+
     #[test]
     fn reframe_keeps_voxels_for_random_offsets() {
         for seed in 0..60u64 {
-            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let (origin, voxels) = crate::io::random_voxels(&mut rng, 5, 8, 400);
-            let tree = LinearOctree::from_voxels(3, origin, voxels.iter().copied()).unwrap();
+            let (mut rng, origin, tree) = random_tree(seed);
             let new_origin = [
                 origin[0] - rng.random_range(0..8),
                 origin[1] - rng.random_range(0..8),
@@ -168,9 +174,7 @@ mod tests {
     #[test]
     fn aligned_sub_cubes_move_by_one_code() {
         for seed in 0..60u64 {
-            let mut rng = rand_pcg::Pcg64::seed_from_u64(seed);
-            let (origin, voxels) = crate::io::random_voxels(&mut rng, 5, 8, 400);
-            let tree = LinearOctree::from_voxels(3, origin, voxels.iter().copied()).unwrap();
+            let (mut rng, origin, tree) = random_tree(seed);
             // Offsets that are multiples of the tree's side: the fast path.
             let new_origin = origin.map(|c| c - 8 * rng.random_range(0..8i64));
             assert!(sub_cube(&tree, 6, new_origin).is_some());

@@ -142,7 +142,7 @@ impl OccupancyMap {
 /// and sort them again. A map beyond OctoMap's keys takes the smallest cube from
 /// `lo`.
 fn space(lo: [i64; 3], hi: [i64; 3]) -> Result<(u8, [i64; 3]), OccupancyError> {
-    use crate::io::octomap::{KEY_ORIGIN, OCTOMAP_DEPTH};
+    use crate::io::octomap::{in_key_range, KEY_ORIGIN, OCTOMAP_DEPTH};
     debug_assert!((0..3).all(|a| lo[a].rem_euclid(8) == 0 && hi[a].rem_euclid(8) == 7));
     let extent = (0..3).map(|a| hi[a].abs_diff(lo[a]) + 1).max().unwrap_or(8);
     let least = u8::try_from(extent.next_power_of_two().trailing_zeros()).unwrap_or(u8::MAX);
@@ -156,8 +156,7 @@ fn space(lo: [i64; 3], hi: [i64; 3]) -> Result<(u8, [i64; 3]), OccupancyError> {
             return Ok((d, lo.map(|c| c >> d << d)));
         }
     }
-    let keys = KEY_ORIGIN..=-KEY_ORIGIN - 1;
-    if (0..3).all(|a| keys.contains(&lo[a]) && keys.contains(&hi[a])) {
+    if in_key_range(lo) && in_key_range(hi) {
         return Ok((OCTOMAP_DEPTH, [KEY_ORIGIN; 3]));
     }
     let last = (1i64 << least) - 1;

@@ -5,7 +5,7 @@ use std::path::Path;
 
 use super::{OccupancyError, OccupancyMap};
 use crate::io::octomap::stream::{Kind, Piece, Writer, UNSET_RGB};
-use crate::io::octomap::{bt_file, ot_file, KEY_ORIGIN, OCTOMAP_DEPTH};
+use crate::io::octomap::{bt_file, in_key_range, ot_file, KEY_ORIGIN, OCTOMAP_DEPTH};
 use crate::io::FormatError;
 
 impl OccupancyMap {
@@ -40,10 +40,23 @@ impl OccupancyMap {
         Ok(ot_file(false, self.resolution, nodes, &data))
     }
 
+    /// The map's file bytes in format `ext` when it is OctoMap's (`bt` or `ot`:
+    /// [`encode_bt`](Self::encode_bt), [`encode_ot`](Self::encode_ot)); `None`
+    /// for any other format, which is written through [`to_model`](Self::to_model).
+    ///
+    /// # Errors
+    /// As [`encode_bt`](Self::encode_bt).
+    pub fn encode_octomap(&self, ext: &str) -> Option<Result<Vec<u8>, OccupancyError>> {
+        match ext {
+            "bt" => Some(self.encode_bt()),
+            "ot" => Some(self.encode_ot()),
+            _ => None,
+        }
+    }
+
     /// Writes the map, atomically, in the format named by the extension: `.bt` and
-    /// `.ot` straight from its blocks ([`encode_bt`](Self::encode_bt),
-    /// [`encode_ot`](Self::encode_ot)), any other through
-    /// [`to_model`](Self::to_model).
+    /// `.ot` straight from its blocks ([`encode_octomap`](Self::encode_octomap)),
+    /// any other through [`to_model`](Self::to_model).
     ///
     /// # Errors
     /// [`FormatError::Unsupported`] for a map the format cannot hold (past
@@ -51,13 +64,13 @@ impl OccupancyMap {
     /// [`crate::io::write_model`].
     pub fn write_file(&self, path: &Path) -> Result<(), FormatError> {
         let cannot = |e: OccupancyError| FormatError::unsupported(e.to_string()).with_path(path);
-        let bytes = match crate::io::extension(path).as_str() {
-            "bt" => self.encode_bt(),
-            "ot" => self.encode_ot(),
-            _ => return crate::io::write_model(path, &self.to_model().map_err(cannot)?),
+        match self.encode_octomap(&crate::io::extension(path)) {
+            Some(bytes) => {
+                let bytes = bytes.map_err(cannot)?;
+                crate::io::write_atomic(path, |w| w.write_all(&bytes))
+            }
+            None => crate::io::write_model(path, &self.to_model().map_err(cannot)?),
         }
-        .map_err(cannot)?;
-        crate::io::write_atomic(path, |w| w.write_all(&bytes))
     }
 
     /// The data section of a `kind` file and its node count.
@@ -67,8 +80,7 @@ impl OccupancyMap {
             return Ok(w.finish());
         };
         let (lo, hi) = (lo.map(|b| b << 3), hi.map(|b| b << 3 | 7));
-        let keys = KEY_ORIGIN..=-KEY_ORIGIN - 1;
-        if !(0..3).all(|a| keys.contains(&lo[a]) && keys.contains(&hi[a])) {
+        if !(in_key_range(lo) && in_key_range(hi)) {
             return Err(OccupancyError::KeyRange { lo, hi });
         }
         let (t, fixed) = (self.fixed.threshold, self.fixed);

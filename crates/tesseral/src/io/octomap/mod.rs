@@ -46,6 +46,13 @@ use crate::model::{Frame, Layer, Model, Rgba};
 pub const OCTOMAP_DEPTH: u8 = 16;
 /// The world voxel of key 0: keys are centred at 32768.
 pub const KEY_ORIGIN: i64 = -32768;
+/// Whether voxel `cell` has an OctoMap key: −32768..32767 on each axis.
+#[must_use]
+pub fn in_key_range(cell: crate::Voxel) -> bool {
+    cell.iter()
+        .all(|c| (KEY_ORIGIN..=-KEY_ORIGIN - 1).contains(c))
+}
+
 /// The log-odds written for occupied leaves: OctoMap's default upper clamping
 /// threshold, probability 0.971.
 pub const OCCUPIED_LOG_ODDS: f32 = 3.511_015_4;
