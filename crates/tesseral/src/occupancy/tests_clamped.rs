@@ -97,8 +97,8 @@ fn rays_cross_clamped_free_blocks_and_keep_the_naive_map() {
     assert_eq!(cells(&replay), cells(&map_before_last(&scans)));
     let clamped = replay.clamped_near(*origin, None);
     assert!(clamped.is_some(), "blocks clamped free round the origin");
-    let with = cast_scan(0.5, *origin, points, None, clamped);
-    let without = cast_scan(0.5, *origin, points, None, None);
+    let with = cast_scan(0.5, *origin, points, None, clamped, true);
+    let without = cast_scan(0.5, *origin, points, None, None, false);
     assert!(
         with.blocks() < without.blocks(),
         "{} blocks marked with the clamped blocks known, {} without",
