@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 
 use super::*;
 use crate::io::chunked::{parse_layout, TessWriter};
-use crate::io::sections::Extras;
+use crate::io::sections::Sections;
 use crate::io::{native, LeafSpool, TessFile};
 use crate::linear::LinearOctree;
 use crate::model::{Layer, Model};
@@ -58,7 +58,7 @@ fn written(model: &Model, block: Option<u64>) -> Vec<u8> {
     for &l in t.leaves() {
         w.push(l).unwrap();
     }
-    w.finish_extras(&Extras::of(model)).unwrap()
+    w.finish_sections(&Sections::of(model)).unwrap()
 }
 
 /// As [`written`], by the spooled writer.

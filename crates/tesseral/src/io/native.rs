@@ -72,7 +72,7 @@ use std::path::Path;
 use super::chunked::{chunk_leaves, parse_layout, TessWriter, VERSION_CHUNKED};
 use super::colour_index::FLAG_COLOUR_INDEX;
 use super::leafstream::{put_leaves, read_leaves, Reader};
-use super::sections::{check_parts, put_sections, read_sections, Extras, KNOWN_FLAGS};
+use super::sections::{check_parts, put_sections, read_sections, Extras, Sections, KNOWN_FLAGS};
 use super::FormatError;
 use crate::linear::{LinearOctree, MAX_DEPTH};
 use crate::model::Model;
@@ -151,7 +151,7 @@ pub fn write(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     for &leaf in tree.leaves() {
         tw.push(leaf)?;
     }
-    tw.finish_extras(&Extras::of(model))?;
+    tw.finish_sections(&Sections::of(model))?;
     Ok(())
 }
 
@@ -165,7 +165,7 @@ pub fn write_v1(w: &mut dyn Write, model: &Model) -> io::Result<()> {
     let mut payload = Vec::with_capacity(tree.leaf_count() + 16);
     put_leaves(&mut payload, tree.leaves());
     let mut tail = Vec::new();
-    let flags = put_sections(&mut tail, &Extras::of(model));
+    let flags = put_sections(&mut tail, &Sections::of(model));
     let mut header = Vec::with_capacity(HEADER_LEN);
     header.extend_from_slice(&MAGIC);
     header.extend_from_slice(&VERSION_1.to_le_bytes());

@@ -89,7 +89,7 @@ pub(crate) fn encode_chunked(model: &Model, chunk: usize) -> Vec<u8> {
     for &l in t.leaves() {
         w.push(l).unwrap();
     }
-    w.finish_extras(&Extras::of(model)).unwrap()
+    w.finish_sections(&Sections::of(model)).unwrap()
 }
 
 #[test]

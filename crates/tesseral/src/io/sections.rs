@@ -24,14 +24,55 @@ pub(crate) struct Extras {
     pub(crate) log_odds: Option<Layer<f32>>,
 }
 
-impl Extras {
-    pub(crate) fn of(model: &Model) -> Self {
+/// The sections to write after a tree, borrowed from a model: writing a model
+/// copies none of its layers.
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Sections<'a> {
+    pub(crate) frame: Frame,
+    pub(crate) colors: Option<&'a Layer<Rgba>>,
+    pub(crate) free: Option<&'a LinearOctree>,
+    pub(crate) log_odds: Option<&'a Layer<f32>>,
+}
+
+impl<'a> Sections<'a> {
+    /// The sections of `model`.
+    pub(crate) fn of(model: &'a Model) -> Self {
         Self {
             frame: model.frame,
-            colors: model.colors.clone(),
-            free: model.free.clone(),
-            log_odds: model.log_odds.clone(),
+            colors: model.colors.as_ref(),
+            free: model.free.as_ref(),
+            log_odds: model.log_odds.as_ref(),
         }
+    }
+
+    /// A frame and no layers.
+    pub(crate) fn frame(frame: Frame) -> Self {
+        Self {
+            frame,
+            ..Self::default()
+        }
+    }
+}
+
+impl Extras {
+    /// A model's parts besides its tree, and the tree.
+    pub(crate) fn split(model: Model) -> (Self, LinearOctree) {
+        let Model {
+            tree,
+            frame,
+            colors,
+            free,
+            log_odds,
+        } = model;
+        (
+            Self {
+                frame,
+                colors,
+                free,
+                log_odds,
+            },
+            tree,
+        )
     }
 
     pub(crate) fn into_model(self, tree: LinearOctree) -> Model {
@@ -47,21 +88,21 @@ impl Extras {
 
 /// Appends the sections of `x` (frame always, then the optional layers) and returns
 /// their flags.
-pub(crate) fn put_sections(tail: &mut Vec<u8>, x: &Extras) -> u16 {
+pub(crate) fn put_sections(tail: &mut Vec<u8>, x: &Sections<'_>) -> u16 {
     let mut flags = FLAG_FRAME;
     tail.extend_from_slice(&x.frame.voxel_size.to_le_bytes());
     for t in x.frame.translate {
         tail.extend_from_slice(&t.to_le_bytes());
     }
-    if let Some(colors) = &x.colors {
+    if let Some(colors) = x.colors {
         flags |= FLAG_COLOR_LAYER;
         put_layer(tail, colors, |c| c.to_vec());
     }
-    if let Some(free) = &x.free {
+    if let Some(free) = x.free {
         flags |= FLAG_FREE;
         put_stream(tail, free);
     }
-    if let Some(odds) = &x.log_odds {
+    if let Some(odds) = x.log_odds {
         flags |= FLAG_LOG_ODDS;
         put_layer(tail, odds, |v| v.to_le_bytes().to_vec());
     }

@@ -10,7 +10,7 @@ use std::path::Path;
 use super::chunked::{TessWriter, MERGE_TAIL};
 use super::colour_index::{IndexBuilder, FLAG_COLOUR_INDEX, INDEX_BLOCK};
 use super::leafstream::put_varint;
-use super::sections::{put_sections, Extras, FLAG_COLOR_LAYER};
+use super::sections::{put_sections, Sections, FLAG_COLOR_LAYER};
 use crate::linear::{push_merging, Leaf};
 use crate::model::{Frame, LayerValue, Rgba};
 
@@ -141,13 +141,7 @@ impl<W: Write> TessWriter<W> {
         }
         self.finish_with(|emit| {
             let mut head = vec![0, 0];
-            let mut flags = put_sections(
-                &mut head,
-                &Extras {
-                    frame,
-                    ..Extras::default()
-                },
-            );
+            let mut flags = put_sections(&mut head, &Sections::frame(frame));
             if keep_layer || !regions.is_empty() {
                 flags |= FLAG_COLOR_LAYER;
                 head.extend_from_slice(&(regions.len() as u64).to_le_bytes());

@@ -186,12 +186,12 @@ impl TessFile {
         let version = u16::from_le_bytes([bytes[8], bytes[9]]);
         if version != super::native::VERSION {
             let model = super::native::decode(&bytes).map_err(err)?;
-            let extras = Extras::of(&model);
+            let (extras, tree) = Extras::split(model);
             let layers =
                 extras.colors.is_some() || extras.free.is_some() || extras.log_odds.is_some();
             return Ok(Self {
                 path: path.to_owned(),
-                body: Body::Decoded(model.tree),
+                body: Body::Decoded(tree),
                 extras,
                 layers,
                 colours_checked: std::sync::OnceLock::new(),

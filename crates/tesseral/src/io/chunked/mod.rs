@@ -6,7 +6,7 @@
 use std::io::{self, Write};
 
 use super::leafstream::put_leaves;
-use super::sections::{put_sections, Extras};
+use super::sections::{put_sections, Sections};
 use crate::linear::{push_merging, Leaf, LinearOctree, MAX_DEPTH};
 use crate::model::Frame;
 use crate::Voxel;
@@ -198,13 +198,11 @@ impl<W: Write> TessWriter<W> {
     /// # Errors
     /// Any error of the underlying writer.
     pub fn finish(self, frame: Frame) -> io::Result<W> {
-        self.finish_extras(&Extras {
-            frame,
-            ..Extras::default()
-        })
+        self.finish_sections(&Sections::frame(frame))
     }
 
-    pub(crate) fn finish_extras(self, extras: &Extras) -> io::Result<W> {
+    /// [`finish`](Self::finish) with the sections given (a model's layers).
+    pub(crate) fn finish_sections(self, extras: &Sections<'_>) -> io::Result<W> {
         let block = self.colour_block;
         self.finish_with(|emit| {
             let mut meta = vec![0, 0];

@@ -4,7 +4,7 @@
 use rand::{Rng, SeedableRng};
 
 use super::{render_streamed, StreamedTree};
-use crate::io::sections::Extras;
+use crate::io::sections::Sections;
 use crate::io::TessWriter;
 use crate::linear::LinearOctree;
 use crate::model::{Layer, Model, Rgba};
@@ -78,7 +78,7 @@ pub(super) fn write_v2(path: &std::path::Path, model: &Model, chunk: usize) {
     for &l in t.leaves() {
         w.push(l).unwrap();
     }
-    std::fs::write(path, w.finish_extras(&Extras::of(model)).unwrap()).unwrap();
+    std::fs::write(path, w.finish_sections(&Sections::of(model)).unwrap()).unwrap();
 }
 
 pub(super) fn random_options(rng: &mut rand_pcg::Pcg64, pose: usize) -> RenderOptions {
