@@ -98,7 +98,7 @@ fn rays_cross_clamped_free_blocks_and_keep_the_naive_map() {
     let clamped = replay.clamped_near(*origin, None);
     assert!(clamped.is_some(), "blocks clamped free round the origin");
     let with = cast_scan(0.5, *origin, points, None, clamped, true);
-    let without = cast_scan(0.5, *origin, points, None, None, false);
+    let without = cast_scan(0.5, *origin, points, None, None, true);
     assert!(
         with.blocks() < without.blocks(),
         "{} blocks marked with the clamped blocks known, {} without",

@@ -202,11 +202,11 @@ impl<W: Write> TessWriter<W> {
     }
 
     /// [`finish`](Self::finish) with the sections given (a model's layers).
-    pub(crate) fn finish_sections(self, extras: &Sections<'_>) -> io::Result<W> {
+    pub(crate) fn finish_sections(self, sections: &Sections<'_>) -> io::Result<W> {
         let block = self.colour_block;
         self.finish_with(|emit| {
             let mut meta = vec![0, 0];
-            let mut flags = put_sections(&mut meta, extras);
+            let mut flags = put_sections(&mut meta, sections);
             let ix = block.and_then(|b| super::colour_index::index_of_sections(&meta, flags, b));
             if let Some(ix) = ix {
                 meta.extend_from_slice(&ix);
