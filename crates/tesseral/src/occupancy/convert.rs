@@ -24,7 +24,7 @@ impl OccupancyMap {
     /// (2^21 cells per axis).
     pub fn to_model(&self) -> Result<Model, OccupancyError> {
         let frame = Frame::new(self.resolution, [0.0; 3]);
-        let Some((lo, hi)) = self.store.block_bounds() else {
+        let Some((lo, hi)) = self.store.cell_bounds() else {
             let empty = LinearOctree::empty(0, [0; 3])?;
             return Ok(Model::from_parts(
                 empty.clone(),
@@ -34,7 +34,7 @@ impl OccupancyMap {
                 Some(Layer::empty(0, [0; 3])),
             )?);
         };
-        let (depth, origin) = space(lo.map(|b| b << 3), hi.map(|b| b << 3 | 7))?;
+        let (depth, origin) = space(lo, hi)?;
         // The cells come in tesseral order: every part is built from sorted leaves,
         // each value's cells grouped through a table indexed by the value.
         let t = self.fixed.threshold;

@@ -76,10 +76,9 @@ impl OccupancyMap {
     /// The data section of a `kind` file and its node count.
     fn encode(&self, kind: Kind) -> Result<(Vec<u8>, u64), OccupancyError> {
         let mut w = Writer::new(kind);
-        let Some((lo, hi)) = self.store.block_bounds() else {
+        let Some((lo, hi)) = self.store.cell_bounds() else {
             return Ok(w.finish());
         };
-        let (lo, hi) = (lo.map(|b| b << 3), hi.map(|b| b << 3 | 7));
         if !(in_key_range(lo) && in_key_range(hi)) {
             return Err(OccupancyError::KeyRange { lo, hi });
         }

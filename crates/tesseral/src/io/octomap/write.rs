@@ -193,8 +193,14 @@ pub fn encode_bt(model: &Model) -> Result<Vec<u8>, String> {
 
 /// A `.bt` file: the header, then `data` (of `nodes` nodes).
 pub(crate) fn bt_file(res: f64, nodes: u64, data: &[u8]) -> Vec<u8> {
+    file(BT_HEADER, "OcTree", res, nodes, data)
+}
+
+/// An OctoMap file whose first line is `first`, of tree type `id`: the header,
+/// then `data` (of `nodes` nodes).
+fn file(first: &str, id: &str, res: f64, nodes: u64, data: &[u8]) -> Vec<u8> {
     let mut out = format!(
-        "{BT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid OcTree\nsize {nodes}\nres {res}\ndata\n"
+        "{first}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid {id}\nsize {nodes}\nres {res}\ndata\n"
     )
     .into_bytes();
     out.extend_from_slice(data);
@@ -220,12 +226,7 @@ pub fn encode_ot(model: &Model) -> Result<Vec<u8>, String> {
 /// `nodes` nodes).
 pub(crate) fn ot_file(colour: bool, res: f64, nodes: u64, data: &[u8]) -> Vec<u8> {
     let id = if colour { "ColorOcTree" } else { "OcTree" };
-    let mut out = format!(
-        "{OT_HEADER}\n# (feel free to add / change comments, but leave the first line as it is!)\n#\nid {id}\nsize {nodes}\nres {res}\ndata\n"
-    )
-    .into_bytes();
-    out.extend_from_slice(data);
-    out
+    file(OT_HEADER, id, res, nodes, data)
 }
 
 #[cfg(test)]

@@ -138,9 +138,9 @@ impl Store {
         self.blocks
     }
 
-    /// The lowest and highest corners of the stored blocks' bounding box, in
-    /// blocks (`None` when no block is stored).
-    pub fn block_bounds(&self) -> Option<(BlockKey, BlockKey)> {
+    /// The lowest and highest cells of the stored blocks' bounding box (whole
+    /// blocks: multiples of 8, and 7 past them; `None` when no block is stored).
+    pub fn cell_bounds(&self) -> Option<([i64; 3], [i64; 3])> {
         let mut bounds: Option<(BlockKey, BlockKey)> = None;
         for (b, _) in stored(&self.keys, &self.tables) {
             let (lo, hi) = bounds.get_or_insert((b, b));
@@ -149,7 +149,7 @@ impl Store {
                 hi[a] = hi[a].max(b[a]);
             }
         }
-        bounds
+        bounds.map(|(lo, hi)| (lo.map(|b| b << BLOCK_LOG2), hi.map(|b| b << BLOCK_LOG2 | 7)))
     }
 
     /// Calls `f` on every known cell as a leaf of the space of side `2^depth` from
