@@ -109,8 +109,9 @@ pub(super) fn cast_scan(
     // scan cast `alone`, 4 beside the apply of the scan before it (each scratch
     // adds merging to the apply, which is serial). On one scan of 88,206 rays
     // (OctoMap's `scan.dat`) on two cores, 16 rather than 4 took the insertion from
-    // 32-33 ms to 29-30; beside an apply (ten street scans), 16 took 1.10 s
-    // against 1.05-1.09.
+    // a median of 35 ms to 32.5 (six runs each); beside an apply (ten street
+    // scans), 16 took 1.10 s against 1.05-1.09 (docs/mapping-history.md,
+    // "Nineteenth pass").
     let threads = rayon::current_num_threads();
     let pieces = match (threads, alone) {
         (1, _) => 1,
