@@ -57,15 +57,16 @@ fn check(store: &Store, model: &HashMap<[i64; 3], i16>, fixed: Fixed, what: &str
 }
 
 /// The forms of the blocks stored: uniform, sparse, palettes of 1, 2, 4, 8 bits,
-/// dense.
-fn forms_of(store: &Store) -> [bool; 7] {
-    let mut forms = [false; 7];
+/// dense, patched palette.
+fn forms_of(store: &Store) -> [bool; 8] {
+    let mut forms = [false; 8];
     for b in BLOCKS {
         let f = match store.entry(b).map(|e| e.kind()) {
             Some(Kind::Uniform(_)) => 0,
             Some(Kind::Sparse) => 1,
             Some(Kind::Palette(w)) => 2 + w.trailing_zeros() as usize,
             Some(Kind::Dense) => 6,
+            Some(Kind::Patched) => 7,
             None => continue,
         };
         forms[f] = true;
@@ -78,10 +79,10 @@ fn blocks_change_form_and_keep_their_cells() {
     let fixed = Fixed::new(&SensorModel::octomap());
     let few = [fixed.min, fixed.max, fixed.miss, fixed.hit, 0];
     let mut compactions = 0;
-    // Forms seen: uniform, sparse, palettes of 1, 2, 4, 8 bits, dense; and those
-    // seen by the whole-store checks (the census among them).
-    let mut forms = [0usize; 7];
-    let mut checked = [false; 7];
+    // Forms seen: uniform, sparse, palettes of 1, 2, 4, 8 bits, dense, patched;
+    // and those seen by the whole-store checks (the census among them).
+    let mut forms = [0usize; 8];
+    let mut checked = [false; 8];
     for seed in 0..8u64 {
         let mut rng = Pcg64::seed_from_u64(seed);
         let mut store = Store::default();
@@ -241,6 +242,24 @@ fn blocks_take_the_smallest_form() {
     }
     store.put(b, &cells, fixed);
     assert_eq!(kind(&store), Some(Kind::Dense));
+    store.assert_valid(fixed);
+    // A surface seen from many viewpoints: unknown, clamped free and clamped
+    // occupied, and 40 cells of ten other values: a patched palette (13 units
+    // against a 4-bit palette's 19).
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = match i % 13 {
+            0 if i < 520 => fixed.min / 2 + (i / 13 % 10) as i16 * 100,
+            1..=4 => UNKNOWN,
+            5..=9 => fixed.min,
+            _ => fixed.max,
+        };
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Patched));
+    assert_eq!(store.cells(b), cells);
+    for (i, &v) in cells.iter().enumerate() {
+        assert_eq!(store.get(cell_of(b, i)), v, "cell {i}");
+    }
     store.assert_valid(fixed);
     // Clamped free everywhere: one entry; then a miss on a clamped-free block
     // changes nothing, and a hit makes it a 1-bit palette.

@@ -6,19 +6,23 @@
 //! - *palette* of width `w` ∈ {1, 2, 4, 8}: 512 cells of `w` bits (cell `i` at bit
 //!   `i·w`, never across a word), then `[k, v0 … v(k−1)]` (room for 2^w values when
 //!   `w ≤ 4`, for `k` when `w = 8`); `UNKNOWN` may be one of the values;
+//! - *patched*: a palette of width 2 whose fourth number sends a cell to a patch
+//!   list (see [`super::patched`]);
 //! - *dense*: 512 `i16`.
 
 use super::arena::UNIT;
 use super::census::Census;
+use super::patched::{self, Patch};
 use super::BLOCK_CELLS;
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
-/// Entry tags (the low three bits of an entry).
-pub(crate) const EMPTY: u32 = 0;
-pub(crate) const UNIFORM: u32 = 1;
-pub(crate) const SPARSE: u32 = 2;
-/// Palette of width `1 << (tag − PALETTE)`: tags 3 to 6.
-pub(crate) const PALETTE: u32 = 3;
+/// Entry tags (the low three bits of an entry). `INLINE`: no block in an arena,
+/// the entry empty or uniform (see [`super::Entry`]).
+pub(crate) const INLINE: u32 = 0;
+pub(crate) const SPARSE: u32 = 1;
+/// Palette of width `1 << (tag − PALETTE)`: tags 2 to 5.
+pub(crate) const PALETTE: u32 = 2;
+pub(crate) const PATCHED: u32 = 6;
 pub(crate) const DENSE: u32 = 7;
 
 /// The most distinct values a sparse block holds.
@@ -103,6 +107,7 @@ pub(crate) fn sparse_get(words: &[u16], i: usize) -> i16 {
 pub(crate) fn units_of(tag: u32, words: &[u16]) -> usize {
     match tag {
         SPARSE => sparse_units(words[0] as usize),
+        PATCHED => patched::units_of(words),
         DENSE => DENSE_UNITS,
         _ => {
             let w = 1 << (tag - PALETTE);
@@ -125,6 +130,10 @@ pub(crate) fn any_occupied(values: impl IntoIterator<Item = i16>, fixed: Fixed) 
 pub(crate) fn lists_occupied(tag: u32, words: &[u16], fixed: Fixed) -> bool {
     let listed = match tag {
         SPARSE => &words[2..2 + usize::from(words[1])],
+        PATCHED => {
+            let (common, patch) = patched::values(words);
+            return any_occupied(common.iter().chain(patch).map(|&v| v as i16), fixed);
+        }
         DENSE => &words[..BLOCK_CELLS],
         _ => {
             let at = bits_words(1 << (tag - PALETTE));
@@ -144,6 +153,7 @@ pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
                 out[(c >> 3) as usize] = words[2 + (c & 7) as usize] as i16;
             }
         }
+        PATCHED => patched::decode(words, out),
         DENSE => {
             for (o, &v) in out.iter_mut().zip(words) {
                 *o = v as i16;
@@ -164,7 +174,8 @@ pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
 pub(crate) const SURFACE_SLACK: usize = 6;
 
 /// The form a block takes: its tag and its units (0 for none and uniform). The
-/// smallest, except that a *surface* (a block that lists an occupied value) whose
+/// smallest (a palette over a patched palette on a tie: its lookups read one
+/// word less), except that a *surface* (a block that lists an occupied value) whose
 /// values fit a palette of width 1 or 2 takes that palette unless the sparse form
 /// is more than [`SURFACE_SLACK`] units (96 bytes) smaller. Lookups land mostly on
 /// surfaces, and a palette is read without the sparse form's compares and without
@@ -176,8 +187,14 @@ pub(crate) fn choose(
     values: usize,
     known_values: usize,
     surface: bool,
+    patch: Option<&Patch>,
 ) -> (u32, usize) {
     let mut best = (DENSE, DENSE_UNITS);
+    if let Some(u) = patch.map(Patch::units) {
+        if u < DENSE_UNITS {
+            best = (PATCHED, u);
+        }
+    }
     let mut slack = 0;
     if let Some(w) = width_for(values) {
         let u = palette_units(w, values);
@@ -241,7 +258,7 @@ pub(crate) fn write_palette(words: &mut [u16], w: u32, census: &Census) {
 /// Packs 512 value numbers of `W` bits into `words`, one word at a time (each
 /// word built in a register: no store waits on the one before it to the same word).
 #[inline]
-fn pack<const W: usize>(words: &mut [u16], index: &[u16; BLOCK_CELLS]) {
+pub(crate) fn pack<const W: usize>(words: &mut [u16], index: &[u16; BLOCK_CELLS]) {
     for (o, cells) in words.iter_mut().zip(index.chunks_exact(16 / W)) {
         *o = cells
             .iter()

@@ -55,7 +55,7 @@ impl Store {
         present.sort_unstable_by_key(|p| p.0);
         let k = present.len() - usize::from(n < BLOCK_CELLS);
         let occupied = any_occupied(present.iter().map(|p| p.1), fixed);
-        let (tag, units) = choose(n, present.len(), k, occupied);
+        let (tag, units) = choose(n, present.len(), k, occupied, None);
         if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
             let mut list = std::mem::take(&mut self.scratch);
             list.clear();

@@ -3,7 +3,8 @@
 //! index ([`super::flat`]) while it is live, else the directory and the tables.
 
 use super::arena::UNIT;
-use super::forms::{list_at, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM};
+use super::forms::{list_at, DENSE, INLINE, PALETTE, PATCHED, SPARSE};
+use super::patched::{self, ESCAPE};
 use super::probe::{sparse_value, LANES};
 use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
 use crate::occupancy::prefetch;
@@ -19,7 +20,8 @@ fn words_at(words: &[u16], k: usize) -> u16 {
     // wholly inside its arena (`assert_valid` checks each block's units against the
     // arena's length), and `value` reads only the words of the block's form: a
     // palette's cells and the list entries their numbers give (each number below
-    // the list's length, also checked there), a dense block's cells.
+    // the list's length, also checked there), a patched palette's words up to its
+    // patch's numbers (its ranks and counts also checked), a dense block's cells.
     unsafe { *words.get_unchecked(k) }
 }
 
@@ -31,16 +33,20 @@ fn prefetch_word(words: &[u16], k: usize) {
     prefetch(unsafe { words.get_unchecked(k) });
 }
 
-/// Palettes of width 1, 2, 4 and 8 (by `tag − PALETTE`): where the value list
-/// starts (after the cells and the count), above the mask of a cell's bits.
-const PALETTES: [u32; 4] = {
-    let mut p = [0; 4];
+/// Palettes of width 1, 2, 4 and 8, then the patched palette (by `tag −
+/// PALETTE`): where the value list starts (after the cells and the count), above
+/// the log2 of a cell's bits, above their mask. A patched palette's cells are read
+/// as a palette of width 2's.
+const PALETTES: [u32; 5] = {
+    let mut p = [0; 5];
     let mut k = 0;
-    while k < 4 {
-        let w = 1 << k;
-        p[k] = (list_at(w) as u32) << 8 | ((1 << w) - 1);
+    while k < 5 {
+        let log2 = if k < 4 { k } else { 1 };
+        let w = 1 << log2;
+        p[k] = (list_at(w) as u32) << 16 | (log2 as u32) << 8 | ((1 << w) - 1);
         k += 1;
     }
+    assert!(PATCHED == PALETTE + 4 && p[4] >> 16 == patched::COMMON as u32);
     p
 };
 
@@ -151,18 +157,24 @@ impl Store {
     fn value(&self, e: Entry, i: usize) -> i16 {
         let tag = e.tag();
         let (words, at) = self.block_at(e);
-        // Palettes of width w = 1, 2, 4 or 8 (tags 3 to 6) first: most lookups land
-        // on surfaces, stored as palettes. No branch on the width.
-        if tag.wrapping_sub(PALETTE) < 4 {
+        // Palettes of width w = 1, 2, 4 or 8 and patched palettes (tags 2 to 6)
+        // first: most lookups land on surfaces, stored as those. No branch on the
+        // width.
+        if tag.wrapping_sub(PALETTE) < 5 {
             let p = PALETTES[tag as usize - PALETTE as usize];
-            let list = at + (p >> 8) as usize;
+            let list = at + (p >> 16) as usize;
             // The list lies a line or more past the cell's word: fetch both at once
             // rather than one after the other.
             prefetch_word(words, list);
-            let bit = i << (tag - PALETTE);
+            let bit = i << (p >> 8 & 0xff);
             let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
             let j = usize::from(x) & (p as usize & 0xff);
-            return words_at(words, list + j) as i16;
+            let v = words_at(words, list + j) as i16;
+            // Only a patched palette lists the escape, for its escaped cells.
+            if v == ESCAPE {
+                return patched::escaped_value(|k| words_at(words, k), at, i);
+            }
+            return v;
         }
         self.value_other(e, i)
     }
@@ -173,8 +185,7 @@ impl Store {
     fn value_other(&self, e: Entry, i: usize) -> i16 {
         let (words, at) = self.block_at(e);
         match e.tag() {
-            EMPTY => UNKNOWN,
-            UNIFORM => (e.0 >> 16) as u16 as i16,
+            INLINE => e.uniform_value().unwrap_or(UNKNOWN),
             // Compares, not a binary search (see `probe`).
             SPARSE => sparse_value(words, at, i),
             // DENSE: the cells are the values.
@@ -229,7 +240,7 @@ impl Store {
     #[inline]
     fn prefetch_cell(&self, e: Entry, i: usize) {
         let tag = e.tag();
-        if tag <= UNIFORM {
+        if tag == INLINE {
             return;
         }
         let (words, at) = self.block_at(e);
@@ -239,6 +250,7 @@ impl Store {
             // with its neighbours by the hardware prefetcher).
             SPARSE => (at, at + UNIT + LANES - 1),
             DENSE => (at + i, at + i),
+            PATCHED => (at + ((i * 2) >> 4), at + patched::COMMON),
             t => {
                 let w = 1 << (t - PALETTE);
                 (at + ((i * w) >> 4), at + list_at(w as u32))

@@ -1,7 +1,8 @@
 //! Blocks of 8×8×8 cells, found through a two-level directory (superblocks of
 //! 8×8×8 blocks, each a flat table of 512 block entries) and held in the smallest
-//! of four forms: uniform (in the entry), sparse, palette (1, 2, 4 or 8 bits a cell
-//! and a value list) or dense (see [`forms`]). The directory is dense over the
+//! of five forms: uniform (in the entry), sparse, palette (1, 2, 4 or 8 bits a cell
+//! and a value list), patched palette (2 bits a cell and a patch list, see
+//! [`patched`]) or dense (see [`forms`]). The directory is dense over the
 //! superblocks' bounding box while that box is small enough, a hash map otherwise
 //! (see [`dir`]); reads are in [`lookup`].
 //!
@@ -19,6 +20,7 @@ mod flat;
 mod forms;
 mod fresh;
 mod lookup;
+mod patched;
 mod place;
 mod probe;
 mod sparse;
@@ -34,9 +36,10 @@ use dir::Directory;
 use flat::Flat;
 use forms::{
     any_occupied, apply_masks, choose, decode, lists_occupied, palette_single, palette_update,
-    units_of, write_dense, write_palette, write_sparse, DENSE, EMPTY, PALETTE, SPARSE, UNIFORM,
+    units_of, write_dense, write_palette, write_sparse, DENSE, INLINE, PALETTE, PATCHED, SPARSE,
 };
 pub(crate) use lookup::BATCH;
+use patched::Patch;
 
 /// Cells per block side (log2).
 pub(crate) const BLOCK_LOG2: u32 = 3;
@@ -108,10 +111,10 @@ pub(crate) fn join(b: BlockKey, i: usize) -> [i64; 3] {
 }
 
 /// A block's entry in its superblock's table: a tag in the low three bits
-/// ([`forms::EMPTY`], uniform, sparse, palette of width 1, 2, 4, 8, dense), then the
-/// value of a uniform block (high 16 bits), or for a block in an arena, the arena
-/// (bit 3: [`OCCUPIED`] or [`OPEN`]) and the block's offset there in 16-byte units
-/// (bits 4 to 31).
+/// ([`forms::INLINE`], sparse, palette of width 1, 2, 4, 8, patched, dense). Then,
+/// for a block in an arena, the arena (bit 3: [`OCCUPIED`] or [`OPEN`]) and the
+/// block's offset there in 16-byte units (bits 4 to 31). An inline entry is empty
+/// (0), or uniform: bit 3 set and the value in the high 16 bits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub(crate) struct Entry(u32);
 
@@ -125,15 +128,26 @@ pub(crate) enum Kind {
     Sparse,
     /// Cells of this many bits, numbers in a value list.
     Palette(u32),
+    /// Cells of 2 bits, the fourth number's values in a patch.
+    Patched,
     /// 512 values.
     Dense,
 }
 
 impl Entry {
-    const EMPTY: Self = Self(EMPTY);
+    const EMPTY: Self = Self(0);
+
+    /// Bit 3 of an inline entry: uniform.
+    const UNIFORM: u32 = 1 << 3;
 
     fn uniform(v: i16) -> Self {
-        Self(UNIFORM | u32::from(v as u16) << 16)
+        Self(INLINE | Self::UNIFORM | u32::from(v as u16) << 16)
+    }
+
+    /// The value of a uniform block's cells (`None` for any other entry).
+    #[inline]
+    fn uniform_value(self) -> Option<i16> {
+        (self.0 & 0xF == INLINE | Self::UNIFORM).then_some((self.0 >> 16) as u16 as i16)
     }
 
     fn at(tag: u32, arena: usize, at: u32) -> Self {
@@ -159,14 +173,17 @@ impl Entry {
 
     /// Whether the block lives in the arena.
     fn in_arena(self) -> bool {
-        self.tag() >= SPARSE
+        self.tag() != INLINE
     }
 
     #[cfg(test)]
     pub fn kind(self) -> Kind {
+        if let Some(v) = self.uniform_value() {
+            return Kind::Uniform(v);
+        }
         match self.tag() {
-            UNIFORM => Kind::Uniform((self.0 >> 16) as u16 as i16),
             SPARSE => Kind::Sparse,
+            PATCHED => Kind::Patched,
             DENSE => Kind::Dense,
             t => Kind::Palette(1 << (t - PALETTE)),
         }
@@ -252,10 +269,9 @@ impl Store {
 
     /// Decodes an entry's 512 values into `out`.
     fn decode_entry(&self, e: Entry, out: &mut Cells) {
-        match e.tag() {
-            EMPTY => out.fill(UNKNOWN),
-            UNIFORM => out.fill((e.0 >> 16) as u16 as i16),
-            t => decode(t, self.words_of(e), out),
+        match (e.tag(), e.uniform_value()) {
+            (INLINE, v) => out.fill(v.unwrap_or(UNKNOWN)),
+            (t, _) => decode(t, self.words_of(e), out),
         }
     }
 
@@ -281,8 +297,8 @@ impl Store {
     }
 
     /// Stores `cells` as block `b`, in the smallest form: nothing when all unknown,
-    /// uniform when all clamped to one value, else sparse, palette or dense,
-    /// whichever takes the fewest units (a palette on a tie).
+    /// uniform when all clamped to one value, else sparse, palette, patched
+    /// palette or dense, whichever takes the fewest units (see [`choose`]).
     pub fn put(&mut self, b: BlockKey, cells: &Cells, fixed: Fixed) {
         let s = self.slot(b);
         self.put_slot(s, cells, fixed);
@@ -305,11 +321,13 @@ impl Store {
             }
         }
         let occupied = any_occupied(census.values.iter().copied(), fixed);
+        let patch = Patch::of(census);
         let (tag, units) = choose(
             census.known,
             census.values.len(),
             census.known_values(),
             occupied,
+            patch.as_ref(),
         );
         match tag {
             SPARSE => {
@@ -332,6 +350,12 @@ impl Store {
                     write_dense(words, cells);
                 }
             }
+            PATCHED => {
+                let patch = patch.expect("a patch chosen");
+                if let Some(words) = self.place(s, tag, units, occupied) {
+                    patched::write(words, census, &patch);
+                }
+            }
             t => {
                 if let Some(words) = self.place(s, t, units, occupied) {
                     write_palette(words, 1 << (t - PALETTE), census);
@@ -346,29 +370,24 @@ impl Store {
     pub fn update(&mut self, b: BlockKey, miss: &[u64; 8], hit: &[u64; 8], fixed: Fixed) -> bool {
         let s = self.slot(b);
         let e = self.tables[s];
-        match e.tag() {
-            UNIFORM => {
-                let v = (e.0 >> 16) as u16 as i16;
-                // A clamped block that the updates only push further: unchanged.
-                let none = |m: &[u64; 8]| m.iter().all(|&w| w == 0);
-                let clamped_free = v == fixed.min;
-                if !(clamped_free && none(hit) || v == fixed.max && none(miss)) {
-                    let mut cells = [v; BLOCK_CELLS];
-                    apply_masks(&mut cells, miss, hit, fixed);
-                    self.put_slot(s, &cells, fixed);
-                }
-                return clamped_free;
+        if let Some(v) = e.uniform_value() {
+            // A clamped block that the updates only push further: unchanged.
+            let none = |m: &[u64; 8]| m.iter().all(|&w| w == 0);
+            let clamped_free = v == fixed.min;
+            if !(clamped_free && none(hit) || v == fixed.max && none(miss)) {
+                let mut cells = [v; BLOCK_CELLS];
+                apply_masks(&mut cells, miss, hit, fixed);
+                self.put_slot(s, &cells, fixed);
             }
-            EMPTY => self.update_empty(s, miss, hit, fixed),
+            return clamped_free;
+        }
+        match e.tag() {
+            INLINE => self.update_empty(s, miss, hit, fixed),
             SPARSE => self.update_sparse(s, e, miss, hit, fixed),
-            DENSE => {
-                let at = e.offset();
+            // Decoded, updated and stored again.
+            t @ (DENSE | PATCHED) => {
                 let mut cells = [0i16; BLOCK_CELLS];
-                decode(
-                    DENSE,
-                    self.arenas[e.arena()].get(at, BLOCK_CELLS),
-                    &mut cells,
-                );
+                decode(t, self.words_of(e), &mut cells);
                 apply_masks(&mut cells, miss, hit, fixed);
                 self.put_slot(s, &cells, fixed);
             }

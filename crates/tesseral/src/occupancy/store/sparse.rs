@@ -3,6 +3,7 @@
 use super::arena::UNIT;
 use super::census::Census;
 use super::forms::{any_occupied, choose, write_sparse, SPARSE, SPARSE_VALUES};
+use super::patched::Patch;
 use super::{Entry, Store, BLOCK_CELLS};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
@@ -70,8 +71,13 @@ impl Store {
         let n = out.len();
         let values_all = if n < BLOCK_CELLS { k + 1 } else { k };
         let occupied = any_occupied(values[..k].iter().map(|&v| v as i16), fixed);
-        let (tag, units) = choose(n, values_all, k, occupied);
-        if tag == SPARSE && !(n == BLOCK_CELLS && k == 1) {
+        // Without the census a patched palette needs: when it might be smaller,
+        // the census path below decides.
+        let (tag, units) = choose(n, values_all, k, occupied, None);
+        if tag == SPARSE
+            && !(n == BLOCK_CELLS && k == 1)
+            && !Patch::may_take_fewer(values_all, units)
+        {
             if let Some(words) = self.place(s, SPARSE, units, occupied) {
                 write_sparse(words, &out);
             }

@@ -2,10 +2,11 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, list_at, lists_occupied, palette_index, sparse_units, units_of, DENSE, EMPTY,
-    PALETTE, SPARSE, SPARSE_VALUES, UNIFORM,
+    bits_words, list_at, lists_occupied, palette_index, sparse_units, units_of, DENSE, INLINE,
+    PALETTE, PATCHED, SPARSE, SPARSE_VALUES,
 };
 use super::{block_of, stored, Store, BLOCK_CELLS, OCCUPIED, TABLE};
+use super::{patched, Entry};
 use crate::occupancy::sensor::{Fixed, UNKNOWN};
 
 impl Store {
@@ -65,22 +66,18 @@ impl Store {
         let mut cells = [UNKNOWN; BLOCK_CELLS];
         for (s, &e) in self.tables.iter().enumerate() {
             let b = block_of(&self.keys, s);
-            match e.tag() {
-                EMPTY => {
-                    assert_eq!(e.0, 0, "block {b:?}: empty entry with bits");
+            if e.tag() == INLINE {
+                let Some(v) = e.uniform_value() else {
+                    assert_eq!(e, Entry::EMPTY, "block {b:?}: empty entry with bits");
                     continue;
-                }
-                UNIFORM => {
-                    let v = (e.0 >> 16) as u16 as i16;
-                    assert!(
-                        v == fixed.min || v == fixed.max,
-                        "uniform block {b:?} holds {v}, not a clamp"
-                    );
-                    assert_eq!(e.0 & 0xFFF8, 0, "block {b:?}: uniform entry with bits");
-                    blocks += 1;
-                    continue;
-                }
-                _ => {}
+                };
+                assert!(
+                    v == fixed.min || v == fixed.max,
+                    "uniform block {b:?} holds {v}, not a clamp"
+                );
+                assert_eq!(e.0 & 0xFFF0, 0, "block {b:?}: uniform entry with bits");
+                blocks += 1;
+                continue;
             }
             blocks += 1;
             let at = e.offset() as usize;
@@ -130,6 +127,7 @@ impl Store {
                         "sparse block {b:?}: bits past its cells"
                     );
                 }
+                PATCHED => patched::assert_valid(words, units, &format!("patched block {b:?}")),
                 DENSE => {}
                 t => {
                     let w = 1 << (t - PALETTE);

@@ -2,9 +2,10 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, decode, list_at, palette_index, DENSE, EMPTY, PALETTE, SPARSE, SPARSE_VALUES,
-    UNIFORM,
+    bits_words, decode, list_at, palette_index, DENSE, INLINE, PALETTE, PATCHED, SPARSE,
+    SPARSE_VALUES,
 };
+use super::patched;
 use super::{join, stored, BlockKey, Entry, Store, BLOCK_CELLS, BLOCK_LOG2};
 use crate::code;
 use crate::linear::sort::sort_by_u64;
@@ -69,10 +70,10 @@ impl Store {
     fn visit(&self, mut f: impl FnMut(BlockKey, Option<usize>, i16)) {
         let mut cells = [UNKNOWN; BLOCK_CELLS];
         for (b, e) in stored(&self.keys, &self.tables) {
-            match e.tag() {
-                UNIFORM => f(b, None, (e.0 >> 16) as u16 as i16),
-                tag => {
-                    decode(tag, self.words_of(e), &mut cells);
+            match e.uniform_value() {
+                Some(v) => f(b, None, v),
+                None => {
+                    decode(e.tag(), self.words_of(e), &mut cells);
                     for (i, &v) in cells.iter().enumerate() {
                         if v != UNKNOWN {
                             f(b, Some(i), v);
@@ -97,12 +98,22 @@ impl Store {
         let mut n = [0u64; 256];
         for &e in &self.tables {
             let (values, k) = match e.tag() {
-                EMPTY => continue,
-                UNIFORM => {
+                INLINE => {
                     // One entry for the whole block.
-                    let v = (e.0 >> 16) as u16 as i16;
-                    tally.add(v, BLOCK_CELLS as u64, 1, threshold);
+                    if let Some(v) = e.uniform_value() {
+                        tally.add(v, BLOCK_CELLS as u64, 1, threshold);
+                    }
                     continue;
+                }
+                PATCHED => {
+                    let words = self.words_of(e);
+                    let mut common = [0; 3];
+                    patched::numbers(words, &mut n, &mut common);
+                    let (values, patch) = patched::values(words);
+                    for (&v, &c) in values.iter().zip(&common) {
+                        tally.add(v as i16, c, c, threshold);
+                    }
+                    (patch, patch.len())
                 }
                 DENSE => {
                     for &v in &self.words_of(e)[..BLOCK_CELLS] {
@@ -180,8 +191,8 @@ impl Store {
         let mut cells = [UNKNOWN; BLOCK_CELLS];
         for (c, e) in blocks {
             let at = c << 9;
-            if e.tag() == UNIFORM {
-                f(Leaf::new(at, 3), (e.0 >> 16) as u16 as i16);
+            if let Some(v) = e.uniform_value() {
+                f(Leaf::new(at, 3), v);
                 continue;
             }
             decode(e.tag(), self.words_of(e), &mut cells);
