@@ -172,7 +172,9 @@ impl OccupancyMap {
     /// [`insert_scan`](Self::insert_scan). Faster with several threads: a scan's
     /// rays are cast while the scan before it is applied to the map (applying is
     /// serial; casting reads nothing of the map), so that no thread waits while
-    /// one writes blocks.
+    /// one writes blocks. After the last scan the map's storage is tidied: an
+    /// arena in which more than an eighth of the bytes hold no block (chunks freed
+    /// as blocks changed form) is compacted, once for the whole call.
     ///
     /// The points of a scan are a slice or anything that holds one (a `Vec` made as
     /// the iterator is read: each is dropped once its scan is cast). The iterator is
@@ -230,6 +232,7 @@ impl OccupancyMap {
         }
         if let Some(cast) = pending {
             let stats = self.apply_cast(cast);
+            self.store.tidy();
             self.store.settle();
             each(self, stats)?;
         }

@@ -4,7 +4,7 @@
 
 use super::arena::UNIT;
 use super::forms::{list_at, DENSE, INLINE, PALETTE, PATCHED, SPARSE};
-use super::patched::{self, ESCAPE};
+use super::patched;
 use super::probe::{sparse_value, LANES};
 use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
 use crate::occupancy::prefetch;
@@ -34,19 +34,20 @@ fn prefetch_word(words: &[u16], k: usize) {
 }
 
 /// Palettes of width 1, 2, 4 and 8, then the patched palette (by `tag −
-/// PALETTE`): where the value list starts (after the cells and the count), above
-/// the log2 of a cell's bits, above their mask. A patched palette's cells are read
-/// as a palette of width 2's.
-const PALETTES: [u32; 5] = {
+/// PALETTE`), from the high bits down: the number that escapes to the patch (3 for
+/// the patched palette, none for a palette), where the value list starts (after
+/// the cells and the count), the log2 of a cell's bits, their mask. A patched
+/// palette's cells are read as a palette of width 2's.
+const PALETTES: [u64; 5] = {
     let mut p = [0; 5];
     let mut k = 0;
     while k < 5 {
-        let log2 = if k < 4 { k } else { 1 };
+        let (log2, escape) = if k < 4 { (k, 0xFFFF) } else { (1, 3) };
         let w = 1 << log2;
-        p[k] = (list_at(w) as u32) << 16 | (log2 as u32) << 8 | ((1 << w) - 1);
+        p[k] = escape << 32 | (list_at(w) as u64) << 16 | (log2 as u64) << 8 | ((1 << w) - 1);
         k += 1;
     }
-    assert!(PATCHED == PALETTE + 4 && p[4] >> 16 == patched::COMMON as u32);
+    assert!(PATCHED == PALETTE + 4 && (p[4] >> 16 & 0xFFFF) as usize == patched::COMMON);
     p
 };
 
@@ -162,19 +163,19 @@ impl Store {
         // width.
         if tag.wrapping_sub(PALETTE) < 5 {
             let p = PALETTES[tag as usize - PALETTE as usize];
-            let list = at + (p >> 16) as usize;
+            let list = at + (p >> 16 & 0xFFFF) as usize;
             // The list lies a line or more past the cell's word: fetch both at once
             // rather than one after the other.
             prefetch_word(words, list);
             let bit = i << (p >> 8 & 0xff);
             let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
             let j = usize::from(x) & (p as usize & 0xff);
-            let v = words_at(words, list + j) as i16;
-            // Only a patched palette lists the escape, for its escaped cells.
-            if v == ESCAPE {
+            // A patched palette's escaped cell: known from its number, before the
+            // list is read.
+            if j == (p >> 32) as usize {
                 return patched::escaped_value(|k| words_at(words, k), at, i);
             }
-            return v;
+            return words_at(words, list + j) as i16;
         }
         self.value_other(e, i)
     }

@@ -8,7 +8,7 @@
 //! values, and 3 ([`ESCAPE`]) for a cell whose value is in the *patch*. The patch
 //! lists the other values, and the escaped cells' numbers in that list in cell
 //! order, 1, 2, 4 or 8 bits each. An escaped cell's rank (the escaped cells
-//! before it) comes from a count per 64 cells and one popcount.
+//! before it) comes from a count per 32 cells and one popcount.
 //!
 //! Layout (`u16` words):
 //! - `0..64`: the cells' numbers, 2 bits each (cell `i` at bit `2i`);
@@ -16,9 +16,9 @@
 //! - `65..69`: the three common values, then [`ESCAPE`] (where a palette of width
 //!   2 lists its values, so that a lookup reads a cell the same way in both, and
 //!   only an escaped cell goes further);
-//! - `69..77`: the escaped cells before cell `64·g`, for `g` in `0..8`;
-//! - `77`: the patch's value count `k` (2 to 256);
-//! - `78..78 + k`: the patch's values;
+//! - `69..85`: the escaped cells before cell `32·g`, for `g` in `0..16`;
+//! - `85`: the patch's value count `k` (2 to 256);
+//! - `86..86 + k`: the patch's values;
 //! - then the escaped cells' numbers in the patch, [`width_for`]`(k)` bits each.
 
 use super::arena::UNIT;
@@ -34,10 +34,12 @@ pub(crate) const ESCAPE: i16 = i16::MAX;
 const ESCAPED: usize = 64;
 /// Where the three common values lie, then [`ESCAPE`].
 pub(crate) const COMMON: usize = 65;
-/// Where the counts of escaped cells before each 64 cells lie.
+/// Where the counts of escaped cells before each [`GROUP`] cells lie.
 const RANKS: usize = 69;
+/// Cells per count of escaped cells: their numbers fill a `u64`.
+const GROUP: usize = 32;
 /// Where the patch's value count lies, then its values, then the numbers.
-const PATCH: usize = 77;
+const PATCH: usize = RANKS + BLOCK_CELLS / GROUP;
 
 /// The most values a patched palette holds: three common and 256 in the patch.
 const MOST: usize = 3 + 256;
@@ -149,8 +151,8 @@ pub(crate) fn write(words: &mut [u16], census: &Census, patch: &Patch) {
     let (head, numbers) = words.split_at_mut(PATCH + 1 + listed);
     let mut rank = 0;
     for (i, &j) in census.index.iter().enumerate() {
-        if i % 64 == 0 {
-            head[RANKS + i / 64] = rank as u16;
+        if i % GROUP == 0 {
+            head[RANKS + i / GROUP] = rank as u16;
         }
         if code[usize::from(j)] == 3 {
             let bit = rank * w as usize;
@@ -197,19 +199,17 @@ pub(crate) fn numbers(words: &[u16], n: &mut [u64; 256], common: &mut [u64; 3]) 
 }
 
 /// The value of cell `i` of the patched palette at `at` in `words`, an escaped
-/// cell: its rank from the count before its 64 cells and a popcount of the
+/// cell: its rank from the count before its 32 cells and a popcount of the
 /// escaped cells among those before it, then its number in the patch.
 ///
 /// `read(k)` gives word `k` of `words` (the lookups' unchecked read).
 #[inline(always)]
 pub(crate) fn escaped_value(read: impl Fn(usize) -> u16, at: usize, i: usize) -> i16 {
-    let (g, r) = (i >> 6, i & 63);
-    // The 64 cells' numbers, 128 bits, cell c at bit 2c.
-    let run = (0..8).fold(0u128, |x, q| {
-        x | u128::from(read(at + 8 * g + q)) << (16 * q)
-    });
-    const EVEN: u128 = 0x5555_5555_5555_5555_5555_5555_5555_5555;
-    let escaped = run & run >> 1 & EVEN & ((1u128 << (2 * r)) - 1);
+    let (g, r) = (i / GROUP, i % GROUP);
+    // The group's numbers, cell c at bit 2c.
+    let run = (0..4).fold(0u64, |x, q| x | u64::from(read(at + 4 * g + q)) << (16 * q));
+    const EVEN: u64 = 0x5555_5555_5555_5555;
+    let escaped = run & run >> 1 & EVEN & ((1u64 << (2 * r)) - 1);
     let rank = usize::from(read(at + RANKS + g)) + escaped.count_ones() as usize;
     let k = usize::from(read(at + PATCH));
     // The numbers' width: the bits of k − 1, rounded up to a power of two.
@@ -239,9 +239,9 @@ pub(crate) fn assert_valid(words: &[u16], units: usize, what: &str) {
     }
     let mut rank = 0;
     for i in 0..BLOCK_CELLS {
-        if i % 64 == 0 {
+        if i % GROUP == 0 {
             assert_eq!(
-                usize::from(words[RANKS + i / 64]),
+                usize::from(words[RANKS + i / GROUP]),
                 rank,
                 "{what}: rank at cell {i}"
             );

@@ -1,6 +1,7 @@
 //! Placing blocks in the arenas: a slot's block emptied, made uniform or given
 //! room in the arena its values call for, moved between the arenas, and an arena
-//! compacted once a quarter of it is free.
+//! compacted once a quarter of it is free, or at the end of a batch of scans once
+//! an eighth of its bytes hold no block ([`Store::tidy`]).
 
 use super::arena::{Arena, UNIT};
 use super::forms::units_of;
@@ -114,12 +115,37 @@ impl Store {
         self.arenas.iter_mut().for_each(|a| a.limit = units);
     }
 
+    /// Compacts each arena in which more than an eighth of the bytes hold no
+    /// block (free chunks and room reserved for growth, more than a few KiB), and
+    /// trims the tables' room for growth past an eighth: called at the end of a
+    /// batch of scans, it leaves the map within an eighth of its blocks' and
+    /// tables' bytes. (The arena grows by an eighth at a time, so growth alone
+    /// does not set it off.)
+    ///
+    /// # Runtime
+    /// O(s + u) for s table slots and u units of an arena compacted; nothing when
+    /// none is.
+    pub fn tidy(&mut self) {
+        for a in [OPEN, OCCUPIED] {
+            let arena = &self.arenas[a];
+            let held = arena.words.capacity() / UNIT;
+            let idle = held - (arena.len_units() - arena.free_units);
+            if idle * 8 > held && idle > 256 {
+                self.compact(a);
+            }
+        }
+        if (self.tables.capacity() - self.tables.len()) * 8 > self.tables.len() {
+            self.tables.shrink_to_fit();
+            self.keys.shrink_to_fit();
+        }
+    }
+
     /// Moves every block of arena `a` to a new arena, in table order, leaving no
-    /// free chunk.
+    /// free chunk and no room for growth (the arena's next block grows it).
     fn compact(&mut self, a: usize) {
         let old = std::mem::take(&mut self.arenas[a]);
         let used = old.len_units() - old.free_units;
-        let mut words = Vec::with_capacity((used + used / 8) * UNIT);
+        let mut words = Vec::with_capacity(used * UNIT);
         for (s, e) in self.tables.iter_mut().enumerate() {
             if e.in_arena() && e.arena() == a {
                 let from = e.offset() as usize * UNIT;
