@@ -42,7 +42,11 @@ const PALETTES: [u64; 5] = {
     let mut p = [0; 5];
     let mut k = 0;
     while k < 5 {
-        let (log2, escape) = if k < 4 { (k, 0xFFFF) } else { (1, 3) };
+        let (log2, escape) = if k < 4 {
+            (k, 0xFFFF)
+        } else {
+            (1, patched::ESCAPE as u64)
+        };
         let w = 1 << log2;
         p[k] = escape << 32 | (list_at(w) as u64) << 16 | (log2 as u64) << 8 | ((1 << w) - 1);
         k += 1;

@@ -13,9 +13,10 @@
 //! Layout (`u16` words):
 //! - `0..64`: the cells' numbers, 2 bits each (cell `i` at bit `2i`);
 //! - `64`: the escaped cells' count;
-//! - `65..69`: the three common values, then [`ESCAPE`] (where a palette of width
-//!   2 lists its values, so that a lookup reads a cell the same way in both, and
-//!   only an escaped cell goes further);
+//! - `65..68`: the three common values (where a palette of width 2 lists its
+//!   values, so that a lookup reads a cell the same way in both, and only an
+//!   escaped cell goes further);
+//! - `68`: the width of the escaped cells' numbers in the patch;
 //! - `69..85`: the escaped cells before cell `32·g`, for `g` in `0..16`;
 //! - `85`: the patch's value count `k` (2 to 256);
 //! - `86..86 + k`: the patch's values;
@@ -26,14 +27,15 @@ use super::census::Census;
 use super::forms::{pack, palette_index, width_for};
 use super::BLOCK_CELLS;
 
-/// The value listed for number 3, the escaped cells: no cell's value (the values
-/// lie within the clamps, at most 16,000 from 0, or are `UNKNOWN`, `i16::MIN`).
-pub(crate) const ESCAPE: i16 = i16::MAX;
+/// The number of the escaped cells.
+pub(crate) const ESCAPE: usize = 3;
 
 /// Where the escaped cells' count lies.
 const ESCAPED: usize = 64;
-/// Where the three common values lie, then [`ESCAPE`].
+/// Where the three common values lie.
 pub(crate) const COMMON: usize = 65;
+/// Where the width of the patch's numbers lies.
+const WIDTH: usize = 68;
 /// Where the counts of escaped cells before each [`GROUP`] cells lie.
 const RANKS: usize = 69;
 /// Cells per count of escaped cells: their numbers fill a `u64`.
@@ -115,7 +117,7 @@ pub(crate) fn units_of(words: &[u16]) -> usize {
     units(usize::from(words[PATCH]), usize::from(words[ESCAPED]))
 }
 
-/// The common values (the three, without [`ESCAPE`]) and the patch's values.
+/// The three common values and the patch's values.
 pub(crate) fn values(words: &[u16]) -> (&[u16], &[u16]) {
     let k = usize::from(words[PATCH]);
     (&words[COMMON..COMMON + 3], &words[PATCH + 1..PATCH + 1 + k])
@@ -127,16 +129,15 @@ pub(crate) fn write(words: &mut [u16], census: &Census, patch: &Patch) {
     words.fill(0);
     // Each census number's number here (0 to 2, or 3: escaped), and its number in
     // the patch.
-    let mut code = [3u16; MOST];
+    let mut code = [ESCAPE as u16; MOST];
     let mut in_patch = [0u16; MOST];
     for (c, &j) in patch.common.iter().enumerate() {
         code[usize::from(j)] = c as u16;
         words[COMMON + c] = census.values[usize::from(j)] as u16;
     }
-    words[COMMON + 3] = ESCAPE as u16;
     let mut listed = 0;
     for (j, &v) in census.values.iter().enumerate() {
-        if code[j] == 3 {
+        if code[j] == ESCAPE as u16 {
             in_patch[j] = listed as u16;
             words[PATCH + 1 + listed] = v as u16;
             listed += 1;
@@ -148,13 +149,14 @@ pub(crate) fn write(words: &mut [u16], census: &Census, patch: &Patch) {
     let codes: [u16; BLOCK_CELLS] = std::array::from_fn(|i| code[usize::from(census.index[i])]);
     pack::<2>(&mut words[..ESCAPED], &codes);
     let w = width_for(listed).expect("at most 256 values in a patch");
+    words[WIDTH] = w as u16;
     let (head, numbers) = words.split_at_mut(PATCH + 1 + listed);
     let mut rank = 0;
     for (i, &j) in census.index.iter().enumerate() {
         if i % GROUP == 0 {
             head[RANKS + i / GROUP] = rank as u16;
         }
-        if code[usize::from(j)] == 3 {
+        if code[usize::from(j)] == ESCAPE as u16 {
             let bit = rank * w as usize;
             numbers[bit >> 4] |= in_patch[usize::from(j)] << (bit & 15);
             rank += 1;
@@ -171,7 +173,7 @@ pub(crate) fn decode(words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
     let mut rank = 0;
     for (i, o) in out.iter_mut().enumerate() {
         let c = palette_index(words, 2, i);
-        *o = if c < 3 {
+        *o = if c != ESCAPE {
             words[COMMON + c] as i16
         } else {
             rank += 1;
@@ -210,32 +212,39 @@ pub(crate) fn escaped_value(read: impl Fn(usize) -> u16, at: usize, i: usize) ->
     let run = (0..4).fold(0u64, |x, q| x | u64::from(read(at + 4 * g + q)) << (16 * q));
     const EVEN: u64 = 0x5555_5555_5555_5555;
     let escaped = run & run >> 1 & EVEN & ((1u64 << (2 * r)) - 1);
-    let rank = usize::from(read(at + RANKS + g)) + escaped.count_ones() as usize;
+    let rank = usize::from(read(at + RANKS + g)) + even_ones(escaped);
     let k = usize::from(read(at + PATCH));
-    // The numbers' width: the bits of k − 1, rounded up to a power of two.
-    let w = (usize::BITS - (k - 1).leading_zeros()).next_power_of_two() as usize;
+    let w = usize::from(read(at + WIDTH));
     let bit = rank * w;
     let number = usize::from(read(at + PATCH + 1 + k + (bit >> 4)) >> (bit & 15)) & ((1 << w) - 1);
     read(at + PATCH + 1 + number) as i16
 }
 
+/// The set bits of `x`, all at even positions: a popcount by shifts and one
+/// multiply, shorter than the general one that x86-64's baseline (no `popcnt`)
+/// compiles `count_ones` to.
+#[inline(always)]
+fn even_ones(x: u64) -> usize {
+    const NIBBLES: u64 = 0x1111_1111_1111_1111;
+    // Each nibble: its bits 0 and 2, 0 to 2; then each byte, 0 to 4.
+    let x = (x & NIBBLES) + (x >> 2 & NIBBLES);
+    let x = (x + (x >> 4)) & 0x0F0F_0F0F_0F0F_0F0F;
+    (x.wrapping_mul(0x0101_0101_0101_0101) >> 56) as usize
+}
+
 /// Checks a patched palette's invariants (its `units` units from `words`): the
-/// common values and the patch's are distinct, none [`ESCAPE`]; the counts and
-/// ranks match the cells; every number lies in the patch; no bits past the
-/// numbers. `what` names the block.
+/// common values and the patch's are distinct; the width fits the patch; the
+/// counts and ranks match the cells; every number lies in the patch; no bits
+/// past the numbers. `what` names the block.
 pub(crate) fn assert_valid(words: &[u16], units: usize, what: &str) {
     let k = usize::from(words[PATCH]);
     assert!((2..=256).contains(&k), "{what}: a patch of {k} values");
-    assert_eq!(
-        words[COMMON + 3] as i16,
-        ESCAPE,
-        "{what}: number 3 is not the escape"
-    );
+    let w = width_for(k).expect("checked");
+    assert_eq!(u32::from(words[WIDTH]), w, "{what}: numbers' width");
     let (common, patch) = values(words);
     let all: Vec<u16> = common.iter().chain(patch).copied().collect();
     for (j, &v) in all.iter().enumerate() {
         assert!(!all[..j].contains(&v), "{what}: value {} twice", v as i16);
-        assert_ne!(v as i16, ESCAPE, "{what}: the escape as a value");
     }
     let mut rank = 0;
     for i in 0..BLOCK_CELLS {
@@ -246,10 +255,10 @@ pub(crate) fn assert_valid(words: &[u16], units: usize, what: &str) {
                 "{what}: rank at cell {i}"
             );
         }
-        rank += usize::from(palette_index(words, 2, i) == 3);
+        rank += usize::from(palette_index(words, 2, i) == ESCAPE);
     }
     assert_eq!(usize::from(words[ESCAPED]), rank, "{what}: escaped cells");
-    let w = width_for(k).expect("checked") as usize;
+    let w = w as usize;
     let numbers = &words[PATCH + 1 + k..units * UNIT];
     for r in 0..rank {
         assert!(

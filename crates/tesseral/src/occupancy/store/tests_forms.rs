@@ -108,9 +108,9 @@ fn a_patched_palette_reads_back_every_cell() {
         assert_eq!(out, cells, "round {round}: decode");
         // The lookup's two steps: the 2-bit number, then the patch for the escape.
         for (i, &v) in cells.iter().enumerate() {
-            let got = match words[patched::COMMON + palette_index(&words, 2, i)] as i16 {
+            let got = match palette_index(&words, 2, i) {
                 patched::ESCAPE => patched::escaped_value(|q| words[q], 0, i),
-                x => x,
+                j => words[patched::COMMON + j] as i16,
             };
             assert_eq!(got, v, "round {round}: cell {i}");
         }
