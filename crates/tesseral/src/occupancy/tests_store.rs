@@ -341,3 +341,49 @@ fn blocks_that_list_an_occupied_value_move_to_their_own_arena() {
         .iter()
         .any(|&b| store.in_occupied_arena(b) == Some(true)));
 }
+
+#[test]
+fn tidy_compacts_an_arena_with_free_chunks_and_keeps_every_cell() {
+    let fixed = Fixed::new(&SensorModel::octomap());
+    let mut rng = Pcg64::seed_from_u64(77);
+    let mut store = Store::default();
+    let blocks: Vec<[i64; 3]> = (0..400).map(|k| [k % 20, k / 20, -3]).collect();
+    let mut model: HashMap<[i64; 3], i16> = HashMap::new();
+    // Blocks of many values each (palettes of 8 bits: 33 units and more).
+    for &b in &blocks {
+        let cells: [i16; 512] = std::array::from_fn(|_| rng.random_range(fixed.min..=fixed.max));
+        store.put(b, &cells, fixed);
+        for (i, &v) in cells.iter().enumerate() {
+            model.insert(cell_of(b, i), v);
+        }
+    }
+    // A fifth of them clamped: their chunks freed, short of the quarter at which
+    // an arena compacts itself.
+    let before = store.compactions();
+    for &b in blocks.iter().step_by(5) {
+        store.put(b, &[fixed.min; 512], fixed);
+        for i in 0..512 {
+            model.insert(cell_of(b, i), fixed.min);
+        }
+    }
+    assert_eq!(
+        store.compactions(),
+        before,
+        "no compaction during the updates"
+    );
+    let bytes = store.bytes();
+    store.tidy();
+    store.assert_valid(fixed);
+    assert_eq!(store.compactions(), before + 1, "tidy compacted the arena");
+    assert!(
+        store.bytes() * 5 < bytes * 4,
+        "{} bytes of {bytes}",
+        store.bytes()
+    );
+    for (&c, &v) in &model {
+        assert_eq!(store.get(c), v, "cell {c:?}");
+    }
+    // Nothing left to tidy.
+    store.tidy();
+    assert_eq!(store.compactions(), before + 1, "a second tidy did nothing");
+}
