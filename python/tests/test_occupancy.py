@@ -106,7 +106,11 @@ def test_insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan():
     m = t.OccupancyMap(0.1)
     got = m.insert_scans(scans, max_range=2.5)
     assert got == want
-    assert m.stats() == one.stats()
+    # The same cells; the batch ends tidied (its arenas compacted), so it holds
+    # no more bytes than the loop.
+    batch, loop = m.stats(), one.stats()
+    assert batch.pop("bytes") <= loop.pop("bytes")
+    assert batch == loop
     ends = np.concatenate([p for _, p in scans])
     cells = m.cells_of(ends[~np.isnan(ends).any(axis=1)])
     np.testing.assert_array_equal(m.log_odds(cells), one.log_odds(cells))  # NaN: unknown

@@ -168,13 +168,14 @@ impl OccupancyMap {
     }
 
     /// Inserts scans in the order given, each from its origin, and gives each one's
-    /// counts: the map and the counts are those of a loop of
+    /// counts: the map's cells and the counts are those of a loop of
     /// [`insert_scan`](Self::insert_scan). Faster with several threads: a scan's
     /// rays are cast while the scan before it is applied to the map (applying is
     /// serial; casting reads nothing of the map), so that no thread waits while
     /// one writes blocks. After the last scan the map's storage is tidied: an
     /// arena in which more than an eighth of the bytes hold no block (chunks freed
-    /// as blocks changed form) is compacted, once for the whole call.
+    /// as blocks changed form) is compacted, once for the whole call, so that the
+    /// map may hold fewer bytes than after the loop.
     ///
     /// The points of a scan are a slice or anything that holds one (a `Vec` made as
     /// the iterator is read: each is dropped once its scan is cast). The iterator is
