@@ -244,6 +244,13 @@ impl OccupancyMap {
             .map_err(value_error)
     }
 
+    /// Packs the map's storage as the end of `insert_scans` does (for a map built
+    /// by a loop of `insert_scan`): the cells are unchanged, the bytes fewer.
+    fn shrink_to_fit(&mut self, py: Python<'_>) {
+        let m = &mut self.map;
+        py.allow_threads(|| m.shrink_to_fit());
+    }
+
     /// Counts: occupied, free, leaves, blocks, bytes.
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let d = PyDict::new(py);

@@ -111,6 +111,8 @@ def test_insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan():
     batch, loop = m.stats(), one.stats()
     assert batch.pop("bytes") <= loop.pop("bytes")
     assert batch == loop
+    one.shrink_to_fit()
+    assert one.stats() == m.stats()
     ends = np.concatenate([p for _, p in scans])
     cells = m.cells_of(ends[~np.isnan(ends).any(axis=1)])
     np.testing.assert_array_equal(m.log_odds(cells), one.log_odds(cells))  # NaN: unknown

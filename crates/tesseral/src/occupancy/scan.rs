@@ -172,10 +172,12 @@ impl OccupancyMap {
     /// [`insert_scan`](Self::insert_scan). Faster with several threads: a scan's
     /// rays are cast while the scan before it is applied to the map (applying is
     /// serial; casting reads nothing of the map), so that no thread waits while
-    /// one writes blocks. After the last scan the map's storage is tidied: an
-    /// arena in which more than an eighth of the bytes hold no block (chunks freed
-    /// as blocks changed form) is compacted, once for the whole call, so that the
-    /// map may hold fewer bytes than after the loop.
+    /// one writes blocks. After the last scan the map's storage is tidied, once
+    /// for the whole call: the blocks the scans left as wide palettes are made
+    /// patched palettes where that is smaller, and an arena in which more than an
+    /// eighth of the bytes hold no block is compacted, so that the map may hold
+    /// fewer bytes than after the loop ([`shrink_to_fit`](Self::shrink_to_fit)
+    /// does the same after a loop).
     ///
     /// The points of a scan are a slice or anything that holds one (a `Vec` made as
     /// the iterator is read: each is dropped once its scan is cast). The iterator is
@@ -233,6 +235,7 @@ impl OccupancyMap {
         }
         if let Some(cast) = pending {
             let stats = self.apply_cast(cast);
+            self.store.repatch(self.fixed);
             self.store.tidy();
             self.store.settle();
             each(self, stats)?;

@@ -136,6 +136,10 @@ fn insert_scans_keeps_the_misses_of_blocks_the_scan_before_hits() {
         cells(&map),
         "the loop gives the checked map"
     );
+    // The batch ends packed, as the loop's map once shrunk.
+    looped.shrink_to_fit();
+    looped.assert_valid();
+    assert_eq!(cells(&looped), cells(&map), "shrink_to_fit keeps the cells");
     for threads in [1, 2, 3] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -147,6 +151,7 @@ fn insert_scans_keeps_the_misses_of_blocks_the_scan_before_hits() {
         piped.assert_valid();
         assert_eq!(got, want, "{threads} threads: counts");
         assert_eq!(cells(&piped), cells(&looped), "{threads} threads: cells");
+        // The batch ends packed, as the loop's map once shrunk.
         assert_eq!(piped.bytes(), looped.bytes(), "{threads} threads: bytes");
     }
 }

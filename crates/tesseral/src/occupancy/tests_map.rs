@@ -350,6 +350,11 @@ fn insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan() {
             "a non-finite origin skips every point"
         );
         assert!(cells(&want_map).len() > 10_000);
+        // The batch ends packed, as the loop's map once shrunk.
+        let before = cells(&want_map);
+        want_map.shrink_to_fit();
+        want_map.assert_valid();
+        assert!(cells(&want_map) == before, "shrink_to_fit keeps the cells");
         for threads in [1, 2, 3] {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)

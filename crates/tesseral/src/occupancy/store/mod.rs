@@ -220,6 +220,11 @@ pub(crate) struct Store {
     overflowed: bool,
     /// Whether a block stayed in the wrong arena because the other was full.
     crowded: bool,
+    /// Slots whose block a scan's update left as a palette of 4 or 8 bits or
+    /// dense, which a patched palette may hold in fewer units: made patched by
+    /// [`Store::repatch`] at the end of a batch of scans, not on every update (a
+    /// patched palette is re-encoded on update, a palette updated in place).
+    pending: Vec<u32>,
 }
 
 impl Store {
@@ -301,15 +306,24 @@ impl Store {
     /// palette or dense, whichever takes the fewest units (see [`choose`]).
     pub fn put(&mut self, b: BlockKey, cells: &Cells, fixed: Fixed) {
         let s = self.slot(b);
-        self.put_slot(s, cells, fixed);
+        self.put_slot(s, cells, fixed, true);
     }
 
-    fn put_slot(&mut self, s: usize, cells: &Cells, fixed: Fixed) {
-        self.put_census(s, cells, &Census::of(cells), fixed);
+    /// [`put`](Self::put) in slot `s`; a patched palette considered only when
+    /// `may_patch` (else the slot noted for [`Store::repatch`] where one may do).
+    fn put_slot(&mut self, s: usize, cells: &Cells, fixed: Fixed, may_patch: bool) {
+        self.put_census(s, cells, &Census::of(cells), fixed, may_patch);
     }
 
-    /// [`put`](Self::put) in slot `s` of `cells`, whose census is `census`.
-    fn put_census(&mut self, s: usize, cells: &Cells, census: &Census, fixed: Fixed) {
+    /// [`put_slot`](Self::put_slot) of `cells`, whose census is `census`.
+    fn put_census(
+        &mut self,
+        s: usize,
+        cells: &Cells,
+        census: &Census,
+        fixed: Fixed,
+        may_patch: bool,
+    ) {
         if census.known == 0 {
             self.clear(s);
             return;
@@ -321,7 +335,7 @@ impl Store {
             }
         }
         let occupied = any_occupied(census.values.iter().copied(), fixed);
-        let patch = Patch::of(census);
+        let patch = Patch::of(census).filter(|_| may_patch);
         let (tag, units) = choose(
             census.known,
             census.values.len(),
@@ -362,6 +376,13 @@ impl Store {
                 }
             }
         }
+        // (A sparse block among them only while a patched palette might be smaller.)
+        let wide = tag >= PALETTE + 2 && tag != PATCHED;
+        if !may_patch
+            && (wide || tag == SPARSE && Patch::may_take_fewer(census.values.len(), units))
+        {
+            self.note_pending(s);
+        }
     }
 
     /// Applies one scan's updates to block `b`: the cells of `miss` get a miss, those
@@ -377,7 +398,7 @@ impl Store {
             if !(clamped_free && none(hit) || v == fixed.max && none(miss)) {
                 let mut cells = [v; BLOCK_CELLS];
                 apply_masks(&mut cells, miss, hit, fixed);
-                self.put_slot(s, &cells, fixed);
+                self.put_slot(s, &cells, fixed, false);
             }
             return clamped_free;
         }
@@ -389,7 +410,7 @@ impl Store {
                 let mut cells = [0i16; BLOCK_CELLS];
                 decode(t, self.words_of(e), &mut cells);
                 apply_masks(&mut cells, miss, hit, fixed);
-                self.put_slot(s, &cells, fixed);
+                self.put_slot(s, &cells, fixed, false);
             }
             t => {
                 let w = 1 << (t - PALETTE);
@@ -406,11 +427,14 @@ impl Store {
                         }
                         _ => {}
                     }
+                    if w >= 4 {
+                        self.note_pending(s);
+                    }
                 } else {
                     let mut cells = [0i16; BLOCK_CELLS];
                     decode(t, self.words_of(e), &mut cells);
                     apply_masks(&mut cells, miss, hit, fixed);
-                    self.put_slot(s, &cells, fixed);
+                    self.put_slot(s, &cells, fixed, false);
                 }
             }
         }
@@ -450,7 +474,7 @@ impl Store {
     }
 
     /// Bytes held: the directory, tables and keys, the arena, the read index
-    /// (capacities) and the merge buffer.
+    /// (capacities), the merge buffer and the slots noted for `repatch`.
     pub fn bytes(&self) -> usize {
         self.dir.bytes()
             + self.keys.capacity() * std::mem::size_of::<BlockKey>()
@@ -458,5 +482,6 @@ impl Store {
             + self.arenas.iter().map(Arena::bytes).sum::<usize>()
             + self.flat.bytes()
             + self.scratch.capacity() * 4
+            + self.pending.capacity() * 4
     }
 }

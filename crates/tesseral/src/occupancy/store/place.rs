@@ -4,8 +4,10 @@
 //! an eighth of its bytes hold no block ([`Store::tidy`]).
 
 use super::arena::{Arena, UNIT};
-use super::forms::units_of;
-use super::{block_of, Entry, Store, OCCUPIED, OPEN};
+use super::census::Census;
+use super::forms::{decode, units_of, INLINE, PALETTE, PATCHED};
+use super::{block_of, Entry, Store, BLOCK_CELLS, OCCUPIED, OPEN};
+use crate::occupancy::sensor::Fixed;
 
 impl Store {
     /// Empties slot `s`, freeing its block's storage.
@@ -138,6 +140,46 @@ impl Store {
             self.tables.shrink_to_fit();
             self.keys.shrink_to_fit();
         }
+    }
+
+    /// Notes slot `s` for [`repatch`](Self::repatch). The notes are kept to one
+    /// per slot once they pass the blocks stored, so that a map updated a scan at
+    /// a time and never repatched holds at most 4 bytes a block of them.
+    pub(super) fn note_pending(&mut self, s: usize) {
+        self.pending.push(s as u32);
+        if self.pending.len() > self.blocks.max(4096) {
+            self.pending.sort_unstable();
+            self.pending.dedup();
+        }
+    }
+
+    /// Stores each block noted by a scan's update (a palette of 4 or 8 bits, a
+    /// dense block, a long sparse one) in its smallest form, a patched palette
+    /// among them. At the end
+    /// of a batch of scans, before [`tidy`](Self::tidy).
+    ///
+    /// # Runtime
+    /// O(n log n + 512 n) for n blocks noted.
+    pub fn repatch(&mut self, fixed: Fixed) {
+        let mut pending = std::mem::take(&mut self.pending);
+        pending.sort_unstable();
+        pending.dedup();
+        let mut cells = [0i16; BLOCK_CELLS];
+        for &s in &pending {
+            let s = s as usize;
+            let e = self.tables[s];
+            let tag = e.tag();
+            if tag == INLINE || tag == PATCHED || tag == PALETTE || tag == PALETTE + 1 {
+                continue;
+            }
+            // Stored again in its smallest form, which may be a patched palette or,
+            // for a palette updated in place whose values have since dwindled, a
+            // narrower palette.
+            decode(tag, self.words_of(e), &mut cells);
+            self.put_census(s, &cells, &Census::of(&cells), fixed, true);
+        }
+        // Its room dropped: a batch's notes may be many.
+        drop(pending);
     }
 
     /// Moves every block of arena `a` to a new arena, in table order, leaving no

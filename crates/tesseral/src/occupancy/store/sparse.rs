@@ -89,7 +89,7 @@ impl Store {
             }
             let census = Census::of_list(&out);
             self.scratch = out;
-            self.put_census(s, &cells, &census, fixed);
+            self.put_census(s, &cells, &census, fixed, false);
         }
     }
 }
