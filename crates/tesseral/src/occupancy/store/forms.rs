@@ -25,6 +25,14 @@ pub(crate) const PALETTE: u32 = 2;
 pub(crate) const PATCHED: u32 = 6;
 pub(crate) const DENSE: u32 = 7;
 
+/// Whether a block of this tag is a palette of 4 or 8 bits or dense: a form a
+/// scan's update leaves for [`Store::repatch`](super::Store::repatch) to store
+/// smaller (a patched palette, or a narrower palette).
+#[inline]
+pub(crate) fn wide(tag: u32) -> bool {
+    tag == PALETTE + 2 || tag == PALETTE + 3 || tag == DENSE
+}
+
 /// The most distinct values a sparse block holds.
 pub(crate) const SPARSE_VALUES: usize = 6;
 
@@ -100,6 +108,41 @@ pub(crate) fn sparse_get(words: &[u16], i: usize) -> i16 {
     match cells.get(p) {
         Some(&c) if c >> 3 == i as u16 => words[2 + (c & 7) as usize] as i16,
         _ => UNKNOWN,
+    }
+}
+
+/// The cells of a palette block of width `w` per number, into `n[..1 << w]`
+/// (widths 1 and 2 by popcounts of the bit planes, 64 cells at a time).
+pub(crate) fn palette_numbers(words: &[u16], w: u32, n: &mut [u64; 256]) {
+    let u64s = || {
+        words[..bits_words(w)].chunks_exact(4).map(|q| {
+            u64::from(q[0]) | u64::from(q[1]) << 16 | u64::from(q[2]) << 32 | u64::from(q[3]) << 48
+        })
+    };
+    let all = BLOCK_CELLS as u64;
+    match w {
+        1 => {
+            let ones: u64 = u64s().map(|x| u64::from(x.count_ones())).sum();
+            n[..2].copy_from_slice(&[all - ones, ones]);
+        }
+        2 => {
+            const EVEN: u64 = 0x5555_5555_5555_5555;
+            let mut c = [0u64; 4];
+            for x in u64s() {
+                let (lo, hi) = (x & EVEN, x >> 1 & EVEN);
+                c[1] += u64::from((lo & !hi).count_ones());
+                c[2] += u64::from((hi & !lo).count_ones());
+                c[3] += u64::from((lo & hi).count_ones());
+            }
+            c[0] = all - c[1] - c[2] - c[3];
+            n[..4].copy_from_slice(&c);
+        }
+        _ => {
+            n[..1 << w].fill(0);
+            for i in 0..BLOCK_CELLS {
+                n[palette_index(words, w, i)] += 1;
+            }
+        }
     }
 }
 

@@ -36,7 +36,8 @@ use dir::Directory;
 use flat::Flat;
 use forms::{
     any_occupied, apply_masks, choose, decode, lists_occupied, palette_single, palette_update,
-    units_of, write_dense, write_palette, write_sparse, DENSE, INLINE, PALETTE, PATCHED, SPARSE,
+    units_of, wide, write_dense, write_palette, write_sparse, DENSE, INLINE, PALETTE, PATCHED,
+    SPARSE,
 };
 pub(crate) use lookup::BATCH;
 use patched::Patch;
@@ -377,9 +378,8 @@ impl Store {
             }
         }
         // (A sparse block among them only while a patched palette might be smaller.)
-        let wide = tag >= PALETTE + 2 && tag != PATCHED;
         if !may_patch
-            && (wide || tag == SPARSE && Patch::may_take_fewer(census.values.len(), units))
+            && (wide(tag) || tag == SPARSE && Patch::may_take_fewer(census.values.len(), units))
         {
             self.note_pending(s);
         }

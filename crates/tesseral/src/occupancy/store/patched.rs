@@ -24,7 +24,7 @@
 
 use super::arena::UNIT;
 use super::census::Census;
-use super::forms::{pack, palette_index, width_for};
+use super::forms::{pack, palette_index, palette_numbers, width_for};
 use super::BLOCK_CELLS;
 
 /// The number of the escaped cells.
@@ -192,12 +192,11 @@ pub(crate) fn numbers(words: &[u16], n: &mut [u64; 256], common: &mut [u64; 3]) 
     for r in 0..usize::from(words[ESCAPED]) {
         n[palette_index(numbers, w, r)] += 1;
     }
-    *common = [0; 3];
-    for i in 0..BLOCK_CELLS {
-        if let Some(c) = common.get_mut(palette_index(words, 2, i)) {
-            *c += 1;
-        }
-    }
+    // The cells' numbers as a 2-bit palette's, counted by popcounts (the escaped
+    // cells' number 3 among them).
+    let mut four = [0u64; 256];
+    palette_numbers(words, 2, &mut four);
+    common.copy_from_slice(&four[..3]);
 }
 
 /// The value of cell `i` of the patched palette at `at` in `words`, an escaped

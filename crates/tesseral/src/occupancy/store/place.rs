@@ -5,7 +5,7 @@
 
 use super::arena::{Arena, UNIT};
 use super::census::Census;
-use super::forms::{decode, units_of, INLINE, PALETTE, PATCHED};
+use super::forms::{decode, units_of, wide, SPARSE};
 use super::{block_of, Entry, Store, BLOCK_CELLS, OCCUPIED, OPEN};
 use crate::occupancy::sensor::Fixed;
 
@@ -155,8 +155,7 @@ impl Store {
 
     /// Stores each block noted by a scan's update (a palette of 4 or 8 bits, a
     /// dense block, a long sparse one) in its smallest form, a patched palette
-    /// among them. At the end
-    /// of a batch of scans, before [`tidy`](Self::tidy).
+    /// among them. At the end of a batch of scans, before [`tidy`](Self::tidy).
     ///
     /// # Runtime
     /// O(n log n + 512 n) for n blocks noted.
@@ -169,7 +168,7 @@ impl Store {
             let s = s as usize;
             let e = self.tables[s];
             let tag = e.tag();
-            if tag == INLINE || tag == PATCHED || tag == PALETTE || tag == PALETTE + 1 {
+            if !(wide(tag) || tag == SPARSE) {
                 continue;
             }
             // Stored again in its smallest form, which may be a patched palette or,

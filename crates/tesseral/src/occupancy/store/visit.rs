@@ -2,7 +2,7 @@
 
 use super::arena::UNIT;
 use super::forms::{
-    bits_words, decode, list_at, palette_index, DENSE, INLINE, PALETTE, PATCHED, SPARSE,
+    bits_words, decode, list_at, palette_numbers, DENSE, INLINE, PALETTE, PATCHED, SPARSE,
     SPARSE_VALUES,
 };
 use super::patched;
@@ -25,41 +25,6 @@ impl CellCounts {
                 self.free += n;
             }
             self.leaves += entries;
-        }
-    }
-}
-
-/// The cells of a palette block of width `w` per number, into `n[..1 << w]`
-/// (widths 1 and 2 by popcounts of the bit planes, 64 cells at a time).
-fn palette_numbers(words: &[u16], w: u32, n: &mut [u64; 256]) {
-    let u64s = || {
-        words[..bits_words(w)].chunks_exact(4).map(|q| {
-            u64::from(q[0]) | u64::from(q[1]) << 16 | u64::from(q[2]) << 32 | u64::from(q[3]) << 48
-        })
-    };
-    let all = BLOCK_CELLS as u64;
-    match w {
-        1 => {
-            let ones: u64 = u64s().map(|x| u64::from(x.count_ones())).sum();
-            n[..2].copy_from_slice(&[all - ones, ones]);
-        }
-        2 => {
-            const EVEN: u64 = 0x5555_5555_5555_5555;
-            let mut c = [0u64; 4];
-            for x in u64s() {
-                let (lo, hi) = (x & EVEN, x >> 1 & EVEN);
-                c[1] += u64::from((lo & !hi).count_ones());
-                c[2] += u64::from((hi & !lo).count_ones());
-                c[3] += u64::from((lo & hi).count_ones());
-            }
-            c[0] = all - c[1] - c[2] - c[3];
-            n[..4].copy_from_slice(&c);
-        }
-        _ => {
-            n[..1 << w].fill(0);
-            for i in 0..BLOCK_CELLS {
-                n[palette_index(words, w, i)] += 1;
-            }
         }
     }
 }
