@@ -348,9 +348,7 @@ impl OccupancyMap {
     /// O(512 n + u) for n blocks left as wide palettes and u units of the arenas
     /// compacted.
     pub fn shrink_to_fit(&mut self) {
-        self.store.repatch(self.fixed);
-        self.store.tidy();
-        self.store.settle();
+        self.store.pack(self.fixed);
     }
 
     /// Every known cell and its log-odds, sorted by cell.

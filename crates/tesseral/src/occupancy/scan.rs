@@ -235,9 +235,7 @@ impl OccupancyMap {
         }
         if let Some(cast) = pending {
             let stats = self.apply_cast(cast);
-            self.store.repatch(self.fixed);
-            self.store.tidy();
-            self.store.settle();
+            self.store.pack(self.fixed);
             each(self, stats)?;
         }
         Ok(())

@@ -117,6 +117,17 @@ impl Store {
         self.arenas.iter_mut().for_each(|a| a.limit = units);
     }
 
+    /// Ends a batch of scans: [`repatch`](Self::repatch), [`tidy`](Self::tidy),
+    /// then [`settle`](Self::settle).
+    ///
+    /// # Runtime
+    /// That of the three.
+    pub fn pack(&mut self, fixed: Fixed) {
+        self.repatch(fixed);
+        self.tidy();
+        self.settle();
+    }
+
     /// Compacts each arena in which more than an eighth of the bytes hold no
     /// block (free chunks and room reserved for growth, more than a few KiB), and
     /// trims the tables' room for growth past an eighth: called at the end of a
