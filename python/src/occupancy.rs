@@ -114,9 +114,11 @@ impl OccupancyMap {
     /// Inserts scans in order, as a loop of `insert_scan` would, each given as an
     /// `(origin, points)` pair: each scan is cast while the one before it is written
     /// into the map, so several threads are kept busy. Returns one dict of counts per
-    /// scan. At the end the map's storage is compacted where an eighth of it holds
-    /// nothing, so it may take fewer bytes than after the loop. Every scan's work is checked against `max_cells` before any is cast
-    /// (ValueError naming the scan).
+    /// scan. At the end the map's storage is packed as `shrink_to_fit` packs it
+    /// (patched palettes where smaller, arenas compacted where an eighth holds
+    /// nothing), so it may take fewer bytes than after the loop. Every scan's work
+    /// is checked against `max_cells` before any is cast (ValueError naming the
+    /// scan).
     #[pyo3(signature = (scans, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
     fn insert_scans<'py>(
         &mut self,

@@ -336,7 +336,8 @@ impl Store {
             }
         }
         let occupied = any_occupied(census.values.iter().copied(), fixed);
-        let patch = Patch::of(census).filter(|_| may_patch);
+        // A scan's update leaves the patch to `repatch`: not even counted here.
+        let patch = if may_patch { Patch::of(census) } else { None };
         let (tag, units) = choose(
             census.known,
             census.values.len(),
@@ -427,7 +428,7 @@ impl Store {
                         }
                         _ => {}
                     }
-                    if w >= 4 {
+                    if wide(t) {
                         self.note_pending(s);
                     }
                 } else {

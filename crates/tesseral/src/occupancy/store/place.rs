@@ -171,11 +171,12 @@ impl Store {
     /// # Runtime
     /// O(n log n + 512 n) for n blocks noted.
     pub fn repatch(&mut self, fixed: Fixed) {
+        // Taken, not cleared: a batch's notes may be many, and their room goes too.
         let mut pending = std::mem::take(&mut self.pending);
         pending.sort_unstable();
         pending.dedup();
         let mut cells = [0i16; BLOCK_CELLS];
-        for &s in &pending {
+        for s in pending {
             let s = s as usize;
             let e = self.tables[s];
             let tag = e.tag();
@@ -188,8 +189,6 @@ impl Store {
             decode(tag, self.words_of(e), &mut cells);
             self.put_census(s, &cells, &Census::of(&cells), fixed, true);
         }
-        // Its room dropped: a batch's notes may be many.
-        drop(pending);
     }
 
     /// Moves every block of arena `a` to a new arena, in table order, leaving no
