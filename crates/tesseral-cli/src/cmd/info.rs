@@ -206,6 +206,9 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
 }
 
 pub fn run(args: Args) -> Result<()> {
+    if !(args.tree || args.codes) && super::info_map::is_map_file(&args.file) {
+        return super::info_map::run(&args.file, args.json);
+    }
     if !(args.tree || args.codes) {
         if let Some((info, bbox)) = streamed(&args.file)? {
             return print(&args, &info, bbox);

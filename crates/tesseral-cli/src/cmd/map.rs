@@ -15,7 +15,8 @@
 //! With `--json` one object is printed with exactly the keys `scans`, `points`,
 //! `rays`, `occupied`, `free`, `leaves`, `bytes`, `seconds` (the insertion time,
 //! reading and writing excluded, as `graph2tree` reports it), `rays_per_second`,
-//! and `skipped` (points with a NaN or infinite coordinate, not cast: `points` is
+//! and `skipped` (points with a NaN or infinite coordinate, or whose ray would end
+//! past ±2^61 cells, not cast: `points` is
 //! `rays + skipped`).
 
 use std::io::IsTerminal;
@@ -238,7 +239,10 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
         crate::outln!("{v}")?;
     } else {
         let skipped = if t.skipped > 0 {
-            format!(" ({} skipped: NaN or infinite)", t.skipped)
+            format!(
+                " ({} skipped: NaN, infinite, or past ±2^61 cells)",
+                t.skipped
+            )
         } else {
             String::new()
         };
@@ -265,11 +269,12 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
 }
 
 /// Writes the map: `.bt` and `.ot` straight from its blocks (no model in between;
-/// the same bytes), any other format through its model.
+/// the same bytes), `.tess` as the map's own file when it is wider than a model
+/// holds (2^21 cells on an axis), any other format through its model.
 fn write_map(map: &OccupancyMap, path: &Path, out: &OutArgs) -> Result<()> {
     let context = || format!("{}: the map cannot be written", path.display());
     let ext = out.format_of(path);
-    match map.encode_octomap(&ext) {
+    match map.encode_direct(&ext) {
         Some(bytes) => octree::save_encoded(path, &ext, &bytes.with_context(context)?, out),
         None => {
             let model = map.to_model().with_context(context)?;

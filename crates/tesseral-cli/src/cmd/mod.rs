@@ -8,6 +8,7 @@ pub mod collide;
 pub mod convert;
 pub mod help;
 pub mod info;
+pub mod info_map;
 pub mod map;
 pub mod octree;
 pub mod op;

@@ -231,3 +231,51 @@ fn a_map_beyond_octomap_keys_is_refused_in_bt_and_kept_in_tess() {
     assert_eq!(info["voxels"], 1);
     assert_eq!(info["free_voxels"], 200_000);
 }
+
+#[test]
+fn a_map_wider_than_a_model_is_kept_whole_in_its_own_tess() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 3,000,000 cells apart at 1 m: past a model's 2^21 cells on an axis.
+    fs::write(
+        d.join("wide.log"),
+        "NODE 0.5 0.5 0.5 0 0 0\n1 0 0\nNODE 3000000.5 0.5 0.5 0 0 0\n1 0 0\n",
+    )
+    .unwrap();
+    let v = json(
+        d,
+        &[
+            "map",
+            "wide.log",
+            "-o",
+            "wide.tess",
+            "--resolution",
+            "1",
+            "--json",
+        ],
+    );
+    assert_eq!(
+        (v["occupied"].as_u64(), v["free"].as_u64()),
+        (Some(2), Some(2))
+    );
+    let info = json(d, &["info", "--json", "wide.tess"]);
+    assert_eq!(info["kind"], "occupancy_map");
+    assert_eq!(
+        (info["voxels"].as_u64(), info["blocks"].as_u64()),
+        (Some(2), Some(2))
+    );
+    assert_eq!(info["bbox_max"][0], 3_000_007);
+    assert_eq!(info["threshold"], 0.5);
+    // Every command that needs a model says why it cannot have one, and what reads it.
+    fails(
+        d,
+        &["render", "wide.tess", "-o", "wide.png", "--size", "8x8"],
+        "wider than a model holds (2^21 cells on an axis), in the map's own .tess",
+    );
+    fails(
+        d,
+        &["convert", "wide.tess", "wide.bt"],
+        "tesseral.OccupancyMap.read",
+    );
+    assert!(!d.join("wide.png").exists() && !d.join("wide.bt").exists());
+}

@@ -26,7 +26,7 @@ pub mod binvox;
 mod chunked;
 pub(crate) mod colour_index;
 mod estimate;
-mod leafstream;
+pub(crate) mod leafstream;
 pub mod mesh;
 pub mod native;
 pub mod octomap;

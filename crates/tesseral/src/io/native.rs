@@ -79,6 +79,25 @@ use crate::model::Model;
 
 /// The eight bytes every `.tess` file starts with.
 pub const MAGIC: [u8; 8] = *b"\x89TESSRL\n";
+/// The eight bytes an occupancy map's own `.tess` starts with: a map too wide for a
+/// model (past 2^21 cells on an axis), written by
+/// [`OccupancyMap::write_file`](crate::occupancy::OccupancyMap::write_file) and read
+/// by [`OccupancyMap::read_file`](crate::occupancy::OccupancyMap::read_file).
+pub const MAP_MAGIC: [u8; 8] = *b"\x89TESSOM\n";
+
+/// The error for bytes that do not start with [`MAGIC`]: a map's own `.tess` is
+/// named as such (it holds more than a model can).
+pub(crate) fn not_a_model(bytes: &[u8]) -> FormatError {
+    if bytes.starts_with(&MAP_MAGIC) {
+        FormatError::unsupported(
+            "an occupancy map wider than a model holds (2^21 cells on an axis), in the map's \
+             own .tess: read it as a map (OccupancyMap::read_file, Python \
+             tesseral.OccupancyMap.read)",
+        )
+    } else {
+        FormatError::corrupt("not a tesseral .tess file (bad magic number)")
+    }
+}
 /// The version this code writes: chunked, with an index.
 pub const VERSION: u16 = VERSION_CHUNKED;
 /// The first version, with the leaves in one payload: still read, and written by
@@ -195,7 +214,7 @@ pub fn write_v1(w: &mut dyn Write, model: &Model) -> io::Result<()> {
 pub fn decode(bytes: &[u8]) -> Result<Model, FormatError> {
     let bad = |m: String| FormatError::corrupt(m);
     if bytes.len() < 8 || bytes[..8] != MAGIC {
-        return Err(bad("not a tesseral .tess file (bad magic number)".into()));
+        return Err(not_a_model(bytes));
     }
     if bytes.len() < 10 {
         return Err(bad("truncated: no version after the magic number".into()));

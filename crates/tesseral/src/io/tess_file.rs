@@ -179,9 +179,7 @@ impl TessFile {
     fn from_body_with(bytes: Bytes, path: &Path, lazy: bool) -> Result<Self, FormatError> {
         let err = |e: FormatError| e.with_path(path);
         if bytes.len() < 10 || bytes[..8] != super::native::MAGIC {
-            return Err(err(FormatError::corrupt(
-                "not a tesseral .tess file (bad magic number)",
-            )));
+            return Err(err(super::native::not_a_model(&bytes)));
         }
         let version = u16::from_le_bytes([bytes[8], bytes[9]]);
         if version != super::native::VERSION {

@@ -8,6 +8,16 @@ use crate::model::{Frame, Layer, Model};
 use crate::Voxel;
 
 impl OccupancyMap {
+    /// Whether the map fits a model ([`to_model`](Self::to_model)): its blocks span
+    /// at most 2^21 cells on each axis (anywhere in the `i64` range). A map past
+    /// that is written as its own `.tess` ([`encode_tess_map`](Self::encode_tess_map)).
+    #[must_use]
+    pub fn fits_model(&self) -> bool {
+        self.store
+            .cell_bounds()
+            .is_none_or(|(lo, hi)| space(lo, hi).is_ok())
+    }
+
     /// The map as a model: frame of voxel size `resolution` with voxel `(0, 0, 0)` at
     /// the world origin; tree = occupied cells; `free` = free cells; `log_odds` =
     /// every known cell's log-odds. The space is an aligned cube holding the map's
@@ -154,7 +164,8 @@ fn space(lo: [i64; 3], hi: [i64; 3]) -> Result<(u8, [i64; 3]), OccupancyError> {
     let least = u8::try_from(extent.next_power_of_two().trailing_zeros()).unwrap_or(u8::MAX);
     if least > MAX_DEPTH {
         return Err(OccupancyError::Model(format!(
-            "the map spans {extent} cells, more than a model holds (2^{MAX_DEPTH})"
+            "the map spans {extent} cells, more than a model holds (2^{MAX_DEPTH}); \
+             its own .tess keeps it whole (OccupancyMap::write_file)"
         )));
     }
     for d in least..OCTOMAP_DEPTH {

@@ -7,7 +7,8 @@
 //! crosses are missed and the point's cell is hit; a cell both hit and missed in one
 //! scan is only hit; each cell is updated at most once per scan; a point beyond the
 //! maximum range clears its ray up to that range and records no hit; NaN and
-//! infinite points are skipped and counted.
+//! infinite points, and rays that would end past ±2^61 cells, are skipped and
+//! counted.
 //!
 //! # Layout
 //! Cell keys are `i64` per axis, so the map is unbounded. Cells are grouped in
@@ -43,6 +44,7 @@ mod scan;
 mod scan_order;
 mod sensor;
 mod store;
+mod tess_map;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
@@ -59,6 +61,8 @@ mod tests_map;
 mod tests_ray;
 #[cfg(test)]
 mod tests_store;
+#[cfg(test)]
+mod tests_tess_map;
 mod work;
 
 pub use sensor::{log_odds, probability, Pose, SensorModel};
@@ -116,7 +120,9 @@ pub struct ScanStats {
     pub points: u64,
     /// Rays cast (points that are finite).
     pub rays: u64,
-    /// Points skipped because a coordinate is NaN or infinite.
+    /// Points skipped: a coordinate NaN or infinite, or the ray's end (the point,
+    /// or where the maximum range cuts the ray) past ±2^61 cells on an axis (or
+    /// every point, for such a sensor origin).
     pub skipped: u64,
     /// Cells updated as hits (each once).
     pub hits: u64,
@@ -329,6 +335,14 @@ impl OccupancyMap {
     #[must_use]
     pub fn block_count(&self) -> usize {
         self.store.block_count()
+    }
+
+    /// The lowest and highest cells of the box of the map's blocks (whole 8³
+    /// blocks, so it may reach up to 7 cells past the known ones); `None` when the
+    /// map is empty.
+    #[must_use]
+    pub fn block_bounds(&self) -> Option<([i64; 3], [i64; 3])> {
+        self.store.cell_bounds()
     }
 
     /// Bytes held by the map (capacities, not lengths).

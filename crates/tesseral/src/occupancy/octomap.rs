@@ -4,6 +4,7 @@
 use std::path::Path;
 
 use super::{OccupancyError, OccupancyMap};
+use crate::io::native::MAP_MAGIC;
 use crate::io::octomap::stream::{Kind, Piece, Writer, UNSET_RGB};
 use crate::io::octomap::{bt_file, in_key_range, ot_file, KEY_ORIGIN, OCTOMAP_DEPTH};
 use crate::io::FormatError;
@@ -54,23 +55,63 @@ impl OccupancyMap {
         }
     }
 
-    /// Writes the map, atomically, in the format named by the extension: `.bt` and
-    /// `.ot` straight from its blocks ([`encode_octomap`](Self::encode_octomap)),
-    /// any other through [`to_model`](Self::to_model).
+    /// The map's file bytes in format `ext` where they come straight from its
+    /// blocks: OctoMap's `.bt` and `.ot` ([`encode_octomap`](Self::encode_octomap)),
+    /// and its own `.tess` ([`encode_tess_map`](Self::encode_tess_map)) for a map
+    /// that does not [fit a model](Self::fits_model); `None` for any other, which
+    /// is written through [`to_model`](Self::to_model).
+    ///
+    /// # Errors
+    /// As [`encode_bt`](Self::encode_bt).
+    pub fn encode_direct(&self, ext: &str) -> Option<Result<Vec<u8>, OccupancyError>> {
+        match ext {
+            "tess" if !self.fits_model() => Some(Ok(self.encode_tess_map())),
+            _ => self.encode_octomap(ext),
+        }
+    }
+
+    /// Writes the map, atomically, in the format named by the extension: `.bt`,
+    /// `.ot`, and `.tess` of a map wider than a model, straight from its blocks
+    /// ([`encode_direct`](Self::encode_direct)); any other through
+    /// [`to_model`](Self::to_model).
     ///
     /// # Errors
     /// [`FormatError::Unsupported`] for a map the format cannot hold (past
-    /// OctoMap's keys; past a model's extent), named with the path; the errors of
-    /// [`crate::io::write_model`].
+    /// OctoMap's keys; past a model's extent, in a format other than `.tess`),
+    /// named with the path; the errors of [`crate::io::write_model`].
     pub fn write_file(&self, path: &Path) -> Result<(), FormatError> {
         let cannot = |e: OccupancyError| FormatError::unsupported(e.to_string()).with_path(path);
-        match self.encode_octomap(&crate::io::extension(path)) {
+        match self.encode_direct(&crate::io::extension(path)) {
             Some(bytes) => {
                 let bytes = bytes.map_err(cannot)?;
                 crate::io::write_atomic(path, |w| w.write_all(&bytes))
             }
             None => crate::io::write_model(path, &self.to_model().map_err(cannot)?),
         }
+    }
+
+    /// Reads a map: a map's own `.tess` ([`decode_tess_map`](Self::decode_tess_map)),
+    /// or any model file ([`from_model`](Self::from_model): OctoMap's sensor model).
+    ///
+    /// # Errors
+    /// The reader's [`FormatError`], named with the path;
+    /// [`FormatError::Unsupported`] for a model that is no map (see
+    /// [`from_model`](Self::from_model)).
+    pub fn read_file(path: &Path) -> Result<Self, FormatError> {
+        let mut head = [0u8; 8];
+        let n = {
+            use std::io::Read;
+            let mut f =
+                std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
+            f.read(&mut head).unwrap_or(0)
+        };
+        if head[..n] == MAP_MAGIC {
+            let bytes = crate::io::read_limited(path, crate::io::MAX_FILE_BYTES)?;
+            return Self::decode_tess_map(&bytes).map_err(|e| e.with_path(path));
+        }
+        let model = crate::io::read_model(path)?;
+        Self::from_model(&model)
+            .map_err(|e| FormatError::unsupported(e.to_string()).with_path(path))
     }
 
     /// The data section of a `kind` file and its node count.

@@ -50,6 +50,47 @@ fn key_at(inv: f64, p: [f64; 3]) -> [i64; 3] {
     p.map(|c| floor(c * inv))
 }
 
+/// The farthest cell from 0 on an axis that a ray may reach, ±2^61: far past any
+/// sensor (10^17 m at 5 cm), with room for the walk's differences of keys in `i64`.
+const REACH: f64 = (1u64 << 61) as f64;
+
+/// Whether `p`'s cell lies within [`REACH`] on every axis (`inv` = 1 / resolution).
+#[inline]
+pub(super) fn within_reach(inv: f64, p: [f64; 3]) -> bool {
+    p.iter().all(|&c| (c * inv).abs() < REACH)
+}
+
+/// `|d|`, without overflow for offsets past 10^154 (where the squares would).
+#[inline]
+pub(super) fn length(d: [f64; 3]) -> f64 {
+    let n = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+    if n.is_finite() {
+        return n;
+    }
+    let m = d.iter().fold(0f64, |m, c| m.max(c.abs()));
+    let u = d.map(|c| c / m);
+    m * (u[0] * u[0] + u[1] * u[1] + u[2] * u[2]).sqrt()
+}
+
+/// Whether the ray from `origin` (within reach) to `p` is cast: `p`'s coordinates
+/// finite, and the ray's end (`p`, or where `max_range` cuts the ray) within
+/// [`REACH`]. Other points are skipped and counted.
+#[inline]
+pub(super) fn castable(inv: f64, origin: [f64; 3], p: &[f64; 3], max_range: Option<f64>) -> bool {
+    if !p.iter().all(|c| c.is_finite()) {
+        return false;
+    }
+    if within_reach(inv, *p) {
+        return true;
+    }
+    let Some(r) = max_range else {
+        return false;
+    };
+    let d = [0, 1, 2].map(|i| p[i] - origin[i]);
+    let n = length(d);
+    n > r && within_reach(inv, [0, 1, 2].map(|i| origin[i] + d[i] / n * r))
+}
+
 /// Casts a scan's rays at resolution `res` into per-thread scratches and puts their
 /// blocks in tesseral order. Reads nothing of the map, so that the next scan can be
 /// cast while this one is applied ([`OccupancyMap::insert_scans`]); given the blocks
@@ -68,7 +109,8 @@ pub(super) fn cast_scan(
         points: points.len() as u64,
         ..ScanStats::default()
     };
-    if !origin.iter().all(|c| c.is_finite()) {
+    let inv = 1.0 / res;
+    if !(origin.iter().all(|c| c.is_finite()) && within_reach(inv, origin)) {
         stats.skipped = stats.points;
         return Cast {
             scratches: Vec::new(),
@@ -77,14 +119,13 @@ pub(super) fn cast_scan(
         };
     }
     let max_range = max_range.filter(|r| *r >= 0.0);
-    let inv = 1.0 / res;
     let key = move |p: [f64; 3]| key_at(inv, p);
     let key_origin = key(origin);
     let block_of_origin = key_origin.map(|c| c >> BLOCK_LOG2);
     let rays = RayOrigin::new(origin, key_origin, res);
     let cast = |s: &mut Scratch, p: &[f64; 3]| {
         let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];
-        let norm = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
+        let norm = length(d);
         match max_range {
             Some(r) if norm > r => {
                 let end = [0, 1, 2].map(|i| origin[i] + d[i] / norm * r);
@@ -102,7 +143,7 @@ pub(super) fn cast_scan(
             }
         }
     };
-    let (order, skipped) = by_direction(origin, points);
+    let (order, skipped) = by_direction(origin, points, |p| castable(inv, origin, p, max_range));
     // Chunks of the rays in direction order, each with its own scratch: one for a
     // thread alone. With more threads, several per thread for balance (a chunk of
     // rays to far surfaces costs more than one to near ones): 16 per thread for a
@@ -251,7 +292,7 @@ impl OccupancyMap {
         origin: [f64; 3],
         pending: Option<&Cast>,
     ) -> Option<Arc<[u64]>> {
-        if !origin.iter().all(|c| c.is_finite()) {
+        if !(origin.iter().all(|c| c.is_finite()) && within_reach(1.0 / self.resolution, origin)) {
             return None;
         }
         debug_assert!(self.fixed.miss < 0, "a miss lowers a cell's value");

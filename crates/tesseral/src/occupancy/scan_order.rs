@@ -18,19 +18,23 @@ fn spread(x: u32) -> u32 {
     (x | x << 1) & 0x5555
 }
 
-/// The finite points, copied in the order of the direction of their ray (a cube map of
-/// 6 × 32 × 32 cells, each face in Morton order), and the number of points that are
-/// not finite. Rays in one direction cell cross the same blocks, so their masks stay
+/// The points `keep` takes (finite, within reach: `scan::castable`), copied in the
+/// order of the direction of their ray (a cube map of 6 × 32 × 32 cells, each face in
+/// Morton order), and the number of points it leaves out. Rays in one direction cell cross the same blocks, so their masks stay
 /// in cache, and a thread's share of the rays is a few cones, not the whole scene.
 /// The order changes no result: each ray only sets bits.
-pub(super) fn by_direction(origin: [f64; 3], points: &[[f64; 3]]) -> (Vec<[f64; 3]>, u64) {
+pub(super) fn by_direction(
+    origin: [f64; 3],
+    points: &[[f64; 3]],
+    keep: impl Fn(&[f64; 3]) -> bool + Sync,
+) -> (Vec<[f64; 3]>, u64) {
     const CELLS: usize = 6 * (FACE_SIDE * FACE_SIDE) as usize;
     const SKIP: u16 = CELLS as u16;
     let cell: Vec<u16> = points
         .par_iter()
         .with_min_len(4096)
         .map(|p| {
-            if !p.iter().all(|c| c.is_finite()) {
+            if !keep(p) {
                 return SKIP;
             }
             let d = [p[0] - origin[0], p[1] - origin[1], p[2] - origin[2]];

@@ -46,7 +46,7 @@ impl SensorModel {
     ///
     /// # Errors
     /// [`OccupancyError::Sensor`] unless `0 < p < 1` for each, `hit > 0.5`,
-    /// `miss < 0.5`, `clamp.0 ≤ threshold ≤ clamp.1`, and the clamps within
+    /// `miss < 0.5`, `clamp.0 < threshold < clamp.1`, and the clamps within
     /// log-odds ±15 (p within about 3·10⁻⁷ of 0 or 1).
     pub fn from_probabilities(
         hit: f64,
@@ -77,22 +77,64 @@ impl SensorModel {
                 "miss probability {miss} must be below 0.5"
             )));
         }
-        if !(clamp.0 <= threshold && threshold <= clamp.1) {
+        // Strictly inside: a lower clamp at the threshold would make every cell
+        // missed to the clamp read occupied (a cell is occupied at or above it).
+        if !(clamp.0 < threshold && threshold < clamp.1) {
             return Err(OccupancyError::Sensor(format!(
-                "clamps {}..{} must hold the threshold {threshold}",
+                "the threshold {threshold} must lie strictly between the clamps {} and {}",
                 clamp.0, clamp.1
             )));
         }
+        Self::from_log_odds(
+            log_odds(hit),
+            log_odds(miss),
+            (log_odds(clamp.0), log_odds(clamp.1)),
+            log_odds(threshold),
+        )
+    }
+
+    /// A model from its log-odds (as a map's `.tess` keeps it): `hit > 0`,
+    /// `miss < 0`, the threshold strictly between the clamps (also once in fixed
+    /// point), every value within ±15.
+    ///
+    /// # Errors
+    /// [`OccupancyError::Sensor`] naming the value at fault.
+    pub fn from_log_odds(
+        hit: f32,
+        miss: f32,
+        clamp: (f32, f32),
+        threshold: f32,
+    ) -> Result<Self, OccupancyError> {
+        let bad = |m: String| Err(OccupancyError::Sensor(m));
         let m = Self {
-            hit: log_odds(hit),
-            miss: log_odds(miss),
-            clamp_min: log_odds(clamp.0),
-            clamp_max: log_odds(clamp.1),
-            threshold: log_odds(threshold),
+            hit,
+            miss,
+            clamp_min: clamp.0,
+            clamp_max: clamp.1,
+            threshold,
         };
-        if m.clamp_min < -15.0 || m.clamp_max > 15.0 || m.hit > 15.0 || m.miss < -15.0 {
-            return Err(OccupancyError::Sensor(
-                "log-odds beyond ±15 (a probability too close to 0 or 1)".into(),
+        let all = [hit, miss, clamp.0, clamp.1, threshold];
+        if !all.iter().all(|l| l.is_finite() && l.abs() <= 15.0) {
+            return bad(format!(
+                "log-odds {all:?} must be finite and within ±15 \
+                 (a probability too close to 0 or 1)"
+            ));
+        }
+        if !(hit > 0.0 && miss < 0.0) {
+            return bad(format!(
+                "a hit must add log-odds (got {hit}) and a miss remove them (got {miss})"
+            ));
+        }
+        let f = Fixed::new(&m);
+        if !(clamp.0 < threshold
+            && threshold < clamp.1
+            && f.min < f.threshold
+            && f.threshold < f.max)
+        {
+            return bad(format!(
+                "the threshold (log-odds {threshold}) must lie strictly between the clamps \
+                 (log-odds {} and {})",
+                clamp.0, clamp.1
             ));
         }
         Ok(m)

@@ -371,3 +371,28 @@ fn insert_scans_gives_the_map_and_counts_of_a_loop_of_insert_scan() {
         }
     }
 }
+
+#[test]
+fn points_past_reach_are_skipped_and_huge_offsets_cut_at_the_range() {
+    // Past ±2^61 cells a point is skipped, not merged into the edge cell; a point
+    // 10^200 away (its squared length overflows) still clears its ray to the range.
+    let mut map = OccupancyMap::new(1.0, SensorModel::octomap()).unwrap();
+    let s = map.insert_scan([0.5; 3], &[[1e19, 0.5, 0.5], [5e30, 0.5, 0.5]], None);
+    assert_eq!((s.points, s.rays, s.skipped, s.hits), (2, 0, 2, 0));
+    let s = map.insert_scan([0.5; 3], &[[1e200, 0.5, 0.5]], Some(10.0));
+    assert_eq!((s.rays, s.skipped, s.hits), (1, 0, 0));
+    // Cells 0..=9 free, the cut end's cell not (as OctoMap's computeRayKeys).
+    assert_eq!(map.free_count(), 10);
+    assert_eq!(map.state([9, 0, 0]), CellState::Free);
+    assert_eq!(map.state([10, 0, 0]), CellState::Unknown);
+    // A sensor past reach: every point skipped, the map unchanged.
+    let s = map.insert_scan([1e19, 0.5, 0.5], &[[1e19 + 4.0, 0.5, 0.5]], None);
+    assert_eq!((s.rays, s.skipped), (0, 1));
+    assert_eq!(map.counts().leaves, 10);
+    // Just inside reach, a point far off is a ray like any other.
+    let edge = ((1u64 << 61) - 4096) as f64;
+    let s = map.insert_scan([edge - 3.5, 0.5, 0.5], &[[edge, 0.5, 0.5]], None);
+    assert_eq!((s.rays, s.hits), (1, 1));
+    assert_eq!(map.state([edge as i64, 0, 0]), CellState::Occupied);
+    map.assert_valid();
+}

@@ -1,12 +1,14 @@
 //! The work a scan asks for, known before it is cast: a budget check for rays that
 //! run far (a corrupt point a million kilometres away, a scan without a maximum range).
 
+use super::scan::{castable, length, within_reach};
 use super::OccupancyMap;
 
 /// An upper bound on what casting a scan costs, from its points alone.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ScanWork {
-    /// Rays that would be cast (points with finite coordinates).
+    /// Rays that would be cast (points with finite coordinates whose rays end
+    /// within ±2^61 cells).
     pub rays: u64,
     /// At most this many cells are crossed, summed over the rays (saturating).
     pub cells: u64,
@@ -33,16 +35,18 @@ impl OccupancyMap {
         max_range: Option<f64>,
     ) -> ScanWork {
         let mut w = ScanWork::default();
-        if !origin.iter().all(|c| c.is_finite()) {
+        let inv = 1.0 / self.resolution;
+        if !(origin.iter().all(|c| c.is_finite()) && within_reach(inv, origin)) {
             return w;
         }
-        let max_range = max_range.filter(|r| *r >= 0.0).unwrap_or(f64::INFINITY);
+        let max_range = max_range.filter(|r| *r >= 0.0);
         let mut cells = 0f64;
-        for p in points.iter().filter(|p| p.iter().all(|c| c.is_finite())) {
+        for p in points
+            .iter()
+            .filter(|p| castable(inv, origin, p, max_range))
+        {
             let d = [0, 1, 2].map(|i| p[i] - origin[i]);
-            let length = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
-                .sqrt()
-                .min(max_range);
+            let length = length(d).min(max_range.unwrap_or(f64::INFINITY));
             w.rays += 1;
             w.longest = w.longest.max(length);
             cells += cells_along(length, self.resolution);
@@ -99,10 +103,14 @@ mod tests {
         let w = one.scan_work([0.0; 3], &far, Some(10.0));
         assert_eq!(w.longest, 10.0);
         assert!(w.cells < 200, "{w:?}");
-        assert_eq!(
-            one.scan_work([0.0; 3], &[[1e300, 1e300, 0.0]], None).cells,
-            u64::MAX
-        );
+        // Past 2^61 cells a point is skipped, unless the range cuts its ray nearer.
+        let huge = [[1e300, 1e300, 0.0]];
+        assert_eq!(one.scan_work([0.0; 3], &huge, None), ScanWork::default());
+        let w = one.scan_work([0.0; 3], &huge, Some(1.0));
+        assert_eq!((w.rays, w.longest), (1, 1.0));
+        let w = one.scan_work([0.0; 3], &[[1e16, 1e16, 0.0]], None);
+        assert_eq!(w.rays, 1);
+        assert!(w.cells > 200_000_000_000_000_000, "{w:?}");
         assert_eq!(
             one.scan_work([f64::NAN; 3], &far, None),
             ScanWork::default()

@@ -6,7 +6,7 @@ use super::forms::{
     SPARSE_VALUES,
 };
 use super::patched;
-use super::{join, stored, BlockKey, Entry, Store, BLOCK_CELLS, BLOCK_LOG2};
+use super::{join, stored, BlockKey, Cells, Entry, Store, BLOCK_CELLS, BLOCK_LOG2};
 use crate::code;
 use crate::linear::sort::sort_by_u64;
 use crate::linear::Leaf;
@@ -167,6 +167,21 @@ impl Store {
                     f(Leaf::new(at | m as u64, 0), v);
                 }
             }
+        }
+    }
+
+    /// Calls `f` on every stored block and its 512 values (`UNKNOWN` for unknown
+    /// cells), in increasing key order (x, then y, then z).
+    ///
+    /// # Runtime
+    /// O(b log b + 512 b) for b blocks.
+    pub fn for_each_block(&self, mut f: impl FnMut(BlockKey, &Cells)) {
+        let mut blocks: Vec<(BlockKey, Entry)> = stored(&self.keys, &self.tables).collect();
+        blocks.sort_unstable_by_key(|&(b, _)| b);
+        let mut cells = [UNKNOWN; BLOCK_CELLS];
+        for (b, e) in blocks {
+            self.decode_entry(e, &mut cells);
+            f(b, &cells);
         }
     }
 
