@@ -1,22 +1,190 @@
 //! numpy arrays in and out: N×3 coordinate arrays without per-element Python work.
+//!
+//! Points (world coordinates) and cells (integer keys) are taken from anything
+//! `numpy.asarray` makes an N×3 array of numbers of: a float64 or int64 array is read
+//! where it lies, a float32 one is widened as it is read, and any other dtype, byte
+//! order or a list of tuples goes through `numpy.asarray` first. Errors name the
+//! argument and say what was expected and what came.
 
 use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray2};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
-/// An N×3 array as rows (one copy; any memory layout).
-pub fn rows<T: numpy::Element + Copy>(arr: &PyReadonlyArray2<'_, T>) -> PyResult<Vec<[T; 3]>> {
+/// An N×3 array as rows (one copy; any memory layout), each element converted.
+fn rows<T: numpy::Element + Copy, U>(
+    arr: &PyReadonlyArray2<'_, T>,
+    name: &str,
+    f: impl Fn(T) -> U,
+) -> PyResult<Vec<[U; 3]>> {
     let a = arr.as_array();
     if a.ncols() != 3 {
         return Err(PyValueError::new_err(format!(
-            "expected an N×3 array, got shape {:?}",
-            a.shape()
+            "{name}: expected an N×3 array, got an array of shape {}",
+            shape_text(a.shape())
         )));
     }
     if let Some(flat) = a.as_slice() {
-        return Ok(flat.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect());
+        return Ok(flat
+            .chunks_exact(3)
+            .map(|c| [f(c[0]), f(c[1]), f(c[2])])
+            .collect());
     }
-    Ok(a.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect())
+    Ok(a.rows()
+        .into_iter()
+        .map(|r| [f(r[0]), f(r[1]), f(r[2])])
+        .collect())
+}
+
+/// The rows of `obj` if it is a two-dimensional array of exactly `T` (native byte
+/// order), else None.
+fn rows_of<T: numpy::Element + Copy, U>(
+    obj: &Bound<'_, PyAny>,
+    name: &str,
+    f: impl Fn(T) -> U,
+) -> Option<PyResult<Vec<[U; 3]>>> {
+    let a = obj.downcast::<PyArray2<T>>().ok()?;
+    Some(match a.try_readonly() {
+        Ok(r) => rows(&r, name, f),
+        Err(e) => Err(PyValueError::new_err(format!("{name}: {e}"))),
+    })
+}
+
+/// A value as an error names it: "an array", "a list", "a str", ...
+fn describe(obj: &Bound<'_, PyAny>) -> String {
+    let n = obj
+        .get_type()
+        .name()
+        .map_or_else(|_| "object".to_owned(), |n| n.to_string());
+    match n.as_str() {
+        "ndarray" => "an array".to_owned(),
+        _ if n.starts_with(['a', 'e', 'i', 'o', 'u']) => format!("an {n}"),
+        _ => format!("a {n}"),
+    }
+}
+
+/// A shape as Python writes it: `(5,)`, `(5, 2)`.
+fn shape_text(shape: &[usize]) -> String {
+    match shape {
+        [n] => format!("({n},)"),
+        _ => format!(
+            "({})",
+            shape
+                .iter()
+                .map(usize::to_string)
+                .collect::<Vec<_>>()
+                .join(", ")
+        ),
+    }
+}
+
+/// `obj` as a numpy array of numbers, N×3 (a zero-length sequence is 0×3), and its
+/// dtype's kind ('b', 'i', 'u', 'f', ...).
+fn numeric<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<(Bound<'py, PyAny>, char)> {
+    let py = obj.py();
+    let np = py.import("numpy")?;
+    let arr = np.call_method1("asarray", (obj,)).map_err(|e| {
+        PyValueError::new_err(format!(
+            "{name}: expected an N×3 array of numbers, got {} that numpy cannot make \
+             one array of: {}",
+            describe(obj),
+            e.value(py)
+        ))
+    })?;
+    let dtype = arr.getattr("dtype")?;
+    let kind: char = dtype.getattr("kind")?.extract()?;
+    if !matches!(kind, 'i' | 'u' | 'f') {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: expected an N×3 array of numbers, got {} of dtype {}",
+            describe(obj),
+            dtype.str()?
+        )));
+    }
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape == [0] {
+        return Ok((arr.call_method1("reshape", (0, 3))?, kind));
+    }
+    if shape.len() != 2 || shape[1] != 3 {
+        return Err(PyValueError::new_err(format!(
+            "{name}: expected an N×3 array, got {} of shape {}",
+            describe(obj),
+            shape_text(&shape)
+        )));
+    }
+    Ok((arr, kind))
+}
+
+/// Points in world units: any N×3 array of numbers (integers converted to float64).
+pub fn points(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[f64; 3]>> {
+    if let Some(r) = rows_of::<f64, f64>(obj, name, |x| x) {
+        return r;
+    }
+    if let Some(r) = rows_of::<f32, f64>(obj, name, f64::from) {
+        return r;
+    }
+    let py = obj.py();
+    let (arr, _) = numeric(obj, name)?;
+    let f64s = arr.call_method1("astype", (numpy::dtype::<f64>(py),))?;
+    rows_of::<f64, f64>(&f64s, name, |x| x).expect("astype gives float64")
+}
+
+/// Integer coordinates (cells, voxels): any N×3 array of integers, or of floats that
+/// are all whole numbers in the range of int64 (anything else is refused, not
+/// rounded).
+pub fn cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
+    if let Some(r) = rows_of::<i64, i64>(obj, name, |x| x) {
+        return r;
+    }
+    let py = obj.py();
+    let (arr, kind) = numeric(obj, name)?;
+    let as_type = |t| arr.call_method1("astype", (t,));
+    // Each row back as i64, or the first value that is not one.
+    let checked = |rows: Vec<[f64; 3]>| -> PyResult<Vec<[i64; 3]>> {
+        // 2**63: the first float past int64.
+        const PAST: f64 = 9_223_372_036_854_775_808.0;
+        rows.iter()
+            .enumerate()
+            .map(|(i, r)| {
+                match r
+                    .iter()
+                    .find(|x| !(x.fract() == 0.0 && (-PAST..PAST).contains(*x)))
+                {
+                    Some(x) => Err(PyValueError::new_err(format!(
+                        "{name}: expected integers, got {x} in row {i} (a float array is \
+                         taken only when every value is a whole number within int64)"
+                    ))),
+                    None => Ok(r.map(|x| x as i64)),
+                }
+            })
+            .collect()
+    };
+    match kind {
+        'f' => {
+            let f64s = as_type(numpy::dtype::<f64>(py))?;
+            checked(rows_of::<f64, f64>(&f64s, name, |x| x).expect("astype gives float64")?)
+        }
+        'u' => {
+            let u64s = as_type(numpy::dtype::<u64>(py))?;
+            let r = rows_of::<u64, u64>(&u64s, name, |x| x).expect("astype gives uint64")?;
+            r.iter()
+                .enumerate()
+                .map(|(i, r)| {
+                    let mut out = [0i64; 3];
+                    for (o, &x) in out.iter_mut().zip(r) {
+                        *o = i64::try_from(x).map_err(|_| {
+                            PyValueError::new_err(format!(
+                                "{name}: {x} in row {i} is past the range of int64"
+                            ))
+                        })?;
+                    }
+                    Ok(out)
+                })
+                .collect()
+        }
+        _ => {
+            let i64s = as_type(numpy::dtype::<i64>(py))?;
+            rows_of::<i64, i64>(&i64s, name, |x| x).expect("astype gives int64")
+        }
+    }
 }
 
 /// Rows as an N×3 array: the vector is handed to numpy without a copy.

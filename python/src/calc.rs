@@ -2,22 +2,22 @@
 //! Codes are u64: 21 octal digits, coordinates 0 to 2**21 - 1 (add and sub wrap
 //! per axis, as the bounded space of Ahuja & Nash).
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tesseral::code::Space;
 
-use crate::arrays::{rows, to_array};
+use crate::arrays::{cells, to_array};
 
 const SIDE: u64 = 1 << 21;
 
-/// The codes of an N×3 array of coordinates in [0, 2**21): a uint64 array.
+/// The codes of an N×3 integer array of coordinates in [0, 2**21): a uint64 array.
 #[pyfunction]
 pub fn encode<'py>(
     py: Python<'py>,
-    coords: PyReadonlyArray2<'_, i64>,
+    coords: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<u64>>> {
-    let c = rows(&coords)?;
+    let c = cells(coords, "coords")?;
     if let Some(bad) = c
         .iter()
         .find(|p| p.iter().any(|&x| !(0..SIDE as i64).contains(&x)))

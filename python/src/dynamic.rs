@@ -1,14 +1,15 @@
 //! `tesseral.DynamicOctree`: Libes' unbounded octree, fed whole arrays at a time.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::dynamic::DynamicOctree as Tree;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
-use crate::arrays::{rows, to_array};
-use crate::occupancy::{check_work, DEFAULT_MAX_CELLS};
+use crate::arrays::{cells, points, to_array};
+use crate::errors::{borrow, borrow_mut};
+use crate::scans::{check_work, max_range, origin, DEFAULT_MAX_CELLS};
 
 /// An unbounded dynamic octree of voxels (i64 coordinates), with the surface-face
 /// list of the random-surface simulations.
@@ -16,6 +17,9 @@ use crate::occupancy::{check_work, DEFAULT_MAX_CELLS};
 pub struct DynamicOctree {
     tree: Tree,
 }
+
+/// What the class's borrows are called in their errors.
+const WHAT: &str = "DynamicOctree";
 
 #[pymethods]
 impl DynamicOctree {
@@ -26,58 +30,69 @@ impl DynamicOctree {
         }
     }
 
-    /// Inserts the voxels of an N×3 int64 array; returns how many were new.
-    fn insert(&mut self, py: Python<'_>, voxels: PyReadonlyArray2<'_, i64>) -> PyResult<u64> {
-        let v = rows(&voxels)?;
-        let t = &mut self.tree;
-        Ok(py.allow_threads(|| v.iter().map(|&p| u64::from(t.insert(p))).sum()))
+    /// Inserts the voxels of an N×3 integer array; returns how many were new.
+    fn insert(slf: &Bound<'_, Self>, voxels: &Bound<'_, PyAny>) -> PyResult<u64> {
+        let v = cells(voxels, "voxels")?;
+        let mut this = borrow_mut(slf, WHAT)?;
+        let t = &mut this.tree;
+        Ok(slf
+            .py()
+            .allow_threads(|| v.iter().map(|&p| u64::from(t.insert(p))).sum()))
     }
 
-    /// Removes the voxels of an N×3 int64 array; returns how many were present.
-    fn remove(&mut self, py: Python<'_>, voxels: PyReadonlyArray2<'_, i64>) -> PyResult<u64> {
-        let v = rows(&voxels)?;
-        let t = &mut self.tree;
-        Ok(py.allow_threads(|| v.iter().map(|&p| u64::from(t.remove(p))).sum()))
+    /// Removes the voxels of an N×3 integer array; returns how many were present.
+    fn remove(slf: &Bound<'_, Self>, voxels: &Bound<'_, PyAny>) -> PyResult<u64> {
+        let v = cells(voxels, "voxels")?;
+        let mut this = borrow_mut(slf, WHAT)?;
+        let t = &mut this.tree;
+        Ok(slf
+            .py()
+            .allow_threads(|| v.iter().map(|&p| u64::from(t.remove(p))).sum()))
     }
 
-    /// Whether each voxel of an N×3 int64 array is present: a bool array.
+    /// Whether each voxel of an N×3 integer array is present: a bool array.
     fn contains<'py>(
-        &self,
-        py: Python<'py>,
-        voxels: PyReadonlyArray2<'_, i64>,
+        slf: &Bound<'py, Self>,
+        voxels: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let v = rows(&voxels)?;
-        let t = &self.tree;
-        let out: Vec<bool> = py.allow_threads(|| v.iter().map(|&p| t.contains(p)).collect());
-        Ok(out.into_pyarray(py))
+        let v = cells(voxels, "voxels")?;
+        let this = borrow(slf, WHAT)?;
+        let t = &this.tree;
+        let out: Vec<bool> = slf
+            .py()
+            .allow_threads(|| v.iter().map(|&p| t.contains(p)).collect());
+        Ok(out.into_pyarray(slf.py()))
     }
 
     /// Inserts one range scan, as a binary map: the cells the ray from `origin` to each
     /// point crosses are cleared and each point's own cell is set (a cell both hit and
     /// crossed in one scan is set), with OctoMap's `insertPointCloud` ray rules (see
     /// `OccupancyMap.insert_scan`). Coordinates are in voxels: voxel i spans [i, i+1).
-    /// A point beyond `max_range` clears its ray up to `max_range` and sets nothing.
-    /// Returns the scan's counts plus `inserted` and `removed` (voxels that changed).
-    /// A scan whose rays may cross more than `max_cells` voxels in all is refused
-    /// (ValueError) before any is cast.
-    #[pyo3(signature = (origin, points, max_range = None, max_cells = DEFAULT_MAX_CELLS))]
+    /// A point beyond `max_range` (None, or a positive number) clears its ray up to
+    /// `max_range` and sets nothing. Returns the scan's counts plus `inserted` and
+    /// `removed` (voxels that changed). A scan whose rays may cross more than
+    /// `max_cells` voxels in all is refused (ValueError) before any is cast.
+    #[pyo3(signature = (origin, points, max_range = None, max_cells = DEFAULT_MAX_CELLS),
+           text_signature = "(self, origin, points, max_range=None, max_cells=10000000000)")]
     fn insert_scan<'py>(
-        &mut self,
-        py: Python<'py>,
-        origin: [f64; 3],
-        points: PyReadonlyArray2<'_, f64>,
+        slf: &Bound<'py, Self>,
+        origin: &Bound<'py, PyAny>,
+        points: &Bound<'py, PyAny>,
         max_range: Option<f64>,
         max_cells: u64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let pts = rows(&points)?;
+        let py = slf.py();
+        let (o, pts) = (self::origin(origin)?, self::points(points, "points")?);
+        let max_range = self::max_range(max_range)?;
         // One scan in a fresh map at unit resolution: hit cells end with a positive
         // log-odds and crossed ones with a negative one.
         let mut map = OccupancyMap::new(1.0, SensorModel::octomap())
             .map_err(|e| PyValueError::new_err(e.to_string()))?;
-        check_work(&map, origin, &pts, max_range, max_cells)?;
-        let t = &mut self.tree;
+        check_work(&map, o, &pts, max_range, max_cells)?;
+        let mut this = borrow_mut(slf, WHAT)?;
+        let t = &mut this.tree;
         let (s, inserted, removed) = py.allow_threads(|| {
-            let s = map.insert_scan(origin, &pts, max_range);
+            let s = map.insert_scan(o, &pts, max_range);
             let (mut inserted, mut removed) = (0u64, 0u64);
             for (cell, l) in map.cells() {
                 if l > 0.0 {
@@ -88,33 +103,35 @@ impl DynamicOctree {
             }
             (s, inserted, removed)
         });
-        let d = crate::occupancy::stats_dict(py, &s)?;
+        let d = crate::scans::stats_dict(py, &s)?;
         d.set_item("inserted", inserted)?;
         d.set_item("removed", removed)?;
         Ok(d)
     }
 
     /// Every voxel, N×3 int64.
-    fn voxels<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyArray2<i64>>> {
-        let t = &self.tree;
-        let v = py.allow_threads(|| t.voxels());
-        to_array(py, v)
+    fn voxels<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyArray2<i64>>> {
+        let this = borrow(slf, WHAT)?;
+        let t = &this.tree;
+        let v = slf.py().allow_threads(|| t.voxels());
+        to_array(slf.py(), v)
     }
 
     /// The number of exposed voxel faces (the surface).
     #[getter]
-    fn face_count(&self) -> usize {
-        self.tree.face_count()
+    fn face_count(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(borrow(slf, WHAT)?.tree.face_count())
     }
 
-    fn __len__(&self) -> usize {
-        self.tree.voxel_count() as usize
+    fn __len__(slf: &Bound<'_, Self>) -> PyResult<usize> {
+        Ok(borrow(slf, WHAT)?.tree.voxel_count() as usize)
     }
 
     /// Counts and memory: voxels, faces, nodes, bytes, expansions, contractions.
-    fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let t = &self.tree;
-        let d = PyDict::new(py);
+    fn stats<'py>(slf: &Bound<'py, Self>) -> PyResult<Bound<'py, PyDict>> {
+        let this = borrow(slf, WHAT)?;
+        let t = &this.tree;
+        let d = PyDict::new(slf.py());
         d.set_item("voxels", t.voxel_count())?;
         d.set_item("faces", t.face_count())?;
         d.set_item("nodes", t.node_count())?;
@@ -124,11 +141,12 @@ impl DynamicOctree {
         Ok(d)
     }
 
-    fn __repr__(&self) -> String {
-        format!(
+    fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
+        let this = borrow(slf, WHAT)?;
+        Ok(format!(
             "DynamicOctree({} voxels, {} faces)",
-            self.tree.voxel_count(),
-            self.tree.face_count()
-        )
+            this.tree.voxel_count(),
+            this.tree.face_count()
+        ))
     }
 }

@@ -13,6 +13,7 @@ mod occupancy;
 mod octree;
 mod partition;
 mod rsmc;
+mod scans;
 mod scene;
 
 #[pymodule]
@@ -25,7 +26,7 @@ fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_class::<dynamic::DynamicOctree>()?;
     m.add_class::<occupancy::OccupancyMap>()?;
-    m.add_function(wrap_pyfunction!(occupancy::read_scans, m)?)?;
+    m.add_function(wrap_pyfunction!(scans::read_scans, m)?)?;
     m.add_function(wrap_pyfunction!(scene::render, m)?)?;
     m.add_function(wrap_pyfunction!(motion::collide, m)?)?;
     m.add_function(wrap_pyfunction!(motion::plan, m)?)?;

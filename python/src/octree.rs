@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray2, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray3};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use tesseral::linear::{Axis, LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
 
-use crate::arrays::{rows, to_array};
+use crate::arrays::{cells, points, to_array};
 use crate::errors;
 
 /// A voxel as Python sees it.
@@ -53,31 +53,27 @@ impl Octree {
 
 #[pymethods]
 impl Octree {
-    /// An octree of the voxels in an N×3 integer array (duplicates allowed), in the
-    /// smallest space that holds them; unit frame.
+    /// An octree of the voxels in an N×3 integer array (duplicates allowed; floats
+    /// only when whole numbers), in the smallest space that holds them; unit frame.
     #[staticmethod]
-    fn from_voxels(py: Python<'_>, voxels: PyReadonlyArray2<'_, i64>) -> PyResult<Octree> {
-        let v = rows(&voxels)?;
+    fn from_voxels(py: Python<'_>, voxels: &Bound<'_, PyAny>) -> PyResult<Octree> {
+        let v = cells(voxels, "voxels")?;
         let tree = py
             .allow_threads(|| LinearOctree::from_voxels_fitted(&v))
             .map_err(errors::octree)?;
         Ok(Octree::new(Model::new(tree)))
     }
 
-    /// The voxels of size `voxel_size` holding the points of an N×3 float array
+    /// The voxels of size `voxel_size` holding the points of an N×3 array of numbers
     /// (world units; voxel i spans [i·h, (i+1)·h)).
     #[staticmethod]
-    fn from_points(
-        py: Python<'_>,
-        points: PyReadonlyArray2<'_, f64>,
-        voxel_size: f64,
-    ) -> PyResult<Octree> {
+    fn from_points(py: Python<'_>, points: &Bound<'_, PyAny>, voxel_size: f64) -> PyResult<Octree> {
         if !(voxel_size.is_finite() && voxel_size > 0.0) {
             return Err(PyValueError::new_err(
                 "voxel_size must be positive and finite",
             ));
         }
-        let p = rows(&points)?;
+        let p = self::points(points, "points")?;
         let frame = Frame::new(voxel_size, [0.0; 3]);
         let tree = py.allow_threads(|| {
             let mut v = Vec::with_capacity(p.len());
@@ -354,13 +350,13 @@ impl Octree {
             .map_err(errors::octree)
     }
 
-    /// Whether each voxel of an N×3 int64 array is black: a bool array.
+    /// Whether each voxel of an N×3 integer array is black: a bool array.
     fn contains<'py>(
         &self,
         py: Python<'py>,
-        voxels: PyReadonlyArray2<'_, i64>,
+        voxels: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, PyArray1<bool>>> {
-        let v = rows(&voxels)?;
+        let v = cells(voxels, "voxels")?;
         let t = &self.model.tree;
         let out: Vec<bool> = py.allow_threads(|| v.iter().map(|&p| t.contains(p)).collect());
         Ok(out.into_pyarray(py))

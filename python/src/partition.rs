@@ -307,8 +307,7 @@ pub fn partition_write_part<'py>(
     tree: &Octree,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &tree.model;
-    std::fs::create_dir_all(&dir)
-        .map_err(|e| pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", dir.display())))?;
+    std::fs::create_dir_all(&dir).map_err(|e| errors::io(&e, Some(&dir)))?;
     let e = py
         .allow_threads(|| part::write_model_part(&dir, i, Partition { lo, hi }, m))
         .map_err(partition_error)?;

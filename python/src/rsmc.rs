@@ -1,7 +1,7 @@
 //! `tesseral.rsmc`: Monte Carlo of self-avoiding random surfaces (Libes §6), with the
 //! trajectory returned as numpy arrays.
 
-use numpy::{IntoPyArray, PyReadonlyArray2};
+use numpy::IntoPyArray;
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -9,21 +9,18 @@ use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{topology, Chain, Counters, DenseLattice, Lattice, Params, Sample};
 use tesseral::Voxel;
 
-use crate::arrays::{rows, to_array};
+use crate::arrays::{cells, to_array};
 
 /// The most rows a trajectory may hold, so that `steps / sample_every` is a budget
 /// checked before the run.
 const MAX_ROWS: u64 = 10_000_000;
 
-/// The start shape: `"voxel"`, `"box:AxBxC"`, or an N×3 int64 array of voxels.
+/// The start shape: `"voxel"`, `"box:AxBxC"`, or an N×3 integer array of voxels.
 fn start_voxels(start: &Bound<'_, PyAny>) -> PyResult<Vec<Voxel>> {
-    if let Ok(arr) = start.extract::<PyReadonlyArray2<'_, i64>>() {
-        return rows(&arr);
+    match start.extract::<String>() {
+        Ok(s) => tesseral::rsmc::parse_start(&s).map_err(|e| PyValueError::new_err(e.to_string())),
+        Err(_) => cells(start, "start"),
     }
-    let s: String = start.extract().map_err(|_| {
-        PyValueError::new_err("start: expected \"voxel\", \"box:AxBxC\" or an N×3 int64 array")
-    })?;
-    tesseral::rsmc::parse_start(&s).map_err(|e| PyValueError::new_err(e.to_string()))
 }
 
 /// Runs the chain for `steps` attempted steps, sampling every `sample_every`.

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use numpy::{IntoPyArray, PyArray3, PyArrayMethods};
-use pyo3::exceptions::PyValueError;
+use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyBytes;
 use tesseral::csg::Scene as CsgScene;
@@ -11,6 +11,7 @@ use tesseral::model::Model;
 use tesseral::render::{self as draw, Camera, Image, Projection, RenderOptions, View};
 
 use crate::errors;
+use crate::occupancy::OccupancyMap;
 use crate::octree::Octree;
 
 /// A parsed `.tss` scene (see docs/scenes.md).
@@ -35,9 +36,7 @@ impl Scene {
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Scene> {
         let scene = CsgScene::read(&path).map_err(|e| errors::scene(py, e))?;
         // It parsed, so it was read and is UTF-8.
-        let text = std::fs::read_to_string(&path).map_err(|e| {
-            pyo3::exceptions::PyOSError::new_err(format!("{}: {e}", path.display()))
-        })?;
+        let text = std::fs::read_to_string(&path).map_err(|e| errors::io(&e, Some(&path)))?;
         Ok(Scene { scene, text, path })
     }
 
@@ -211,12 +210,13 @@ pub fn png<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyBytes>> {
     Ok(PyBytes::new(py, &buf))
 }
 
-/// Renders an Octree or a Scene as an H×W×3 uint8 array. Keyword arguments are the
-/// CLI's options: size=(w, h), view ('iso', 'front', 'top', 'side'), azimuth,
-/// elevation, zoom, outline, shadows, perspective (field of view in degrees),
-/// background (r, g, b).
+/// Renders an Octree, a Scene or an OccupancyMap (its `to_octree()`) as an H×W×3
+/// uint8 array. Keyword arguments are the CLI's options: size=(w, h), view ('iso',
+/// 'front', 'top', 'side'), azimuth, elevation, zoom, outline, shadows, perspective
+/// (field of view in degrees), background (r, g, b).
 #[pyfunction]
-#[pyo3(signature = (obj, size = (800, 600), view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = (255, 255, 255)))]
+#[pyo3(signature = (obj, size = (800, 600), view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = (255, 255, 255)),
+       text_signature = "(obj, size=(800, 600), view='iso', azimuth=None, elevation=None, zoom=1.0, outline=False, shadows=True, perspective=None, background=(255, 255, 255))")]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
@@ -231,6 +231,16 @@ pub fn render<'py>(
     perspective: Option<f64>,
     background: (u8, u8, u8),
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
+    // What is drawn is checked first: a wrong object is a TypeError whatever the options.
+    let octree = obj.downcast::<Octree>().ok();
+    let scene = obj.downcast::<Scene>().ok();
+    let map = obj.downcast::<OccupancyMap>().ok();
+    if octree.is_none() && scene.is_none() && map.is_none() {
+        return Err(PyTypeError::new_err(format!(
+            "render takes an Octree, a Scene or an OccupancyMap, got {}",
+            obj.get_type().name()?
+        )));
+    }
     let view = View::parse(view).ok_or_else(|| {
         PyValueError::new_err(format!("view {view:?}: expected iso, front, top or side"))
     })?;
@@ -256,12 +266,16 @@ pub fn render<'py>(
         perspective,
         background: [background.0, background.1, background.2],
     };
-    let img = if let Ok(t) = obj.downcast::<Octree>() {
+    let img = if let Some(t) = octree {
         render_model(py, &t.get().model, &o)?
-    } else if let Ok(s) = obj.downcast::<Scene>() {
+    } else if let Some(s) = scene {
         render_scene(py, &s.get().scene, &o)?
     } else {
-        return Err(PyValueError::new_err("render takes an Octree or a Scene"));
+        let map = map.expect("checked above");
+        let this = errors::borrow(map, "OccupancyMap")?;
+        let m = &this.map;
+        let model = py.allow_threads(|| m.to_model()).map_err(errors::octree)?;
+        render_model(py, &model, &o)?
     };
     let (w, h) = (img.width, img.height);
     let flat: Vec<u8> = img.pixels.into_iter().flatten().collect();

@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, List, Optional, Sequence, Tuple, Union
+from typing import Any, Iterable, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -16,12 +16,18 @@ class OctreeError(ValueError): ...
 
 Vec3i = Tuple[int, int, int]
 Path = Union[str, PathLike[str]]
+# N×3 arrays in: any array-like of numbers (an array of any numeric dtype and byte
+# order, a list of rows); float64 and int64 arrays are read without a conversion.
+Points = npt.ArrayLike
+# Integer coordinates: integers, or floats that are all whole numbers.
+Cells = npt.ArrayLike
+Origin = Union[Sequence[float], npt.NDArray[np.floating[Any]]]
 
 class Octree:
     @staticmethod
-    def from_voxels(voxels: npt.NDArray[np.int64]) -> Octree: ...
+    def from_voxels(voxels: Cells) -> Octree: ...
     @staticmethod
-    def from_points(points: npt.NDArray[np.float64], voxel_size: float) -> Octree: ...
+    def from_points(points: Points, voxel_size: float) -> Octree: ...
     @staticmethod
     def from_dense(mask: npt.NDArray[np.bool_], origin: Vec3i = ...) -> Octree: ...
     @staticmethod
@@ -62,7 +68,7 @@ class Octree:
     def rotate(self, axis_name: str, turns: int) -> Octree: ...
     def mirror(self, axis_name: str) -> Octree: ...
     def scale(self, k: Union[int, Vec3i]) -> Octree: ...
-    def contains(self, voxels: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]: ...
+    def contains(self, voxels: Cells) -> npt.NDArray[np.bool_]: ...
     def mesh(self) -> Tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]: ...
     def _repr_png_(self) -> bytes: ...
 
@@ -83,9 +89,9 @@ class Scene:
 
 class DynamicOctree:
     def __init__(self) -> None: ...
-    def insert(self, voxels: npt.NDArray[np.int64]) -> int: ...
-    def remove(self, voxels: npt.NDArray[np.int64]) -> int: ...
-    def contains(self, voxels: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]: ...
+    def insert(self, voxels: Cells) -> int: ...
+    def remove(self, voxels: Cells) -> int: ...
+    def contains(self, voxels: Cells) -> npt.NDArray[np.bool_]: ...
     def voxels(self) -> npt.NDArray[np.int64]: ...
     @property
     def face_count(self) -> int: ...
@@ -93,67 +99,68 @@ class DynamicOctree:
     def stats(self) -> dict[str, int]: ...
     def insert_scan(
         self,
-        origin: Tuple[float, float, float],
-        points: npt.NDArray[np.float64],
-        max_range: Optional[float] = ...,
-        max_cells: int = ...,
+        origin: Origin,
+        points: Points,
+        max_range: Optional[float] = None,
+        max_cells: int = 10_000_000_000,
     ) -> dict[str, int]: ...
 
 class OccupancyMap:
     def __init__(
         self,
         resolution: float,
-        prob_hit: float = ...,
-        prob_miss: float = ...,
-        clamp: Tuple[float, float] = ...,
-        threshold: float = ...,
+        prob_hit: float = 0.7,
+        prob_miss: float = 0.4,
+        clamp: Tuple[float, float] = (0.1192, 0.971),
+        threshold: float = 0.5,
     ) -> None: ...
     def insert_scan(
         self,
-        origin: Tuple[float, float, float],
-        points: npt.NDArray[np.float64],
-        max_range: Optional[float] = ...,
-        max_cells: int = ...,
+        origin: Origin,
+        points: Points,
+        max_range: Optional[float] = None,
+        max_cells: int = 10_000_000_000,
     ) -> dict[str, int]: ...
     def insert_scans(
         self,
-        scans: Sequence[Tuple[Tuple[float, float, float], npt.NDArray[np.float64]]],
-        max_range: Optional[float] = ...,
-        max_cells: int = ...,
+        scans: Iterable[Sequence[Any]],  # (origin, points) pairs
+        max_range: Optional[float] = None,
+        max_cells: int = 10_000_000_000,
     ) -> List[dict[str, int]]: ...
-    def state(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.uint8]: ...
-    def log_odds(self, cells: npt.NDArray[np.int64]) -> npt.NDArray[np.float32]: ...
-    def cells_of(self, points: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]: ...
+    def state(self, cells: Cells) -> npt.NDArray[np.uint8]: ...
+    def log_odds(self, cells: Cells) -> npt.NDArray[np.float32]: ...
+    def cells_of(self, points: Points) -> npt.NDArray[np.int64]: ...
     @property
     def resolution(self) -> float: ...
     def stats(self) -> dict[str, int]: ...
     def to_octree(self) -> Octree: ...
     def write(self, path: Path) -> None: ...
+    def shrink_to_fit(self) -> None: ...
     @staticmethod
     def from_octree(
         octree: Octree,
-        prob_hit: float = ...,
-        prob_miss: float = ...,
-        clamp: Tuple[float, float] = ...,
-        threshold: float = ...,
+        prob_hit: float = 0.7,
+        prob_miss: float = 0.4,
+        clamp: Tuple[float, float] = (0.1192, 0.971),
+        threshold: float = 0.5,
     ) -> OccupancyMap: ...
 
 def read_scans(
     path: Path,
-    origin: Optional[Tuple[float, float, float]] = ...,
-    pose: Optional[Tuple[float, float, float, float, float, float]] = ...,
+    origin: Optional[Origin] = None,
+    pose: Optional[Sequence[float]] = None,  # x, y, z, roll, pitch, yaw
 ) -> List[Tuple[Tuple[float, float, float], npt.NDArray[np.float64]]]: ...
 def render(
-    obj: Union[Octree, Scene],
-    size: Tuple[int, int] = ...,
-    view: str = ...,
-    azimuth: Optional[float] = ...,
-    elevation: Optional[float] = ...,
-    zoom: float = ...,
-    outline: bool = ...,
-    shadows: bool = ...,
-    perspective: Optional[float] = ...,
-    background: Tuple[int, int, int] = ...,
+    obj: Union[Octree, Scene, OccupancyMap],
+    size: Tuple[int, int] = (800, 600),
+    view: str = "iso",
+    azimuth: Optional[float] = None,
+    elevation: Optional[float] = None,
+    zoom: float = 1.0,
+    outline: bool = False,
+    shadows: bool = True,
+    perspective: Optional[float] = None,
+    background: Tuple[int, int, int] = (255, 255, 255),
 ) -> npt.NDArray[np.uint8]: ...
 def collide(a: Octree, b: Octree, offset: Vec3i = ..., turns: str = ...) -> dict[str, Any]: ...
 def plan(
@@ -172,12 +179,12 @@ def rsmc(
     mu: float = ...,
     max_area: Optional[int] = ...,
     seed: int = ...,
-    start: Union[str, npt.NDArray[np.int64], None] = ...,
+    start: Union[str, Cells, None] = ...,
     libes: bool = ...,
     sample_every: int = ...,
     backend: str = ...,
 ) -> dict[str, Any]: ...
-def encode(coords: npt.NDArray[np.int64]) -> npt.NDArray[np.uint64]: ...
+def encode(coords: Cells) -> npt.NDArray[np.uint64]: ...
 def decode(codes: npt.NDArray[np.uint64]) -> npt.NDArray[np.int64]: ...
 def add(a: npt.NDArray[np.uint64], b: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]: ...
 def sub(a: npt.NDArray[np.uint64], b: npt.NDArray[np.uint64]) -> npt.NDArray[np.uint64]: ...
