@@ -207,7 +207,10 @@ impl OccupancyMap {
 
     /// Writes the map, atomically, in the format named by the extension: `.bt`
     /// and `.ot` straight from its cells (the bytes of `to_octree().write(path)`,
-    /// without building the octree), any other format through `to_octree()`.
+    /// without building the octree), any other format through `to_octree()`. A
+    /// map wider than an octree holds (2^21 cells on an axis) is written to `.tess`
+    /// as the map's own file, which keeps the full range: `OccupancyMap.read`
+    /// reads it back.
     fn write(slf: &Bound<'_, Self>, path: PathBuf) -> PyResult<()> {
         let this = borrow(slf, WHAT)?;
         let m = &this.map;
@@ -236,6 +239,16 @@ impl OccupancyMap {
         py.allow_threads(|| Map::from_model_with(model, sensor))
             .map(|map| Self { map })
             .map_err(value_error)
+    }
+
+    /// Reads a map from a file: a map's own `.tess` (a map wider than an octree,
+    /// with its sensor model), or any octree file as `from_octree` reads it
+    /// (OctoMap's sensor model).
+    #[staticmethod]
+    fn read(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        py.allow_threads(|| Map::read_file(&path))
+            .map(|map| Self { map })
+            .map_err(crate::errors::format)
     }
 
     /// Packs the map's storage as the end of `insert_scans` does (for a map built

@@ -225,3 +225,29 @@ def test_write_gives_the_bytes_of_the_octree_and_refuses_past_the_keys(tmp_path)
         far.write(tmp_path / "far.bt")
     assert not (tmp_path / "far.bt").exists()
     far.write(tmp_path / "far.tess")
+
+
+def test_a_map_wider_than_an_octree_keeps_its_range_and_reads_back(tmp_path):
+    m = t.OccupancyMap(0.5, prob_hit=0.8, threshold=0.6)
+    m.insert_scans(_room_scans())
+    # 3,000,000 cells off: past the 2^21 an octree holds on an axis.
+    m.insert_scan((1.5e6, 0.25, 0.25), np.array([[1.5e6 + 3.0, 0.25, 0.25]]))
+    with pytest.raises(Exception, match="more than a model holds"):
+        m.to_octree()
+    m.write(tmp_path / "wide.tess")
+    back = t.OccupancyMap.read(tmp_path / "wide.tess")
+    assert back.stats()["occupied"] == m.stats()["occupied"]
+    assert back.stats()["free"] == m.stats()["free"]
+    cells = m.cells_of(np.array([[1.5e6 + 3.0, 0.25, 0.25], [1.5e6 + 1.0, 0.25, 0.25], [0.0, 0.0, 0.0]]))
+    assert np.array_equal(back.log_odds(cells), m.log_odds(cells), equal_nan=True)
+    assert list(back.state(cells)) == list(m.state(cells))
+    # Read as an octree, it says what it is and what reads it.
+    with pytest.raises(Exception, match="OccupancyMap.read"):
+        t.Octree.read(tmp_path / "wide.tess")
+    # A map that fits an octree reads back from any octree file.
+    near = t.OccupancyMap(0.1)
+    near.insert_scans(_room_scans())
+    near.write(tmp_path / "near.ot")
+    assert t.OccupancyMap.read(tmp_path / "near.ot").stats()["occupied"] == near.stats()["occupied"]
+    with pytest.raises(FileNotFoundError):
+        t.OccupancyMap.read(tmp_path / "missing.tess")

@@ -217,6 +217,15 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     bar.finish_and_clear();
 
     write_map(&map, &args.output, &args.out)?;
+    if args.out.format_of(&args.output) == "ot" && (args.threshold - 0.5).abs() > 1e-12 {
+        eprintln!(
+            "warning: {}: an .ot keeps every cell's log-odds but not the threshold; \
+             OctoMap (and tesseral) read it as occupied from probability 0.5, where this \
+             map used {} (.bt and .tess keep the states as mapped)",
+            args.output.display(),
+            args.threshold
+        );
+    }
     let rate = if t.seconds > 0.0 {
         t.rays as f64 / t.seconds
     } else {

@@ -98,7 +98,7 @@ pub fn save(
     options: &tesseral::io::WriteOptions,
 ) -> Result<()> {
     let ext = out.format_of(path);
-    let estimate = tesseral::io::estimate_output_bytes(&model.tree, &ext);
+    let estimate = tesseral::io::estimate_model_bytes(model, &ext);
     if let Some(bytes) = estimate {
         output::check_size(path, bytes, out.limits.max_output)?;
     }

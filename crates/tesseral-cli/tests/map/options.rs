@@ -279,3 +279,80 @@ fn a_map_wider_than_a_model_is_kept_whole_in_its_own_tess() {
     );
     assert!(!d.join("wide.png").exists() && !d.join("wide.bt").exists());
 }
+
+#[test]
+fn an_ot_of_a_map_with_its_own_threshold_is_written_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("one.xyz"), "1.05 0.05 0.05\n").unwrap();
+    let args = |out: &'static str, threshold: &'static str| {
+        [
+            "map",
+            "one.xyz",
+            "--origin",
+            "0.05,0.05,0.05",
+            "-o",
+            out,
+            "--resolution",
+            "0.1",
+            "--threshold",
+            threshold,
+        ]
+    };
+    let out = run(d, &args("t.ot", "0.75"));
+    assert!(out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("warning: t.ot") && err.contains("not the threshold"),
+        "{err}"
+    );
+    for (file, threshold) in [("t.bt", "0.75"), ("d.ot", "0.5")] {
+        let out = run(d, &args(file, threshold));
+        assert!(out.status.success() && out.stderr.is_empty(), "{out:?}");
+    }
+}
+
+#[test]
+fn max_output_counts_the_free_space_and_log_odds_of_a_map() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("line.xyz"), "1000 0 0\n").unwrap();
+    // 20,000 free cells: their leaves and log-odds, not the one occupied cell, make
+    // the file's size.
+    fails(
+        d,
+        &[
+            "map",
+            "line.xyz",
+            "--origin",
+            "0,0,0",
+            "-o",
+            "k.tess",
+            "--resolution",
+            "0.05",
+            "--max-output",
+            "1K",
+        ],
+        "--max-output",
+    );
+    assert!(!d.join("k.tess").exists());
+    ok(
+        d,
+        &[
+            "map",
+            "line.xyz",
+            "--origin",
+            "0,0,0",
+            "-o",
+            "k.tess",
+            "--resolution",
+            "0.05",
+        ],
+    );
+    fails(
+        d,
+        &["convert", "k.tess", "k2.tess", "--max-output", "1K"],
+        "--max-output",
+    );
+    assert!(!d.join("k2.tess").exists());
+}

@@ -6,6 +6,7 @@
 //! the truth; for `.xyz` and `.tess` they are upper bounds.
 
 use crate::linear::LinearOctree;
+use crate::model::{Layer, LayerValue, Model};
 
 /// Bytes per leaf of a mesh file: a block has six faces of two triangles; binary STL
 /// stores 50 bytes per triangle, and OBJ/PLY/glTF spend about as much on shared
@@ -21,7 +22,7 @@ const MESH_BYTES_PER_LEAF: u64 = 12 * 50;
 /// | format | estimate |
 /// |---|---|
 /// | `.xyz` | one line per voxel, each as long as the widest coordinates allow (an upper bound) |
-/// | `.tess` | at most ten bytes per leaf, plus header, chunk headers and index (an upper bound; colours not counted) |
+/// | `.tess` | at most ten bytes per leaf, plus header, chunk headers and index (an upper bound for the voxels; [`estimate_model_bytes`] adds a model's layers) |
 /// | `.bt`, `.ot` | OctoMap nodes: at most 16 levels above each leaf, 2 (`.bt`) or 9 (`.ot`) bytes each |
 /// | `.binvox` | two bytes per run of the dense grid over the bounding box |
 /// | `.vox` | four bytes per voxel, plus the palette |
@@ -68,6 +69,50 @@ pub fn estimate_output_bytes(tree: &LinearOctree, ext: &str) -> Option<u64> {
         _ => return None,
     };
     Some(bytes)
+}
+
+/// [`estimate_output_bytes`] of a whole model: a `.tess` holds its layers too
+/// (colours, free space, log-odds: at most ten bytes a leaf and 16 a region, plus
+/// 64 bytes a colour region for its index), and OctoMap's `.bt` and `.ot` hold the
+/// free space beside the occupied cells (its leaves counted as the tree's). Other
+/// formats write the voxels only.
+///
+/// # Runtime
+/// O(n) in the number of leaves.
+///
+/// # Example
+/// ```
+/// use tesseral::io::{estimate_model_bytes, estimate_output_bytes};
+/// use tesseral::linear::LinearOctree;
+/// use tesseral::model::{Frame, Model};
+/// let tree = LinearOctree::from_voxels(4, [0, 0, 0], [[1, 2, 3]]).unwrap();
+/// let free = LinearOctree::from_voxels(4, [0, 0, 0], [[0, 0, 0], [5, 5, 5]]).unwrap();
+/// let model = Model::from_parts(tree.clone(), Frame::default(), None, Some(free), None).unwrap();
+/// let alone = estimate_output_bytes(&tree, "tess").unwrap();
+/// assert_eq!(estimate_model_bytes(&model, "tess"), Some(alone + 16 + 2 * 10));
+/// assert_eq!(estimate_model_bytes(&model, "xyz"), estimate_output_bytes(&tree, "xyz"));
+/// ```
+#[must_use]
+pub fn estimate_model_bytes(model: &Model, ext: &str) -> Option<u64> {
+    let base = estimate_output_bytes(&model.tree, ext)?;
+    let free = model.free.as_ref().map_or(0, |f| f.leaf_count() as u64);
+    fn layer<T: LayerValue>(l: Option<&Layer<T>>, per_region: u64) -> u64 {
+        l.map_or(0, |l| {
+            l.regions().iter().fold(16, |n: u64, (_, t)| {
+                n.saturating_add(per_region)
+                    .saturating_add((t.leaf_count() as u64).saturating_mul(10))
+            })
+        })
+    }
+    let more = match ext {
+        "tess" => (if model.free.is_some() { 16 } else { 0 } + free.saturating_mul(10))
+            .saturating_add(layer(model.log_odds.as_ref(), 16))
+            .saturating_add(layer(model.colors.as_ref(), 16 + 64)),
+        "bt" => free.saturating_mul(16 * 2),
+        "ot" => free.saturating_mul(16 * 9),
+        _ => 0,
+    };
+    Some(base.saturating_add(more))
 }
 
 /// The `.xyz` estimate of [`estimate_output_bytes`] from the voxel count and the

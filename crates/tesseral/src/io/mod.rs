@@ -50,7 +50,9 @@ mod staged;
 pub use atomic::{pending_temporaries, remove_pending_temporaries, write_atomic};
 pub use chunked::{ChunkInfo, TessWriter, DEFAULT_CHUNK_LEAVES};
 pub use error::FormatError;
-pub use estimate::{estimate_image_bytes, estimate_output_bytes, estimate_xyz_bytes};
+pub use estimate::{
+    estimate_image_bytes, estimate_model_bytes, estimate_output_bytes, estimate_xyz_bytes,
+};
 pub use reframe::reframe;
 pub use sniff::sniff_format;
 pub use spool::LeafSpool;

@@ -54,8 +54,9 @@ pub fn in_key_range(cell: crate::Voxel) -> bool {
 }
 
 /// The log-odds written for occupied leaves: OctoMap's default upper clamping
-/// threshold, probability 0.971.
-pub const OCCUPIED_LOG_ODDS: f32 = 3.511_015_4;
+/// threshold, probability 0.971, as OctoMap computes it (`log(p / (1 − p))` rounded
+/// to `f32`; what it gives a `.bt`'s occupied cells).
+pub const OCCUPIED_LOG_ODDS: f32 = 3.511_030_7;
 
 const BT_HEADER: &str = "# Octomap OcTree binary file";
 const OT_HEADER: &str = "# Octomap OcTree file";

@@ -162,3 +162,17 @@ fn out_of_key_range_is_refused() {
     let t = LinearOctree::from_voxels(17, [0; 3], [[40000, 0, 0]]).unwrap();
     assert!(encode_bt(&Model::new(t)).is_err());
 }
+
+#[test]
+fn clamp_log_odds_are_octomaps_defaults_as_it_computes_them() {
+    // OctoMap reads a .bt's cells at its clamping thresholds, logodds(0.971) and
+    // logodds(0.1192) in f32; ours must be the same numbers, as the maps' clamps are.
+    use crate::occupancy::{log_odds, SensorModel};
+    assert_eq!(super::OCCUPIED_LOG_ODDS, log_odds(0.971));
+    assert_eq!(super::FREE_LOG_ODDS, log_odds(0.1192));
+    let m = SensorModel::octomap();
+    assert_eq!(
+        (m.clamp_min(), m.clamp_max()),
+        (super::FREE_LOG_ODDS, super::OCCUPIED_LOG_ODDS)
+    );
+}

@@ -10,8 +10,9 @@ use crate::linear::{Leaf, LinearOctree};
 use crate::model::{Layer, LayerValue, Model, Rgba};
 
 /// The log-odds written for free leaves when the model has none: OctoMap's default
-/// lower clamping threshold, probability 0.1192.
-pub const FREE_LOG_ODDS: f32 = -1.992_430_1;
+/// lower clamping threshold, probability 0.1192, as OctoMap computes it
+/// (`log(p / (1 − p))` rounded to `f32`; what it gives a `.bt`'s free cells).
+pub const FREE_LOG_ODDS: f32 = -2.000_028;
 
 /// A model's parts in OctoMap's key space.
 pub(super) struct KeyModel {
