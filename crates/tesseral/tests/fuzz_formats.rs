@@ -405,6 +405,38 @@ fn hostile_scan_headers_are_refused_cheaply() {
 }
 
 #[test]
+fn compressed_pcd_holds_only_its_points() {
+    // 3,000 points of x y z and 4,096 doubles: 98 MB uncompressed in a 1.1 MB
+    // file. The reader streams the LZF output through a window and keeps the
+    // points (72 KB), not the uncompressed data (or two copies of it).
+    use tesseral::io::scan::{parse, ScanFormat};
+    let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
+    let (n, record) = (3000usize, 12 + 8 * 4096);
+    let size = n * record;
+    let mut packed = vec![0u8, 0];
+    let refs = (size - 1) / 264;
+    for _ in 0..refs {
+        packed.extend_from_slice(&[0xe0, 255, 0]);
+    }
+    let last = size - 1 - refs * 264;
+    assert!((9..264).contains(&last));
+    packed.extend_from_slice(&[0xe0, (last - 9) as u8, 0]);
+    let mut input = format!("VERSION 0.7\nFIELDS x y z pad\nSIZE 4 4 4 8\nTYPE F F F F\nCOUNT 1 1 1 4096\nPOINTS {n}\nDATA binary_compressed\n").into_bytes();
+    input.extend_from_slice(&(packed.len() as u32).to_le_bytes());
+    input.extend_from_slice(&(size as u32).to_le_bytes());
+    input.extend_from_slice(&packed);
+    let base = LIVE.load(Ordering::Relaxed);
+    PEAK.store(base, Ordering::Relaxed);
+    let scans = parse(&input, ScanFormat::Pcd).unwrap();
+    let peak = PEAK.load(Ordering::Relaxed).saturating_sub(base);
+    assert_eq!(scans[0].points.len(), n);
+    assert!(
+        peak < 24 * n + (2 << 20),
+        "{peak} bytes at most for {n} points of {size} uncompressed bytes"
+    );
+}
+
+#[test]
 fn hostile_headers_are_refused_cheaply() {
     let _guard = SERIAL.lock().unwrap_or_else(|e| e.into_inner());
     let cases: Vec<(&str, Parser, Vec<u8>)> = vec![

@@ -36,6 +36,7 @@ pub(crate) mod sections;
 mod sniff;
 mod spool;
 pub(crate) mod tess_colours;
+pub(crate) mod text_number;
 
 mod tess_file;
 mod tess_file_colours;

@@ -2,17 +2,18 @@
 //! one scan in the sensor frame at the identity pose (the sensor at the world origin);
 //! `tesseral map --origin` or `--pose` places it.
 
-use super::{check_budget, syntax, PointFrame, ScanRecord};
-use crate::io::FormatError;
+use super::{check_budget, strip_bom, syntax, PointFrame, ScanRecord};
+use crate::io::{text_number, FormatError};
 
 /// Parses `.xyz` points: one point per line, its first three numbers (separated by
 /// white space or commas) its `x y z`; further columns (intensity, colour) are
-/// ignored; `#` starts a comment; blank lines are skipped. `nan` and `inf` are read
-/// (mapping skips and counts them).
+/// ignored; `#` starts a comment; blank lines are skipped; a UTF-8 byte order mark
+/// is skipped. `nan` and `inf` are read (mapping skips and counts them).
 ///
 /// # Errors
 /// [`FormatError::Syntax`] naming the line and column of a malformed or missing
-/// number; [`FormatError::TooLarge`] past [`super::MAX_SCAN_POINTS`].
+/// number, or of one out of range (`1e400`); [`FormatError::TooLarge`] past
+/// [`super::MAX_SCAN_POINTS`].
 ///
 /// ```
 /// let s = tesseral::io::scan::cloud::parse_xyz(b"# a cloud\n1 2 3\n4.5,5,6 255\n").unwrap();
@@ -20,7 +21,7 @@ use crate::io::FormatError;
 /// ```
 pub fn parse_xyz(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
     let mut points = Vec::new();
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+    for (i, raw) in strip_bom(bytes).split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
         let content = raw.split(|&b| b == b'#').next().unwrap_or_default();
         let line = std::str::from_utf8(content)
@@ -46,9 +47,7 @@ pub fn parse_xyz(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
                     format!("a point needs three numbers `x y z`; found {k}"),
                 ));
             };
-            *x = w
-                .parse::<f64>()
-                .map_err(|_| syntax(line_no, col, format!("`{w}` is not a number")))?;
+            *x = text_number::real(w).map_err(|m| syntax(line_no, col, m))?;
         }
         points.push(p);
         check_budget(points.len())?;

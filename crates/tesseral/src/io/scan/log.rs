@@ -12,11 +12,12 @@
 //! `log2graph`, lines that are empty or begin with `#` or a space are skipped, a line
 //! is a node when it begins with `NODE`, numbers are read as `f32`, and words after
 //! the numbers a line needs are ignored. Unlike `log2graph`, a malformed number is an
-//! error naming its line and column (OctoMap would insert a garbage point), and a last
-//! line without a newline is read (OctoMap drops it).
+//! error naming its line and column (OctoMap would insert a garbage point), as is one
+//! past `f32` (`1e39`; `inf` written as such is read), and a last line without a
+//! newline is read (OctoMap drops it).
 
-use super::{check_budget, syntax, words, PointFrame, ScanRecord};
-use crate::io::FormatError;
+use super::{check_budget, strip_bom, syntax, words, PointFrame, ScanRecord};
+use crate::io::{text_number, FormatError};
 
 /// Parses a scan log.
 ///
@@ -27,7 +28,7 @@ use crate::io::FormatError;
 pub fn parse(bytes: &[u8]) -> Result<Vec<ScanRecord>, FormatError> {
     let mut scans: Vec<ScanRecord> = Vec::new();
     let mut total = 0usize;
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+    for (i, raw) in strip_bom(bytes).split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         if raw.is_empty() || raw[0] == b'#' || raw[0] == b' ' {
@@ -84,10 +85,7 @@ fn numbers<const N: usize>(
                 format!("{what}; found {k}"),
             ));
         };
-        *x = word
-            .parse::<f32>()
-            .map(f64::from)
-            .map_err(|_| syntax(line_no, col, format!("`{word}` is not a number")))?;
+        *x = text_number::real32(word).map_err(|m| syntax(line_no, col, m))?;
     }
     Ok(out)
 }

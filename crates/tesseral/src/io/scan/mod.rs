@@ -10,7 +10,9 @@
 //! | `.pcd` | PCL point clouds (ASCII or binary; the `VIEWPOINT` is the sensor origin) | [`pcd`] |
 //!
 //! Decoders take bytes and know no path; their errors name the line and column or
-//! the byte offset, and [`read`] attaches the file. Whatever a header claims, no
+//! the byte offset (counted from the start of the file), and [`read`] attaches the
+//! file. Text may start with a UTF-8 byte order mark, which is skipped; a number
+//! whose literal overflows its type (`1e400`) is an error, not an infinity. Whatever a header claims, no
 //! decoder allocates more than the input's own size allows (a count is checked
 //! against the bytes left before anything is reserved) and none returns more than
 //! [`MAX_SCAN_POINTS`] points.
@@ -18,9 +20,13 @@
 pub mod cloud;
 pub mod graph;
 pub mod log;
+mod lzf_decode;
 pub mod pcd;
+mod pcd_data;
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_faults;
 
 use std::borrow::Cow;
 use std::path::Path;
@@ -264,6 +270,11 @@ fn check_budget(total: usize) -> Result<(), FormatError> {
         )));
     }
     Ok(())
+}
+
+/// The bytes after a UTF-8 byte order mark, if they start with one.
+fn strip_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
 }
 
 /// A syntax error at a 1-based line and column.

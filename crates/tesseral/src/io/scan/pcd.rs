@@ -10,29 +10,32 @@
 //! first element). `POINTS` (or `WIDTH` × `HEIGHT`) is the number of points.
 //! `VIEWPOINT tx ty tz qw qx qy qz` is where the sensor was: the points are world
 //! coordinates and the sensor origin is the viewpoint's translation. NaN points (as
-//! organised clouds hold) are kept; mapping skips and counts them.
+//! organised clouds hold) are kept; mapping skips and counts them. In `DATA ascii`
+//! every value must fit its field's type (a whole number within an `I` or `U`
+//! field's size, a 4-byte float within `f32`).
 
-use super::{check_budget, syntax, words, PointFrame, ScanRecord};
-use crate::io::FormatError;
+use super::pcd_data;
+use super::{strip_bom, syntax, words, PointFrame, ScanRecord};
+use crate::io::{text_number, FormatError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Kind {
+pub(super) enum Kind {
     Int,
     Uint,
     Float,
 }
 
 #[derive(Debug, Clone)]
-struct Field {
-    name: String,
-    size: usize,
-    kind: Kind,
-    count: usize,
+pub(super) struct Field {
+    pub(super) name: String,
+    pub(super) size: usize,
+    pub(super) kind: Kind,
+    pub(super) count: usize,
 }
 
 impl Field {
-    /// Decodes one little-endian value of this field.
-    fn value(&self, b: &[u8]) -> f64 {
+    /// Decodes one little-endian value of this field from the start of `b`.
+    pub(super) fn value(&self, b: &[u8]) -> f64 {
         let mut w = [0u8; 8];
         w[..self.size].copy_from_slice(&b[..self.size]);
         match (self.kind, self.size) {
@@ -46,109 +49,110 @@ impl Field {
             }
         }
     }
+
+    /// Reads one value of this field from text; the error completes a sentence.
+    /// A 4-byte float holds an `f32`, as PCL reads it and as the same cloud saved
+    /// as `binary` holds it.
+    pub(super) fn text(&self, w: &str) -> Result<f64, String> {
+        match (self.kind, self.size) {
+            (Kind::Float, 4) => text_number::real32(w),
+            (Kind::Float, _) => text_number::real(w),
+            (kind, n) => {
+                let (lo, hi) = text_number::int_range(n, kind == Kind::Int);
+                let sign = if kind == Kind::Int { "" } else { "un" };
+                let what = format!("a {n}-byte {sign}signed field (`{}`)", self.name);
+                text_number::whole(w, lo, hi, &what)
+            }
+        }
+    }
+
+    /// Bytes of one point's values of this field.
+    pub(super) fn width(&self) -> usize {
+        self.size * self.count
+    }
 }
 
 /// How the points follow the header.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Data {
+pub(super) enum Data {
     Ascii,
     Binary,
     Compressed,
 }
 
-/// The most bytes LZF gives back per compressed byte: a back reference of three
-/// bytes copies at most 264.
-const LZF_RATIO: usize = 88;
+/// What the header says, with where it says it.
+pub(super) struct Header {
+    pub(super) fields: Vec<Field>,
+    /// The fields of `x`, `y` and `z`.
+    pub(super) xyz: [usize; 3],
+    /// The number of points.
+    pub(super) declared: u64,
+    /// The line and column of that number (`POINTS`, else `WIDTH`).
+    pub(super) count_at: (usize, usize),
+    pub(super) data: Data,
+    /// The byte offset and line number where the data starts.
+    pub(super) body: usize,
+    pub(super) body_line: usize,
+    pub(super) origin: [f64; 3],
+}
 
-/// The points of `DATA binary_compressed` (`body`, starting at byte `at` of the
-/// file), decompressed and put back into records of all fields, as `DATA binary`
-/// holds them. Every size is checked before anything is allocated: the
-/// uncompressed size must be the declared points' and at most what the compressed
-/// bytes can give.
-fn decompress(
-    body: &[u8],
-    at: usize,
-    declared: u64,
-    fields: &[Field],
-) -> Result<Vec<u8>, FormatError> {
-    let corrupt = |m: String| FormatError::corrupt(format!("byte {at}: {m}"));
-    let word = |k: usize| {
-        body.get(k..k + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]) as usize)
-    };
-    let (Some(packed), Some(size)) = (word(0), word(4)) else {
-        return Err(corrupt(
-            "`binary_compressed` data needs its two sizes (8 bytes)".into(),
-        ));
-    };
-    let record: usize = fields.iter().map(|f| f.size * f.count).sum();
-    let want = usize::try_from(declared)
-        .ok()
-        .and_then(|n| n.checked_mul(record));
-    if want != Some(size) {
-        return Err(corrupt(format!(
-            "{declared} points of {record} bytes make {} bytes, but the data says {size} uncompressed",
-            want.map_or_else(|| "too many".to_string(), |w| w.to_string())
-        )));
-    }
-    if packed > body.len() - 8 {
-        return Err(corrupt(format!(
-            "{packed} compressed bytes declared; {} follow",
-            body.len() - 8
-        )));
-    }
-    if size == 0 {
-        return Ok(Vec::new());
-    }
-    check_budget(declared as usize)?;
-    if size > packed.saturating_mul(LZF_RATIO) + 64 {
-        return Err(corrupt(format!(
-            "{packed} compressed bytes cannot hold {size}"
-        )));
-    }
-    let columns = lzf::decompress(&body[8..8 + packed], size)
-        .map_err(|e| corrupt(format!("the compressed data is damaged ({e:?})")))?;
-    if columns.len() != size {
-        return Err(corrupt(format!(
-            "the data decompresses to {} bytes, not {size}",
-            columns.len()
-        )));
-    }
-    // Field f's values for every point lie together; a record takes each in turn.
-    let n = declared as usize;
-    let mut records = vec![0u8; size];
-    let (mut column, mut offset) = (0, 0);
-    for f in fields {
-        let w = f.size * f.count;
-        let values = &columns[column..column + n * w];
-        for (p, v) in values.chunks_exact(w).enumerate() {
-            records[p * record + offset..][..w].copy_from_slice(v);
-        }
-        column += n * w;
-        offset += w;
-    }
-    Ok(records)
+/// One header line's entries: the line, the column after its last word, and each
+/// entry with its column.
+struct Entries<T> {
+    line: usize,
+    end: usize,
+    values: Vec<(usize, T)>,
+}
+
+/// The entries after a header line's key (`ws`, its words), each parsed.
+fn entries<T>(
+    line: usize,
+    ws: &[(usize, &str)],
+    parse: impl Fn((usize, &str)) -> Result<T, FormatError>,
+) -> Result<Entries<T>, FormatError> {
+    let values = ws[1..]
+        .iter()
+        .map(|&(c, w)| parse((c, w)).map(|v| (c, v)))
+        .collect::<Result<Vec<_>, _>>()?;
+    let end = ws.last().map_or(1, |&(c, w)| c + w.len());
+    Ok(Entries { line, end, values })
 }
 
 /// Parses a PCD file.
 ///
 /// # Errors
-/// [`FormatError::Syntax`] naming the header or data line at fault;
-/// [`FormatError::Corrupt`] naming the byte offset where binary data ends early or a
-/// point count the bytes cannot hold, or compressed data that does not decompress
-/// to the declared points; [`FormatError::TooLarge`] past
-/// [`super::MAX_SCAN_POINTS`].
+/// [`FormatError::Syntax`] naming the header or data line at fault (the entry of
+/// `SIZE`, `TYPE` or `COUNT` that disagrees, the `POINTS` count the data cannot
+/// hold, or where text data ends early); [`FormatError::Corrupt`] naming the byte
+/// offset where binary data ends early or a point count the bytes cannot hold, or
+/// where compressed data is malformed or does not decompress to the declared
+/// points; [`FormatError::TooLarge`] past [`super::MAX_SCAN_POINTS`].
 pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
-    let mut pos = 0usize;
+    let h = header(bytes)?;
+    let points = match h.data {
+        Data::Ascii => pcd_data::ascii(bytes, &h)?,
+        Data::Binary => pcd_data::binary(bytes, &h)?,
+        Data::Compressed => pcd_data::compressed(bytes, &h)?,
+    };
+    Ok(ScanRecord {
+        translation: h.origin,
+        rpy: [0.0; 3],
+        points,
+        frame: PointFrame::World,
+    })
+}
+
+/// Reads the header, up to and including its `DATA` line.
+fn header(bytes: &[u8]) -> Result<Header, FormatError> {
+    let mut pos = bytes.len() - strip_bom(bytes).len();
     let mut line_no = 0usize;
-    let mut names: Option<Vec<String>> = None;
-    let mut sizes: Option<Vec<usize>> = None;
-    let mut kinds: Option<Vec<Kind>> = None;
-    let mut counts: Option<Vec<usize>> = None;
-    let (mut width, mut height, mut points): (Option<u64>, Option<u64>, Option<u64>) =
-        (None, None, None);
-    let mut viewpoint = [0.0f64; 7];
-    viewpoint[3] = 1.0;
+    let mut names: Option<Entries<String>> = None;
+    let mut sizes: Option<Entries<usize>> = None;
+    let mut kinds: Option<Entries<Kind>> = None;
+    let mut counts: Option<Entries<usize>> = None;
+    // Each count with its line and column.
+    let (mut width, mut height, mut points) = (None, None, None);
+    let mut origin = [0.0f64; 3];
     let data = loop {
         if pos >= bytes.len() {
             return Err(syntax(
@@ -181,48 +185,40 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
         };
         match key {
             "VERSION" => {}
-            "FIELDS" | "COLUMNS" => names = Some(rest.iter().map(|w| w.1.to_string()).collect()),
+            "FIELDS" | "COLUMNS" => {
+                names = Some(entries(line_no, &ws, |(_, w)| Ok(w.to_string()))?);
+            }
             "SIZE" => {
-                let mut v = Vec::new();
-                for &(c, w) in rest {
-                    v.push(match w {
-                        "1" => 1,
-                        "2" => 2,
-                        "4" => 4,
-                        "8" => 8,
-                        _ => return Err(err(c, format!("field size `{w}` must be 1, 2, 4 or 8"))),
-                    });
-                }
-                sizes = Some(v);
+                sizes = Some(entries(line_no, &ws, |(c, w)| match w {
+                    "1" => Ok(1),
+                    "2" => Ok(2),
+                    "4" => Ok(4),
+                    "8" => Ok(8),
+                    _ => Err(err(c, format!("field size `{w}` must be 1, 2, 4 or 8"))),
+                })?);
             }
             "TYPE" => {
-                let mut v = Vec::new();
-                for &(c, w) in rest {
-                    v.push(match w {
-                        "I" => Kind::Int,
-                        "U" => Kind::Uint,
-                        "F" => Kind::Float,
-                        _ => return Err(err(c, format!("field type `{w}` must be I, U or F"))),
-                    });
-                }
-                kinds = Some(v);
+                kinds = Some(entries(line_no, &ws, |(c, w)| match w {
+                    "I" => Ok(Kind::Int),
+                    "U" => Ok(Kind::Uint),
+                    "F" => Ok(Kind::Float),
+                    _ => Err(err(c, format!("field type `{w}` must be I, U or F"))),
+                })?);
             }
             "COUNT" => {
-                let mut v = Vec::new();
-                for &w in rest {
+                counts = Some(entries(line_no, &ws, |w| {
                     let n = uint(w)?;
                     if n == 0 || n > 1 << 16 {
                         return Err(err(w.0, format!("field count {n} must be 1..65536")));
                     }
-                    v.push(n as usize);
-                }
-                counts = Some(v);
+                    Ok(n as usize)
+                })?);
             }
             "WIDTH" | "HEIGHT" | "POINTS" => {
                 let w = *rest
                     .first()
                     .ok_or_else(|| err(col, format!("`{key}` needs a number")))?;
-                let n = Some(uint(w)?);
+                let n = Some((uint(w)?, (line_no, w.0)));
                 match key {
                     "WIDTH" => width = n,
                     "HEIGHT" => height = n,
@@ -234,11 +230,14 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
                     return Err(err(col, "`VIEWPOINT` needs tx ty tz qw qx qy qz".into()));
                 }
                 for (k, &(c, w)) in rest.iter().enumerate() {
-                    viewpoint[k] = w
+                    let v = w
                         .parse::<f64>()
                         .ok()
                         .filter(|x| x.is_finite())
                         .ok_or_else(|| err(c, format!("`{w}` is not a finite number")))?;
+                    if k < 3 {
+                        origin[k] = v;
+                    }
                 }
             }
             "DATA" => {
@@ -255,50 +254,71 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
             _ => return Err(err(col, format!("unexpected `{key}` in the PCD header"))),
         }
     };
-    let header_end_line = line_no;
     let names = names.ok_or_else(|| syntax(line_no, 1, "the header has no `FIELDS` line"))?;
-    let n_fields = names.len();
-    let sizes = sizes.unwrap_or_else(|| vec![4; n_fields]);
-    let kinds = kinds.unwrap_or_else(|| vec![Kind::Float; n_fields]);
-    let counts = counts.unwrap_or_else(|| vec![1; n_fields]);
-    if sizes.len() != n_fields || kinds.len() != n_fields || counts.len() != n_fields {
+    let n = names.values.len();
+    // Each of SIZE, TYPE, COUNT: as many entries as FIELDS, or absent (the default).
+    fn check<T>(
+        e: &Option<Entries<T>>,
+        key: &str,
+        n: usize,
+        fields: usize,
+    ) -> Result<(), FormatError> {
+        match e {
+            Some(e) if e.values.len() != n => {
+                let col = e.values.get(n).map_or(e.end, |v| v.0);
+                Err(syntax(
+                    e.line,
+                    col,
+                    format!(
+                        "`{key}` has {} entries; `FIELDS` (line {fields}) names {n}",
+                        e.values.len()
+                    ),
+                ))
+            }
+            _ => Ok(()),
+        }
+    }
+    check(&sizes, "SIZE", n, names.line)?;
+    check(&kinds, "TYPE", n, names.line)?;
+    check(&counts, "COUNT", n, names.line)?;
+    fn entry<T: Copy>(e: &Option<Entries<T>>, i: usize, default: T) -> T {
+        e.as_ref().map_or(default, |e| e.values[i].1)
+    }
+    let fields: Vec<Field> = (0..n)
+        .map(|i| Field {
+            name: names.values[i].1.clone(),
+            size: entry(&sizes, i, 4),
+            kind: entry(&kinds, i, Kind::Float),
+            count: entry(&counts, i, 1),
+        })
+        .collect();
+    if let Some(i) = fields
+        .iter()
+        .position(|f| f.kind == Kind::Float && f.size != 4 && f.size != 8)
+    {
+        // Only a given SIZE can make a float of 1 or 2 bytes.
+        let (line, col) = sizes
+            .as_ref()
+            .map_or((line_no, 1), |e| (e.line, e.values[i].0));
         return Err(syntax(
-            line_no,
-            1,
+            line,
+            col,
             format!(
-                "{n_fields} FIELDS but {} SIZE, {} TYPE and {} COUNT entries",
-                sizes.len(),
-                kinds.len(),
-                counts.len()
+                "float field `{}` has size {}; a float takes 4 or 8 bytes",
+                fields[i].name, fields[i].size
             ),
         ));
     }
-    let fields: Vec<Field> = (0..n_fields)
-        .map(|i| Field {
-            name: names[i].clone(),
-            size: sizes[i],
-            kind: kinds[i],
-            count: counts[i],
-        })
-        .collect();
-    if let Some(f) = fields
-        .iter()
-        .find(|f| f.kind == Kind::Float && f.size != 4 && f.size != 8)
-    {
-        return Err(syntax(
-            line_no,
-            1,
-            format!("float field `{}` has size {}", f.name, f.size),
-        ));
+    let mut xyz = [0; 3];
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        xyz[a] = fields
+            .iter()
+            .position(|f| f.name == *axis)
+            .ok_or_else(|| syntax(names.line, names.end, format!("`FIELDS` lacks `{axis}`")))?;
     }
-    let xyz: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .map(|n| fields.iter().position(|f| f.name == *n))
-        .collect::<Option<_>>()
-        .ok_or_else(|| syntax(line_no, 1, "FIELDS lacks x, y or z"))?;
-    let declared = match (points, width, height) {
+    let (declared, count_at) = match (points, width, height) {
         (Some(p), _, _) => p,
-        (None, Some(w), Some(h)) => w.saturating_mul(h),
+        (None, Some((w, at)), Some((h, _))) => (w.saturating_mul(h), at),
         (None, Some(w), None) => w,
         _ => {
             return Err(syntax(
@@ -308,99 +328,14 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
             ))
         }
     };
-    let left = bytes.len() - pos;
-    let mut out = Vec::new();
-    if data == Data::Ascii {
-        // A point takes at least two bytes per value (a digit and a separator).
-        let values: usize = fields.iter().map(|f| f.count).sum();
-        if declared > (left / (2 * values).max(1)) as u64 + 1 {
-            return Err(FormatError::corrupt(format!(
-                "the header declares {declared} points; the {left} bytes after it hold fewer"
-            )));
-        }
-        check_budget(declared as usize)?;
-        out.reserve(declared as usize);
-        let mut starts = Vec::with_capacity(n_fields);
-        let mut at = 0;
-        for f in &fields {
-            starts.push(at);
-            at += f.count;
-        }
-        let want = [starts[xyz[0]], starts[xyz[1]], starts[xyz[2]]];
-        let mut lines = bytes[pos..].split(|&b| b == b'\n').enumerate();
-        while (out.len() as u64) < declared {
-            let Some((k, raw)) = lines.next() else {
-                return Err(syntax(
-                    header_end_line + 1,
-                    1,
-                    format!("the data ends after {} of {declared} points", out.len()),
-                ));
-            };
-            let line_no = header_end_line + 1 + k;
-            let line = String::from_utf8_lossy(raw);
-            let ws: Vec<(usize, &str)> = words(&line).take(values + 1).collect();
-            if ws.is_empty() {
-                continue;
-            }
-            if ws.len() < values {
-                return Err(syntax(
-                    line_no,
-                    line.trim_end().len() + 1,
-                    format!("a point needs {values} values; found {}", ws.len()),
-                ));
-            }
-            let mut p = [0.0; 3];
-            for (a, &i) in want.iter().enumerate() {
-                let (c, w) = ws[i];
-                let v = w
-                    .parse::<f64>()
-                    .map_err(|_| syntax(line_no, c, format!("`{w}` is not a number")))?;
-                // A 4-byte float field holds an `f32`, as PCL reads it and as the
-                // same cloud saved as `binary` holds it.
-                let f = &fields[xyz[a]];
-                p[a] = if f.kind == Kind::Float && f.size == 4 {
-                    f64::from(v as f32)
-                } else {
-                    v
-                };
-            }
-            out.push(p);
-        }
-    } else {
-        let record: usize = fields.iter().map(|f| f.size * f.count).sum();
-        let unpacked;
-        let (bytes, pos) = if data == Data::Compressed {
-            unpacked = decompress(&bytes[pos..], pos, declared, &fields)?;
-            (unpacked.as_slice(), 0)
-        } else {
-            (bytes, pos)
-        };
-        let left = bytes.len() - pos;
-        if declared > (left / record) as u64 {
-            return Err(FormatError::corrupt(format!(
-                "byte {pos}: the header declares {declared} points of {record} bytes; {left} bytes follow"
-            )));
-        }
-        check_budget(declared as usize)?;
-        let mut offsets = Vec::with_capacity(n_fields);
-        let mut at = 0;
-        for f in &fields {
-            offsets.push(at);
-            at += f.size * f.count;
-        }
-        out.reserve(declared as usize);
-        for r in bytes[pos..].chunks_exact(record).take(declared as usize) {
-            out.push(std::array::from_fn(|a| {
-                let f = &fields[xyz[a]];
-                f.value(&r[offsets[xyz[a]]..])
-            }));
-        }
-    }
-    let [tx, ty, tz, ..] = viewpoint;
-    Ok(ScanRecord {
-        translation: [tx, ty, tz],
-        rpy: [0.0; 3],
-        points: out,
-        frame: PointFrame::World,
+    Ok(Header {
+        fields,
+        xyz,
+        declared,
+        count_at,
+        data,
+        body: pos,
+        body_line: line_no + 1,
+        origin,
     })
 }

@@ -361,8 +361,8 @@ fn pcd_errors() {
     let (l, _, m) = syntax_at(pcd::parse(
         pcd_header("x y w", "4 4 4", "F F F", 0, "ascii").as_bytes(),
     ));
-    assert_eq!(l, 11);
-    assert!(m.contains("lacks x, y or z"), "{m}");
+    assert_eq!(l, 3, "the `FIELDS` line");
+    assert!(m.contains("lacks `z`"), "{m}");
     let (l, c, _) = syntax_at(pcd::parse(
         pcd_header("x y z", "4 3 4", "F F F", 0, "ascii").as_bytes(),
     ));

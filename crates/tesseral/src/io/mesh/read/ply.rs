@@ -1,7 +1,7 @@
 //! PLY: ASCII and binary of either byte order.
 
 use super::{syntax, words, MAX_MESH_ELEMENTS};
-use crate::io::FormatError;
+use crate::io::{text_number, FormatError};
 use crate::mesh::TriMesh;
 
 #[derive(Clone, Copy, PartialEq, Eq, Debug)]
@@ -30,6 +30,36 @@ impl Scalar {
             _ => return None,
         })
     }
+    fn name(self) -> &'static str {
+        match self {
+            Self::I8 => "char",
+            Self::U8 => "uchar",
+            Self::I16 => "short",
+            Self::U16 => "ushort",
+            Self::I32 => "int",
+            Self::U32 => "uint",
+            Self::F32 => "float",
+            Self::F64 => "double",
+        }
+    }
+    /// Reads an ASCII value of this type: a whole number within an integer type's
+    /// range, a real within `f32` for `float`; the error completes a sentence.
+    fn text(self, w: &str) -> Result<f64, String> {
+        let (signed, bytes) = match self {
+            Self::F32 => {
+                let v = text_number::real(w)?;
+                return match text_number::real32(w) {
+                    Err(m) if m.contains("out of range") => Err(format!("{m} for `float`")),
+                    _ => Ok(v),
+                };
+            }
+            Self::F64 => return text_number::real(w),
+            Self::I8 | Self::I16 | Self::I32 => (true, self.size()),
+            Self::U8 | Self::U16 | Self::U32 => (false, self.size()),
+        };
+        let (lo, hi) = text_number::int_range(bytes, signed);
+        text_number::whole(w, lo, hi, &format!("`{}`", self.name()))
+    }
     fn size(self) -> usize {
         match self {
             Self::I8 | Self::U8 => 1,
@@ -53,6 +83,8 @@ struct Element {
     name: String,
     count: u64,
     props: Vec<Property>,
+    /// The header line that declares it.
+    line: usize,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq)]
@@ -70,7 +102,7 @@ struct PlyBody<'a> {
     line: usize,
     /// Where the current line starts (ASCII), for error columns.
     line_start: usize,
-    /// Where the last value read starts (ASCII).
+    /// Where the last value read starts, for errors.
     token: usize,
     /// Whether a NaN or infinite value is an error (a mesh), or passed on (a point
     /// cloud, whose reader skips and counts such points).
@@ -112,13 +144,14 @@ impl PlyBody<'_> {
                 return Err(syntax(self.line, column, "file ends inside an element"));
             }
             let w = String::from_utf8_lossy(&self.bytes[start..self.pos]);
-            return match w.parse::<f64>() {
+            return match ty.text(&w) {
                 Ok(x) if x.is_finite() || !finite => Ok(x),
                 Ok(_) => Err(syntax(self.line, column, format!("`{w}` is not finite"))),
-                _ => Err(syntax(self.line, column, format!("`{w}` is not a number"))),
+                Err(m) => Err(syntax(self.line, column, m)),
             };
         }
         let n = ty.size();
+        self.token = self.pos;
         if self.pos + n > self.bytes.len() {
             return Err(FormatError::corrupt(format!(
                 "file ends at byte {} inside an element",
@@ -152,6 +185,35 @@ impl PlyBody<'_> {
 }
 
 impl PlyBody<'_> {
+    /// An error at the last value read: its line and column (ASCII) or byte offset.
+    fn fault(&self, message: String) -> FormatError {
+        if self.format == PlyFormat::Ascii {
+            syntax(self.line, self.token - self.line_start + 1, message)
+        } else {
+            FormatError::corrupt(format!("byte {}: {message}", self.token))
+        }
+    }
+
+    /// An error where the data ends: the line and column of the file's end (ASCII),
+    /// else the byte offset of the current element.
+    fn short(&self, message: String) -> FormatError {
+        if self.format == PlyFormat::Ascii {
+            let rest = &self.bytes[self.pos..];
+            let lines = rest.iter().filter(|&&b| b == b'\n').count();
+            let last = rest
+                .iter()
+                .rposition(|&b| b == b'\n')
+                .map_or(self.pos - self.line_start, |k| rest.len() - k - 1);
+            syntax(self.line + lines, last + 1, message)
+        } else {
+            FormatError::corrupt(format!(
+                "byte {}: {message}; the file ends at byte {}",
+                self.pos,
+                self.bytes.len()
+            ))
+        }
+    }
+
     /// Ends an element (ASCII): nothing but spaces may follow its last value on its
     /// line, and the next value starts a new element.
     fn end_element(&mut self) -> Result<(), FormatError> {
@@ -201,7 +263,13 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
         .windows(11)
         .position(|w| w == b"end_header\n" || w == b"end_header\r")
         .ok_or_else(|| syntax(1, 1, "no `end_header` line"))?;
-    let header = String::from_utf8_lossy(&bytes[..end]);
+    // A UTF-8 byte order mark before `ply` is skipped.
+    let bom = if bytes.starts_with(b"\xef\xbb\xbf") {
+        3
+    } else {
+        0
+    };
+    let header = String::from_utf8_lossy(&bytes[bom.min(end)..end]);
     let mut body_start = end + 11;
     if bytes.get(end + 10) == Some(&b'\r') && bytes.get(body_start) == Some(&b'\n') {
         body_start += 1;
@@ -240,6 +308,7 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                     name: name.1.to_string(),
                     count,
                     props: Vec::new(),
+                    line: i + 1,
                 });
             }
             "property" => {
@@ -276,7 +345,6 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
         }
     }
     let format = format.ok_or_else(|| syntax(2, 1, "no `format` line"))?;
-    let remaining = (bytes.len() - body_start.min(bytes.len())) as u64;
     let mut body = PlyBody {
         bytes,
         pos: body_start.min(bytes.len()),
@@ -288,7 +356,13 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
         fresh: true,
     };
     let mut m = TriMesh::default();
+    // Faces are checked against the vertices the header declares, as they are read.
+    let vertices: u64 = elements
+        .iter()
+        .filter(|e| e.name == "vertex")
+        .fold(0, |n, e| n.saturating_add(e.count));
     for el in &elements {
+        let remaining = (bytes.len() - body.pos) as u64;
         // Every element takes at least one byte (binary) or two (ASCII: a digit and a
         // separator), so a count beyond the bytes left is a lie.
         let min = if format == PlyFormat::Ascii {
@@ -300,9 +374,9 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                 .sum()
         };
         if el.count > 0 && min > 0 && el.count > remaining / min {
-            return Err(FormatError::corrupt(format!(
-                "header declares {} `{}` elements; the file is too short for them",
-                el.count, el.name
+            return Err(body.short(format!(
+                "header declares {} `{}` elements (line {}), of at least {min} bytes each; the file is too short for them",
+                el.count, el.name, el.line
             )));
         }
         if el.count > MAX_MESH_ELEMENTS as u64 {
@@ -323,12 +397,21 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
             p.list.is_some() && (p.name == "vertex_indices" || p.name == "vertex_index")
         });
         let is_vertex = el.name == "vertex";
-        if is_vertex && xyz.iter().any(Option::is_none) {
-            return Err(syntax(1, 1, "`vertex` element lacks x, y or z"));
+        if let Some(a) = xyz.iter().position(Option::is_none).filter(|_| is_vertex) {
+            let axis = ["x", "y", "z"][a];
+            return Err(syntax(
+                el.line,
+                1,
+                format!("`vertex` element lacks `{axis}` (a property that is not a list)"),
+            ));
         }
         let is_face = el.name == "face";
         if is_face && faces.is_none() {
-            return Err(syntax(1, 1, "`face` element lacks a vertex_indices list"));
+            return Err(syntax(
+                el.line,
+                1,
+                "`face` element lacks a `vertex_indices` list",
+            ));
         }
         let mut poly: Vec<u32> = Vec::new();
         for index in 0..el.count {
@@ -348,9 +431,9 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                     Some(ct) => {
                         let n = body.value(ct, true)?;
                         if !(0.0..=1e9).contains(&n) || n.fract() != 0.0 {
-                            return Err(FormatError::corrupt(format!(
-                                "element {index}: bad list length {n}"
-                            )));
+                            return Err(
+                                body.fault(format!("`{}` {index}: bad list length {n}", el.name))
+                            );
                         }
                         let take = is_face && faces == Some(pi);
                         poly.clear();
@@ -360,25 +443,20 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                                 // A vertex index is a whole number from 0: `1.5` or `-2`
                                 // is an error that says so, not a face to guess at.
                                 let why = if v.fract() != 0.0 {
-                                    Some("is not a whole number")
+                                    "is not a whole number".to_string()
                                 } else if v < 0.0 {
-                                    Some("is negative")
+                                    "is negative".to_string()
+                                } else if v >= vertices as f64 {
+                                    format!("names a vertex beyond the {vertices} there are")
                                 } else {
-                                    None
+                                    String::new()
                                 };
-                                if let Some(why) = why {
+                                if !why.is_empty() {
                                     let msg = format!("face {index}: vertex index {v} {why}");
-                                    return Err(if body.format == PlyFormat::Ascii {
-                                        syntax(body.line, body.token - body.line_start + 1, msg)
-                                    } else {
-                                        FormatError::corrupt(format!("{msg} (byte {})", body.pos))
-                                    });
+                                    return Err(body.fault(msg));
                                 }
-                                poly.push(if v < u32::MAX as f64 {
-                                    v as u32
-                                } else {
-                                    u32::MAX
-                                });
+                                // Below the vertex count (a saturating cast past u32).
+                                poly.push(v as u32);
                             }
                         }
                         if take {
@@ -404,12 +482,6 @@ fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
                 m.positions.push(p);
             }
         }
-    }
-    let n = m.positions.len() as u32;
-    if let Some(t) = m.triangles.iter().position(|t| t.iter().any(|&i| i >= n)) {
-        return Err(FormatError::corrupt(format!(
-            "face {t} names a vertex beyond the {n} there are"
-        )));
     }
     Ok(m)
 }
