@@ -284,7 +284,10 @@ fn missing_returns_are_skipped_and_counted_in_every_cloud_format() {
         d,
         &["map", "holes.ply", "-o", "h.bt", "--resolution", "0.1"],
     );
-    assert!(text.contains("(3 skipped: NaN or infinite)"), "{text}");
+    assert!(
+        text.contains("(3 skipped: NaN, infinite, or past ±2^61 cells)"),
+        "{text}"
+    );
     // A mesh is still refused with a NaN vertex: it is not a cloud.
     fails(d, &["convert", "holes.ply", "h.stl"], "not finite");
 }

@@ -12,6 +12,22 @@ pub(crate) fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     out.push(v as u8);
 }
 
+/// `bytes` less their last four, which must hold the CRC-32 (IEEE, little-endian)
+/// of all before them (the trailer of a version-1 `.tess` and of a map's own
+/// `.tess`); the caller has checked that there are four.
+pub(crate) fn crc_checked(bytes: &[u8]) -> Result<&[u8], String> {
+    let (body, tail) = bytes.split_at(bytes.len() - 4);
+    let stored = u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]);
+    let actual = crc32fast::hash(body);
+    if stored != actual {
+        return Err(format!(
+            "checksum mismatch (stored {stored:08x}, computed {actual:08x}): \
+             the file is truncated or corrupted"
+        ));
+    }
+    Ok(body)
+}
+
 /// A bounds-checked cursor over untrusted bytes.
 #[derive(Clone)]
 pub(crate) struct Reader<'a> {

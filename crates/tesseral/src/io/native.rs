@@ -311,14 +311,7 @@ fn decode_v1(bytes: &[u8]) -> Result<Model, FormatError> {
             HEADER_LEN + 4
         )));
     }
-    let (body, stored) = bytes.split_at(bytes.len() - 4);
-    let stored = u32::from_le_bytes([stored[0], stored[1], stored[2], stored[3]]);
-    let actual = crc32fast::hash(body);
-    if stored != actual {
-        return Err(bad(format!(
-            "checksum mismatch (stored {stored:08x}, computed {actual:08x}): the file is truncated or corrupted"
-        )));
-    }
+    let body = super::leafstream::crc_checked(bytes).map_err(bad)?;
     let mut r = Reader {
         bytes: body,
         pos: 10,

@@ -33,7 +33,7 @@
 use super::sensor::{Fixed, UNKNOWN};
 use super::store::{BlockKey, Cells, BLOCK_CELLS};
 use super::{OccupancyMap, SensorModel};
-use crate::io::leafstream::{put_varint, Reader};
+use crate::io::leafstream::{crc_checked, put_varint, Reader};
 use crate::io::native::MAP_MAGIC;
 use crate::io::FormatError;
 
@@ -123,15 +123,7 @@ impl OccupancyMap {
                 HEADER_LEN + 4
             )));
         }
-        let (body, tail) = bytes.split_at(bytes.len() - 4);
-        let stored = u32::from_le_bytes([tail[0], tail[1], tail[2], tail[3]]);
-        let computed = crc32fast::hash(body);
-        if stored != computed {
-            return Err(bad(format!(
-                "checksum mismatch (stored {stored:#010x}, computed {computed:#010x}): \
-                 the file is damaged"
-            )));
-        }
+        let body = crc_checked(bytes).map_err(bad)?;
         let mut r = Reader {
             bytes: body,
             pos: 8,
