@@ -64,7 +64,7 @@ fn unzigzag(u: u64) -> i64 {
 }
 
 impl OccupancyMap {
-    /// The map as its own `.tess` bytes (see the [module docs](self)): the full
+    /// The map as its own `.tess` bytes (layout in docs/formats.md): the full
     /// `i64` range, the values exact, the sensor model kept.
     ///
     /// # Runtime
