@@ -45,16 +45,31 @@ pub struct Args {
     #[arg(long, value_name = "M", allow_hyphen_values = true)]
     pub max_range: Option<f64>,
     /// The probability that a measured end point is occupied (OctoMap: 0.7).
-    #[arg(long, value_name = "P", default_value_t = 0.7)]
+    #[arg(
+        long,
+        value_name = "P",
+        default_value_t = 0.7,
+        allow_hyphen_values = true
+    )]
     pub prob_hit: f64,
     /// The probability that a cell a ray crosses is occupied (OctoMap: 0.4).
-    #[arg(long, value_name = "P", default_value_t = 0.4)]
+    #[arg(
+        long,
+        value_name = "P",
+        default_value_t = 0.4,
+        allow_hyphen_values = true
+    )]
     pub prob_miss: f64,
     /// The probabilities log-odds are clamped to (OctoMap: 0.1192,0.971).
-    #[arg(long, value_name = "LO,HI", default_value = "0.1192,0.971", value_parser = parse_clamp)]
+    #[arg(long, value_name = "LO,HI", default_value = "0.1192,0.971", value_parser = parse_clamp, allow_hyphen_values = true)]
     pub clamp: (f64, f64),
     /// A cell is occupied above this probability (OctoMap: 0.5).
-    #[arg(long, value_name = "P", default_value_t = 0.5)]
+    #[arg(
+        long,
+        value_name = "P",
+        default_value_t = 0.5,
+        allow_hyphen_values = true
+    )]
     pub threshold: f64,
     /// The sensor position for point clouds (their points are world coordinates).
     #[arg(long, value_name = "X,Y,Z", value_parser = parse_floats::<3>, allow_hyphen_values = true, conflicts_with = "pose")]
@@ -66,7 +81,7 @@ pub struct Args {
     /// The most cells one scan's rays may cross, summed (an upper bound computed
     /// from the points before the scan is cast): a point far off, with no
     /// --max-range, is refused rather than walked for hours.
-    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CELLS)]
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CELLS, allow_hyphen_values = true)]
     pub max_cells: u64,
     /// Print the report as one JSON object.
     #[arg(long)]
@@ -147,13 +162,13 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     }
     if !(args.resolution.is_finite() && args.resolution > 0.0) {
         bail!(
-            "--resolution {}: must be a positive number",
+            "--resolution {:?}: must be a positive number",
             args.resolution
         );
     }
     if let Some(m) = args.max_range {
         if !(m.is_finite() && m > 0.0) {
-            bail!("--max-range {m}: must be a positive number");
+            bail!("--max-range {m:?}: must be a positive number");
         }
     }
     let sensor =
@@ -215,6 +230,13 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
         t.seconds += start.elapsed().as_secs_f64();
     }
     bar.finish_and_clear();
+    if t.points == 0 {
+        eprintln!(
+            "warning: the scans hold no points: the map is empty (of {} file{})",
+            args.scans.len(),
+            if args.scans.len() == 1 { "" } else { "s" }
+        );
+    }
 
     write_map(&map, &args.output, &args.out)?;
     if args.out.format_of(&args.output) == "ot" && (args.threshold - 0.5).abs() > 1e-12 {
@@ -352,7 +374,7 @@ fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64
         .map(|p| map.cell_of(p))
     {
         bail!(
-            "a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{} m at resolution {}): write .tess, which keeps the full range, or cut rays with --max-range",
+            "a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{:?} m at resolution {:?}): write .tess, which keeps the full range, or cut rays with --max-range",
             c[0],
             c[1],
             c[2],
@@ -361,6 +383,16 @@ fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64
         );
     }
     Ok(())
+}
+
+/// A length for people: three decimals from a millimetre to 10,000 km, four
+/// significant digits in scientific notation beyond.
+fn metres(x: f64) -> String {
+    if (1e-3..1e7).contains(&x) {
+        format!("{x:.3}")
+    } else {
+        format!("{x:.3e}")
+    }
 }
 
 /// Refuses a scan whose rays would cross more than `--max-cells` cells, before any
@@ -378,9 +410,9 @@ fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
             n => format!("its {n} rays"),
         };
         bail!(
-            "{rays} may cross {} cells (the longest is {:.6e} m at resolution {}), past --max-cells {}: {hint}",
+            "{rays} may cross {} cells (the longest is {} m at resolution {:?}), past --max-cells {}: {hint}",
             work.cells,
-            work.longest,
+            metres(work.longest),
             args.resolution,
             args.max_cells
         );

@@ -73,7 +73,7 @@ pub fn to_stdout(ext: &str, write: impl FnOnce(&Path) -> Result<()>) -> Result<(
     })?;
     let mut file = std::fs::File::open(&path).context("<stdout>")?;
     let mut out = std::io::stdout().lock();
-    std::io::copy(&mut file, &mut out)?;
-    out.flush()?;
+    std::io::copy(&mut file, &mut out).context("<stdout>: writing the output")?;
+    out.flush().context("<stdout>: writing the output")?;
     Ok(())
 }

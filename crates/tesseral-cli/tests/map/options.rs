@@ -356,3 +356,47 @@ fn max_output_counts_the_free_space_and_log_odds_of_a_map() {
     );
     assert!(!d.join("k2.tess").exists());
 }
+
+#[test]
+fn negative_probabilities_are_read_and_refused_and_empty_scans_warned() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    fs::write(d.join("one.xyz"), "1 0 0\n").unwrap();
+    fs::write(d.join("empty.xyz"), "").unwrap();
+    let base = [
+        "map",
+        "one.xyz",
+        "--origin",
+        "0,0,0",
+        "-o",
+        "m.bt",
+        "--resolution",
+        "0.1",
+    ];
+    // A negative value after the flag is the value, refused by the sensor model.
+    for (flag, needle) in [
+        ("--prob-hit", "hit probability -1 is not in (0, 1)"),
+        ("--prob-miss", "miss probability -1 is not in (0, 1)"),
+        ("--threshold", "threshold -1 is not in (0, 1)"),
+    ] {
+        let mut args = base.to_vec();
+        args.extend([flag, "-1"]);
+        fails(d, &args, needle);
+    }
+    let out = run(
+        d,
+        &[
+            "map",
+            "empty.xyz",
+            "--origin",
+            "0,0,0",
+            "-o",
+            "e.bt",
+            "--resolution",
+            "0.1",
+        ],
+    );
+    assert!(out.status.success(), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("warning: the scans hold no points"), "{err}");
+}

@@ -176,3 +176,13 @@ fn clamp_log_odds_are_octomaps_defaults_as_it_computes_them() {
         (super::FREE_LOG_ODDS, super::OCCUPIED_LOG_ODDS)
     );
 }
+
+#[test]
+fn voxels_past_the_keys_are_named_not_the_space_corner() {
+    let tree = LinearOctree::from_voxels(17, [0; 3], [[50_000, 0, 0], [50_010, 3, 0]]).unwrap();
+    let e = super::encode_bt(&crate::model::Model::new(tree)).unwrap_err();
+    assert!(
+        e.contains("reach [50000, 0, 0] to [50010, 3, 0]") && e.contains("−32768..32767"),
+        "{e}"
+    );
+}

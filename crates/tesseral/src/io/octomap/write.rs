@@ -40,6 +40,15 @@ pub(super) fn to_key_space(model: &Model) -> Result<KeyModel, String> {
         let shifted =
             LinearOctree::from_sorted_leaves(t.depth(), origin, t.leaves().iter().copied())
                 .map_err(|e| e.to_string())?;
+        // Name the voxels that do not fit, not the space's corner.
+        if let Some((lo, hi)) = shifted.bbox() {
+            if !(super::in_key_range(lo) && super::in_key_range(hi)) {
+                return Err(format!(
+                    "the voxels reach {lo:?} to {hi:?} in OctoMap's key space: OctoMap \
+                     keys reach only voxels −32768..32767 on each axis"
+                ));
+            }
+        }
         reframe(&shifted, OCTOMAP_DEPTH, [KEY_ORIGIN; 3])
             .map_err(|e| format!("{e}: OctoMap keys reach only voxels −32768..32767 on each axis"))
     };
