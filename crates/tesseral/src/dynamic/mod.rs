@@ -60,6 +60,7 @@ mod grow;
 mod pool;
 mod search;
 mod surface;
+mod tess_dyn;
 mod validate;
 
 use std::fmt;

@@ -12,6 +12,17 @@ pub(crate) fn put_varint(out: &mut Vec<u8>, mut v: u64) {
     out.push(v as u8);
 }
 
+/// Maps a signed number to an unsigned one, small magnitudes to small numbers
+/// (0, −1, 1, −2, … to 0, 1, 2, 3, …), for [`put_varint`].
+pub(crate) fn zigzag(v: i64) -> u64 {
+    ((v << 1) ^ (v >> 63)) as u64
+}
+
+/// The inverse of [`zigzag`].
+pub(crate) fn unzigzag(u: u64) -> i64 {
+    (u >> 1) as i64 ^ -((u & 1) as i64)
+}
+
 /// `bytes` less their last four, which must hold the CRC-32 (IEEE, little-endian)
 /// of all before them (the trailer of a version-1 `.tess` and of a map's own
 /// `.tess`); the caller has checked that there are four.

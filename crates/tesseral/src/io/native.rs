@@ -84,15 +84,26 @@ pub const MAGIC: [u8; 8] = *b"\x89TESSRL\n";
 /// [`OccupancyMap::write_file`](crate::occupancy::OccupancyMap::write_file) and read
 /// by [`OccupancyMap::read_file`](crate::occupancy::OccupancyMap::read_file).
 pub const MAP_MAGIC: [u8; 8] = *b"\x89TESSOM\n";
+/// The eight bytes an unbounded dynamic octree's own `.tess` starts with: an octree
+/// too wide for a model (past 2^21 voxels on an axis), written by
+/// [`DynamicOctree::write_file`](crate::dynamic::DynamicOctree::write_file) and read
+/// by [`DynamicOctree::read_file`](crate::dynamic::DynamicOctree::read_file).
+pub const DYN_MAGIC: [u8; 8] = *b"\x89TESSDY\n";
 
-/// The error for bytes that do not start with [`MAGIC`]: a map's own `.tess` is
-/// named as such (it holds more than a model can).
+/// The error for bytes that do not start with [`MAGIC`]: a map's or a dynamic
+/// octree's own `.tess` is named as such (it holds more than a model can).
 pub(crate) fn not_a_model(bytes: &[u8]) -> FormatError {
     if bytes.starts_with(&MAP_MAGIC) {
         FormatError::unsupported(
             "an occupancy map wider than a model holds (2^21 cells on an axis), in the map's \
              own .tess: read it as a map (OccupancyMap::read_file, Python \
              tesseral.OccupancyMap.read)",
+        )
+    } else if bytes.starts_with(&DYN_MAGIC) {
+        FormatError::unsupported(
+            "an unbounded dynamic octree wider than a model holds (2^21 voxels on an axis), \
+             in the dynamic octree's own .tess (written by tesseral replay -o): read it as a \
+             dynamic octree (DynamicOctree::read_file; tesseral info describes it)",
         )
     } else {
         FormatError::corrupt("not a tesseral .tess file (bad magic number)")

@@ -33,7 +33,7 @@
 use super::sensor::{Fixed, UNKNOWN};
 use super::store::{BlockKey, Cells, BLOCK_CELLS};
 use super::{OccupancyMap, SensorModel};
-use crate::io::leafstream::{crc_checked, put_varint, Reader};
+use crate::io::leafstream::{crc_checked, put_varint, unzigzag, zigzag, Reader};
 use crate::io::native::MAP_MAGIC;
 use crate::io::FormatError;
 
@@ -53,14 +53,6 @@ fn read_budget(file_len: usize) -> usize {
 /// The bits of a palette number for `k` values.
 fn width(k: usize) -> u32 {
     usize::BITS - (k - 1).leading_zeros()
-}
-
-fn zigzag(v: i64) -> u64 {
-    ((v << 1) ^ (v >> 63)) as u64
-}
-
-fn unzigzag(u: u64) -> i64 {
-    (u >> 1) as i64 ^ -((u & 1) as i64)
 }
 
 impl OccupancyMap {

@@ -13,6 +13,7 @@ mod convert;
 mod faces;
 mod growth;
 mod sequences;
+mod tess_dyn;
 
 /// The face-list rule of the contract, applied to a plain `Vec` with linear search.
 #[derive(Default)]
