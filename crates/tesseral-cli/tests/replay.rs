@@ -268,3 +268,54 @@ fn replay_o_refuses_stdout_an_unknown_format_and_the_input() {
     let (out, _dir) = replay_file("+ 40000 0 0\n+ 40001 0 0\n", &["-o", "far.tess"]);
     assert!(out.status.success());
 }
+
+#[test]
+fn replay_o_keeps_an_octree_wider_than_a_model_in_its_own_tess() {
+    let body = "+ 0 0 0\n+ 4000000 0 0\n+ -3 1099511627776 -9\n+ 1 0 0\n";
+    let (out, dir) = replay_file(body, &["-o", "d.tess"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(dir.path().join("d.tess")).unwrap();
+    assert!(bytes.starts_with(b"\x89TESSDY\n"));
+    // Three blocks: two voxels share one, each other voxel has its own.
+    assert_eq!(bytes.len(), 32 + 3 * 65 + 4 + 9 + 12, "{}", bytes.len());
+    let info = tesseral()
+        .args(["info", "--json", "d.tess"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(info.status.success(), "{}", String::from_utf8_lossy(&info.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    assert_eq!(v["kind"], "dynamic_octree");
+    assert_eq!(v["voxels"], 4);
+    assert_eq!(v["blocks"], 3);
+    assert_eq!(v["bbox_min"], serde_json::json!([-3, 0, -9]));
+    assert_eq!(v["bbox_max"], serde_json::json!([4000000, 1099511627776i64, 0]));
+    let text = tesseral()
+        .args(["info", "d.tess"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&text.stdout).contains("unbounded dynamic octree"));
+    // A command that needs a model names the file's kind and how to read it.
+    let conv = tesseral()
+        .args(["convert", "d.tess", "d.xyz"])
+        .current_dir(dir.path())
+        .output()
+        .unwrap();
+    assert!(!conv.status.success());
+    let e = String::from_utf8_lossy(&conv.stderr);
+    assert!(e.contains("DynamicOctree::read_file"), "{e}");
+    // Other formats cannot hold it; a narrow octree stays a model .tess.
+    let (out, dir) = replay_file(body, &["-o", "d.xyz"]);
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("only .tess keeps it"));
+    assert!(!dir.path().join("d.xyz").exists());
+    let (out, dir) = replay_file("+ 0 0 0\n+ 2000000 0 0\n", &["-o", "n.tess"]);
+    assert!(out.status.success());
+    let bytes = std::fs::read(dir.path().join("n.tess")).unwrap();
+    assert!(bytes.starts_with(b"\x89TESSRL\n"));
+}

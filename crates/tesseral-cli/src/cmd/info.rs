@@ -206,8 +206,10 @@ fn streamed(path: &std::path::Path) -> Result<Option<(Info, Option<BBox>)>> {
 }
 
 pub fn run(args: Args) -> Result<()> {
-    if !(args.tree || args.codes) && super::info_map::is_map_file(&args.file) {
-        return super::info_map::run(&args.file, args.json);
+    if !(args.tree || args.codes) {
+        if let Some(done) = super::info_wide::run_if_wide(&args.file, args.json) {
+            return done;
+        }
     }
     if !(args.tree || args.codes) {
         if let Some((info, bbox)) = streamed(&args.file)? {

@@ -8,7 +8,7 @@ pub mod collide;
 pub mod convert;
 pub mod help;
 pub mod info;
-pub mod info_map;
+pub mod info_wide;
 pub mod map;
 pub mod octree;
 pub mod op;

@@ -7,11 +7,13 @@
 //! are skipped. At the end one JSON object is printed with the keys `voxels`, `faces`,
 //! `root_size_log2`, `root_min`, `expansions`, `contractions`, `nodes`, `bytes`.
 //! With `-o FILE` the octree built is saved (any format `convert` writes, voxel size
-//! 1), through the output-safety layer; the report then also has `output`.
+//! 1), through the output-safety layer; the report then also has `output`. An
+//! octree wider than a model holds (2^21 voxels on an axis) keeps its full range in
+//! a `.tess` of its own (`DynamicOctree::encode_tess_dyn`); other formats refuse it.
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, IsTerminal, Read, Write};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use tesseral::dynamic::DynamicOctree;
@@ -127,20 +129,7 @@ pub fn run(args: Args) -> Result<()> {
         b.finish_and_clear();
     }
     if let Some(path) = &args.output {
-        let depth = u8::try_from(tree.root_size_log2()).unwrap_or(u8::MAX);
-        let lin = tree
-            .to_linear(depth, tree.root_min())
-            .with_context(|| format!("{}: the octree does not fit a file", path.display()))?;
-        let out_args = super::octree::OutArgs {
-            limits: args.limits,
-            format: None,
-        };
-        super::octree::save(
-            path,
-            &tesseral::model::Model::new(lin),
-            &out_args,
-            &Default::default(),
-        )?;
+        save(&tree, path, args.limits)?;
     }
     let mut report = serde_json::json!({
         "voxels": tree.voxel_count(),
@@ -158,4 +147,36 @@ pub fn run(args: Args) -> Result<()> {
     writeln!(out, "{report}").context("writing to stdout")?;
     out.flush().context("writing to stdout")?;
     Ok(())
+}
+
+/// Saves the octree built: through a model when it fits one, else in its own `.tess`
+/// (the only format that keeps its range).
+fn save(tree: &DynamicOctree, path: &Path, limits: super::output::Limits) -> Result<()> {
+    let out_args = super::octree::OutArgs {
+        limits,
+        format: None,
+    };
+    let ext = out_args.format_of(path);
+    if !tree.fits_model() {
+        if ext != "tess" {
+            bail!(
+                "{}: the octree spans 2^{} voxels on an axis, past a model's 2^{}: only .tess \
+                 keeps it (the dynamic octree's own format)",
+                path.display(),
+                tree.root_size_log2(),
+                tesseral::linear::MAX_DEPTH
+            );
+        }
+        return super::octree::save_encoded(path, &ext, &tree.encode_tess_dyn(), &out_args);
+    }
+    let depth = u8::try_from(tree.root_size_log2()).unwrap_or(u8::MAX);
+    let lin = tree
+        .to_linear(depth, tree.root_min())
+        .with_context(|| format!("{}: the octree does not fit a file", path.display()))?;
+    super::octree::save(
+        path,
+        &tesseral::model::Model::new(lin),
+        &out_args,
+        &Default::default(),
+    )
 }

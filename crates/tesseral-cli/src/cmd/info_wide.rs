@@ -1,20 +1,90 @@
-//! `tesseral info` of an occupancy map's own `.tess` (a map wider than a model
-//! holds: see `tesseral::occupancy::OccupancyMap::write_file`): its frame, cells
-//! and sensor model, read as a map.
+//! `tesseral info` of the `.tess` files wider than a model holds (2^21 voxels on
+//! an axis): an occupancy map's own (see
+//! `tesseral::occupancy::OccupancyMap::write_file`: its frame, cells and sensor
+//! model, read as a map) and a dynamic octree's own (see
+//! `tesseral::dynamic::DynamicOctree::write_file`, written by `tesseral replay -o`:
+//! its voxels, blocks and box).
 
 use std::io::Read;
 use std::path::Path;
 
 use anyhow::Result;
 use serde::Serialize;
+use tesseral::dynamic::DynamicOctree;
+use tesseral::io::native::{DYN_MAGIC, MAP_MAGIC};
 use tesseral::occupancy::{probability, OccupancyMap};
 
-/// Whether `path` is a map's own `.tess` (by its magic number).
-pub fn is_map_file(path: &Path) -> bool {
+/// Describes `path` when it is a map's or a dynamic octree's own `.tess` (by its
+/// magic number); `None` for any other file.
+pub fn run_if_wide(path: &Path, json: bool) -> Option<Result<()>> {
     let mut head = [0u8; 8];
     std::fs::File::open(path)
         .and_then(|mut f| f.read_exact(&mut head))
-        .is_ok_and(|()| head == tesseral::io::native::MAP_MAGIC)
+        .ok()?;
+    match head {
+        MAP_MAGIC => Some(run_map(path, json)),
+        DYN_MAGIC => Some(run_dyn(path, json)),
+        _ => None,
+    }
+}
+
+/// The `--json` output of a dynamic octree. Its keys are a public interface: only
+/// ever add.
+#[derive(Serialize)]
+struct DynInfo {
+    /// Always `"dynamic_octree"`.
+    kind: &'static str,
+    /// Voxels (as a model's `voxels`).
+    voxels: u64,
+    /// World-aligned 8³ blocks holding a voxel (the file's blocks).
+    blocks: usize,
+    /// The voxels' lowest coordinates, or null when empty.
+    bbox_min: Option<[i64; 3]>,
+    /// Their highest coordinates, or null.
+    bbox_max: Option<[i64; 3]>,
+    /// log2 of the root's side.
+    root_size_log2: u32,
+    /// Bytes the octree takes in memory.
+    bytes: usize,
+}
+
+/// Prints a dynamic octree file's info (`json`: one object).
+fn run_dyn(path: &Path, json: bool) -> Result<()> {
+    let t = DynamicOctree::read_file(path)?;
+    let bounds = t.bounds();
+    let info = DynInfo {
+        kind: "dynamic_octree",
+        voxels: t.voxel_count(),
+        blocks: t.world_block_count(),
+        bbox_min: bounds.map(|b| b.0),
+        bbox_max: bounds.map(|b| b.1),
+        root_size_log2: t.root_size_log2(),
+        bytes: t.bytes(),
+    };
+    if json {
+        crate::outln!("{}", serde_json::to_string_pretty(&info)?)?;
+        return Ok(());
+    }
+    crate::outln!("file     {}", path.display())?;
+    crate::outln!(
+        "kind     unbounded dynamic octree, wider than a model holds (2^21 voxels on an axis)"
+    )?;
+    crate::outln!(
+        "voxels   {} in {} blocks of 8^3",
+        info.voxels,
+        info.blocks
+    )?;
+    match bounds {
+        Some((lo, hi)) => crate::outln!(
+            "bbox     {} to {}",
+            super::octree::fmt_voxel(lo),
+            super::octree::fmt_voxel(hi)
+        )?,
+        None => crate::outln!("bbox     (empty)")?,
+    }
+    crate::outln!("root     2^{} voxels on a side", info.root_size_log2)?;
+    crate::outln!("bytes    {} in memory", info.bytes)?;
+    Ok(())
 }
 
 /// The `--json` output of a map. Its keys are a public interface: only ever add.
@@ -53,7 +123,7 @@ struct MapInfo {
 }
 
 /// Prints a map file's info (`json`: one object).
-pub fn run(path: &Path, json: bool) -> Result<()> {
+fn run_map(path: &Path, json: bool) -> Result<()> {
     let map = OccupancyMap::read_file(path)?;
     let counts = map.counts();
     let s = map.sensor();
