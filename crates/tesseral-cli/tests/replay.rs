@@ -287,13 +287,20 @@ fn replay_o_keeps_an_octree_wider_than_a_model_in_its_own_tess() {
         .current_dir(dir.path())
         .output()
         .unwrap();
-    assert!(info.status.success(), "{}", String::from_utf8_lossy(&info.stderr));
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
     let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
     assert_eq!(v["kind"], "dynamic_octree");
     assert_eq!(v["voxels"], 4);
     assert_eq!(v["blocks"], 3);
     assert_eq!(v["bbox_min"], serde_json::json!([-3, 0, -9]));
-    assert_eq!(v["bbox_max"], serde_json::json!([4000000, 1099511627776i64, 0]));
+    assert_eq!(
+        v["bbox_max"],
+        serde_json::json!([4000000, 1099511627776i64, 0])
+    );
     let text = tesseral()
         .args(["info", "d.tess"])
         .current_dir(dir.path())

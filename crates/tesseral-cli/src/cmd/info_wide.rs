@@ -69,11 +69,7 @@ fn run_dyn(path: &Path, json: bool) -> Result<()> {
     crate::outln!(
         "kind     unbounded dynamic octree, wider than a model holds (2^21 voxels on an axis)"
     )?;
-    crate::outln!(
-        "voxels   {} in {} blocks of 8^3",
-        info.voxels,
-        info.blocks
-    )?;
+    crate::outln!("voxels   {} in {} blocks of 8^3", info.voxels, info.blocks)?;
     match bounds {
         Some((lo, hi)) => crate::outln!(
             "bbox     {} to {}",

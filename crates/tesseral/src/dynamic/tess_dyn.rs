@@ -158,8 +158,7 @@ impl DynamicOctree {
         let mut out: Option<(Voxel, Voxel)> = None;
         for (key, bits) in self.world_blocks() {
             let m = leaf_axis_masks(&bits);
-            let lo: Voxel =
-                std::array::from_fn(|a| key[a] * 8 + i64::from(m[a].trailing_zeros()));
+            let lo: Voxel = std::array::from_fn(|a| key[a] * 8 + i64::from(m[a].trailing_zeros()));
             let hi: Voxel =
                 std::array::from_fn(|a| key[a] * 8 + 7 - i64::from(m[a].leading_zeros()));
             out = Some(match out {

@@ -15,7 +15,11 @@ fn round_trip(t: &DynamicOctree, set: &HashSet<Voxel>) -> Vec<u8> {
     assert_eq!(back.voxel_count(), set.len() as u64);
     let got: HashSet<Voxel> = back.voxels().into_iter().collect();
     assert_eq!(&got, set);
-    assert_eq!(back.encode_tess_dyn(), bytes, "a second write gives the same bytes");
+    assert_eq!(
+        back.encode_tess_dyn(),
+        bytes,
+        "a second write gives the same bytes"
+    );
     assert_eq!(back.world_block_count(), t.world_block_count());
     assert_eq!(back.bounds(), t.bounds());
     bytes
@@ -49,8 +53,16 @@ fn random_sets_round_trip_near_far_and_at_the_edges() {
         (2, vec![[0, 0, 0]], 40),
         (3, vec![[0, 0, 0], [far, -far, 3]], 20),
         (4, vec![[-far, 5, far], [far, far, -far], [0, 0, 0]], 12),
-        (5, vec![[lo + 20, lo + 20, lo + 20], [hi - 20, hi - 20, hi - 20]], 20),
-        (6, vec![[lo + 9, 0, hi - 9], [0, hi - 3, lo + 3], [5, 5, 5]], 9),
+        (
+            5,
+            vec![[lo + 20, lo + 20, lo + 20], [hi - 20, hi - 20, hi - 20]],
+            20,
+        ),
+        (
+            6,
+            vec![[lo + 9, 0, hi - 9], [0, hi - 3, lo + 3], [5, 5, 5]],
+            9,
+        ),
     ] {
         for small in [true, false] {
             let (mut t, set) = random_set(seed, &centres, r, 3000);
@@ -135,13 +147,19 @@ fn every_truncation_and_bit_flip_is_an_error_or_a_valid_octree() {
     for i in 0..bytes.len() * 8 {
         let mut b = bytes.clone();
         b[i / 8] ^= 1 << (i % 8);
-        assert!(DynamicOctree::decode_tess_dyn(&b).is_err(), "bit {i} past the CRC");
+        assert!(
+            DynamicOctree::decode_tess_dyn(&b).is_err(),
+            "bit {i} past the CRC"
+        );
         reseal(&mut b);
         if let Ok(d) = DynamicOctree::decode_tess_dyn(&b) {
             d.assert_valid();
             // Read again from its own bytes (a padded varint may write shorter).
             let again = DynamicOctree::decode_tess_dyn(&d.encode_tess_dyn()).unwrap();
-            assert!(again.voxels() == d.voxels(), "bit {i}: a different octree read back");
+            assert!(
+                again.voxels() == d.voxels(),
+                "bit {i}: a different octree read back"
+            );
         }
     }
 }
@@ -175,22 +193,43 @@ fn hostile_blocks_are_named_with_their_offsets() {
     assert!(DynamicOctree::decode_tess_dyn(&file_of(&[one.clone()], 1)).is_ok());
     // Keys must increase: a zero delta repeats block 0 at byte 32 + 68.
     let e = error_of(&file_of(&[one.clone(), one.clone()], 2));
-    assert!(e.contains("block 1 (byte 100)") && e.contains("increase strictly"), "{e}");
+    assert!(
+        e.contains("block 1 (byte 100)") && e.contains("increase strictly"),
+        "{e}"
+    );
     let e = error_of(&file_of(&[[vec![0, 0, 0, 1], mask([0; 8])].concat()], 0));
-    assert!(e.contains("block 0 (byte 32)") && e.contains("empty mask"), "{e}");
+    assert!(
+        e.contains("block 0 (byte 32)") && e.contains("empty mask"),
+        "{e}"
+    );
     let e = error_of(&file_of(&[[vec![0, 0, 0, 1], mask([!0; 8])].concat()], 512));
-    assert!(e.contains("block 0 (byte 32)") && e.contains("tag 0"), "{e}");
+    assert!(
+        e.contains("block 0 (byte 32)") && e.contains("tag 0"),
+        "{e}"
+    );
     let e = error_of(&file_of(&[vec![0, 0, 0, 0], vec![2, 0, 0, 7]], 512));
-    assert!(e.contains("block 1 (byte 36)") && e.contains("tag 7"), "{e}");
+    assert!(
+        e.contains("block 1 (byte 36)") && e.contains("tag 7"),
+        "{e}"
+    );
     let e = error_of(&file_of(&[vec![0, 0, 0, 0]], 511));
-    assert!(e.contains("voxel count 511") && e.contains("hold 512"), "{e}");
+    assert!(
+        e.contains("voxel count 511") && e.contains("hold 512"),
+        "{e}"
+    );
     // 2^61 (zigzag 2^62) is past the keys' range −2^60..2^60.
     let far = [vec![0x80; 8], vec![0x40, 0, 0, 0]].concat();
     let e = error_of(&file_of(&[far], 512));
-    assert!(e.contains("block 0 (byte 32)") && e.contains("past the i64 voxel range"), "{e}");
+    assert!(
+        e.contains("block 0 (byte 32)") && e.contains("past the i64 voxel range"),
+        "{e}"
+    );
     // A truncated mask, a count the bytes cannot hold, trailing bytes.
     let e = error_of(&file_of(&[vec![0, 0, 0, 1, 1, 2, 3]], 1));
-    assert!(e.contains("block 0 (byte 32)") && e.contains("truncated"), "{e}");
+    assert!(
+        e.contains("block 0 (byte 32)") && e.contains("truncated"),
+        "{e}"
+    );
     let mut b = file_of(&[vec![0, 0, 0, 0]], 512);
     b[24] = 2;
     reseal(&mut b);
@@ -231,7 +270,10 @@ fn blocks_spread_far_apart_are_refused_before_memory_runs_out() {
     let per_block = t.bytes() as f64 / few as f64;
     let per_byte = t.bytes() as f64 / bytes.len() as f64;
     eprintln!("spread full blocks: {per_block:.0} bytes a block, {per_byte:.0} times the file");
-    assert!(per_byte > 64.0, "the hostile case is past the budget's ratio");
+    assert!(
+        per_byte > 64.0,
+        "the hostile case is past the budget's ratio"
+    );
     // Points scattered over 2^40 (a robot's log): far inside the budget.
     let (t, _) = random_set(11, &[[0, 0, 0]], 1 << 40, 20_000);
     let bytes = t.encode_tess_dyn();
@@ -266,9 +308,15 @@ fn files_hold_wide_octrees_in_their_own_tess_and_others_as_models() {
             assert_eq!(model.unwrap().tree.voxel_count(), t.voxel_count());
         } else {
             let e = model.unwrap_err().to_string();
-            assert!(e.contains("wide.tess") && e.contains("DynamicOctree::read_file"), "{e}");
+            assert!(
+                e.contains("wide.tess") && e.contains("DynamicOctree::read_file"),
+                "{e}"
+            );
         }
     }
-    let e = wide.write_file(&dir.path().join("wide.bt")).unwrap_err().to_string();
+    let e = wide
+        .write_file(&dir.path().join("wide.bt"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("only .tess"), "{e}");
 }
