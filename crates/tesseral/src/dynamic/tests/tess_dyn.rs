@@ -190,7 +190,7 @@ fn error_of(bytes: &[u8]) -> String {
 fn hostile_blocks_are_named_with_their_offsets() {
     let mask = |bits: [u64; 8]| -> Vec<u8> { bits.iter().flat_map(|w| w.to_le_bytes()).collect() };
     let one = [vec![0, 0, 0, 1], mask([1, 0, 0, 0, 0, 0, 0, 0])].concat();
-    assert!(DynamicOctree::decode_tess_dyn(&file_of(&[one.clone()], 1)).is_ok());
+    assert!(DynamicOctree::decode_tess_dyn(&file_of(std::slice::from_ref(&one), 1)).is_ok());
     // Keys must increase: a zero delta repeats block 0 at byte 32 + 68.
     let e = error_of(&file_of(&[one.clone(), one.clone()], 2));
     assert!(
