@@ -30,11 +30,14 @@
 use std::collections::BTreeMap;
 use std::path::Path;
 
-#[allow(unused_imports)]
-use super::*;
+use super::blocks::leaf_axis_masks;
+use super::{
+    child_index, DynamicOctree, Small, EMPTY, FULL_BLOCK, LEAF_LOG2, NONE, SMALL_CAP, ZERO_BLOCK,
+};
 use crate::io::leafstream::{crc_checked, put_varint, unzigzag, zigzag, Reader};
 use crate::io::native::DYN_MAGIC;
 use crate::io::FormatError;
+use crate::Voxel;
 
 const VERSION: u16 = 1;
 const HEADER_LEN: usize = 32;
