@@ -34,12 +34,12 @@ use super::blocks::leaf_axis_masks;
 use super::{
     child_index, DynamicOctree, Small, EMPTY, FULL_BLOCK, LEAF_LOG2, NONE, SMALL_CAP, ZERO_BLOCK,
 };
-use crate::io::leafstream::{crc_checked, put_varint, unzigzag, zigzag, Reader};
+use crate::io::leafstream::{put_varint, unzigzag, zigzag, Reader};
 use crate::io::native::DYN_MAGIC;
+use crate::io::wide;
 use crate::io::FormatError;
 use crate::Voxel;
 
-const VERSION: u16 = 1;
 const HEADER_LEN: usize = 32;
 const FULL_TAG: u8 = 0;
 const MASK_TAG: u8 = 1;
@@ -191,9 +191,7 @@ impl DynamicOctree {
     pub fn encode_tess_dyn(&self) -> Vec<u8> {
         let blocks = self.world_blocks();
         let mut out = Vec::with_capacity(HEADER_LEN + 8 * blocks.len() + 4);
-        out.extend_from_slice(&DYN_MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&[0; 6]);
+        wide::start(&mut out, &DYN_MAGIC);
         out.extend_from_slice(&self.voxels.to_le_bytes());
         out.extend_from_slice(&(blocks.len() as u64).to_le_bytes());
         let mut prev = [0i64; 3];
@@ -211,8 +209,7 @@ impl DynamicOctree {
                 }
             }
         }
-        let crc = crc32fast::hash(&out);
-        out.extend_from_slice(&crc.to_le_bytes());
+        wide::seal(&mut out);
         out
     }
 
@@ -230,32 +227,8 @@ impl DynamicOctree {
     /// [`FormatError::Unsupported`] for another version or flags.
     pub fn decode_tess_dyn(bytes: &[u8]) -> Result<Self, FormatError> {
         let bad = |m: String| FormatError::corrupt(m);
-        if bytes.len() < 8 || bytes[..8] != DYN_MAGIC {
-            return Err(bad(
-                "not a tesseral dynamic octree (bad magic number)".into()
-            ));
-        }
-        if bytes.len() < HEADER_LEN + 4 {
-            return Err(bad(format!(
-                "truncated: {} bytes, a dynamic octree's header and checksum take {}",
-                bytes.len(),
-                HEADER_LEN + 4
-            )));
-        }
-        let body = crc_checked(bytes).map_err(bad)?;
-        let mut r = Reader {
-            bytes: body,
-            pos: 8,
-        };
-        let version = r.u16().map_err(bad)?;
-        let flags = r.u16().map_err(bad)?;
-        let zero = r.u32().map_err(bad)?;
-        if version != VERSION || flags != 0 || zero != 0 {
-            return Err(FormatError::unsupported(format!(
-                "dynamic octree format version {version}, flags {flags:#x}; this build reads \
-                 version {VERSION} with no flags"
-            )));
-        }
+        let mut r = wide::open(bytes, &DYN_MAGIC, "dynamic octree", HEADER_LEN)?;
+        let body = r.bytes;
         let voxels = r.u64().map_err(bad)?;
         let count = r.u64().map_err(bad)?;
         // Every block takes at least four bytes (three varints and a tag).
@@ -381,15 +354,7 @@ impl DynamicOctree {
     /// # Errors
     /// The reader's [`FormatError`], named with the path.
     pub fn read_file(path: &Path) -> Result<Self, FormatError> {
-        let mut head = [0u8; 8];
-        let n = {
-            use std::io::Read;
-            let mut f =
-                std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
-            f.read(&mut head).unwrap_or(0)
-        };
-        if head[..n] == DYN_MAGIC {
-            let bytes = crate::io::read_limited(path, crate::io::MAX_FILE_BYTES)?;
+        if let Some(bytes) = crate::io::wide::read_if(path, &DYN_MAGIC)? {
             return Self::decode_tess_dyn(&bytes).map_err(|e| e.with_path(path));
         }
         let model = crate::io::read_model(path)?;

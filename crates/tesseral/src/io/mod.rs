@@ -44,6 +44,7 @@ mod tess_v1;
 #[cfg(all(test, target_os = "linux"))]
 mod tests_release;
 pub mod vox;
+pub(crate) mod wide;
 pub mod xyz;
 
 mod error;

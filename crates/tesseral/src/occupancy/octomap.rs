@@ -98,15 +98,7 @@ impl OccupancyMap {
     /// [`FormatError::Unsupported`] for a model that is no map (see
     /// [`from_model`](Self::from_model)).
     pub fn read_file(path: &Path) -> Result<Self, FormatError> {
-        let mut head = [0u8; 8];
-        let n = {
-            use std::io::Read;
-            let mut f =
-                std::fs::File::open(path).map_err(|e| FormatError::io(e).with_path(path))?;
-            f.read(&mut head).unwrap_or(0)
-        };
-        if head[..n] == MAP_MAGIC {
-            let bytes = crate::io::read_limited(path, crate::io::MAX_FILE_BYTES)?;
+        if let Some(bytes) = crate::io::wide::read_if(path, &MAP_MAGIC)? {
             return Self::decode_tess_map(&bytes).map_err(|e| e.with_path(path));
         }
         let model = crate::io::read_model(path)?;

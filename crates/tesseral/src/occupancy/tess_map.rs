@@ -33,11 +33,11 @@
 use super::sensor::{Fixed, UNKNOWN};
 use super::store::{BlockKey, Cells, BLOCK_CELLS};
 use super::{OccupancyMap, SensorModel};
-use crate::io::leafstream::{crc_checked, put_varint, unzigzag, zigzag, Reader};
+use crate::io::leafstream::{put_varint, unzigzag, zigzag, Reader};
 use crate::io::native::MAP_MAGIC;
+use crate::io::wide;
 use crate::io::FormatError;
 
-const VERSION: u16 = 1;
 const HEADER_LEN: usize = 56;
 const UNIFORM: u8 = 0;
 const SPARSE: u8 = 1;
@@ -64,9 +64,7 @@ impl OccupancyMap {
     #[must_use]
     pub fn encode_tess_map(&self) -> Vec<u8> {
         let mut out = Vec::with_capacity(HEADER_LEN + 64 * self.store.block_count());
-        out.extend_from_slice(&MAP_MAGIC);
-        out.extend_from_slice(&VERSION.to_le_bytes());
-        out.extend_from_slice(&[0; 6]);
+        wide::start(&mut out, &MAP_MAGIC);
         out.extend_from_slice(&self.resolution.to_le_bytes());
         let s = &self.sensor;
         for l in [
@@ -88,8 +86,7 @@ impl OccupancyMap {
             prev = b;
             put_block(&mut out, cells);
         });
-        let crc = crc32fast::hash(&out);
-        out.extend_from_slice(&crc.to_le_bytes());
+        wide::seal(&mut out);
         out
     }
 
@@ -105,30 +102,8 @@ impl OccupancyMap {
     /// [`FormatError::Unsupported`] for another version or flags.
     pub fn decode_tess_map(bytes: &[u8]) -> Result<Self, FormatError> {
         let bad = |m: String| FormatError::corrupt(m);
-        if bytes.len() < 8 || bytes[..8] != MAP_MAGIC {
-            return Err(bad("not a tesseral occupancy map (bad magic number)".into()));
-        }
-        if bytes.len() < HEADER_LEN + 4 {
-            return Err(bad(format!(
-                "truncated: {} bytes, a map's header and checksum take {}",
-                bytes.len(),
-                HEADER_LEN + 4
-            )));
-        }
-        let body = crc_checked(bytes).map_err(bad)?;
-        let mut r = Reader {
-            bytes: body,
-            pos: 8,
-        };
-        let version = r.u16().map_err(bad)?;
-        let flags = r.u16().map_err(bad)?;
-        let zero = r.u32().map_err(bad)?;
-        if version != VERSION || flags != 0 || zero != 0 {
-            return Err(FormatError::unsupported(format!(
-                "map format version {version}, flags {flags:#x}; this build reads version {VERSION} \
-                 with no flags"
-            )));
-        }
+        let mut r = wide::open(bytes, &MAP_MAGIC, "occupancy map", HEADER_LEN)?;
+        let body = r.bytes;
         let resolution = r.f64().map_err(bad)?;
         let mut l = [0f32; 5];
         for x in &mut l {
