@@ -295,8 +295,10 @@ pub struct Entry {
     crc32: u32,
 }
 
-/// Writes part `i` (range `[lo, hi)`) of a dataset in `dir` (created if missing),
-/// with its frame and colours; returns its manifest entry as a dict.
+/// Writes part `i` (range `[lo, hi)`) of a dataset in `dir`, which must exist (the
+/// staged folder the client made: a task still running after the write was
+/// abandoned and its folder removed must not make it again), with its frame and
+/// colours; returns its manifest entry as a dict.
 #[pyfunction]
 pub fn partition_write_part<'py>(
     py: Python<'py>,
@@ -307,7 +309,13 @@ pub fn partition_write_part<'py>(
     tree: &Octree,
 ) -> PyResult<Bound<'py, PyDict>> {
     let m = &tree.model;
-    std::fs::create_dir_all(&dir).map_err(|e| errors::io(&e, Some(&dir)))?;
+    if !dir.is_dir() {
+        let gone = std::io::Error::new(
+            std::io::ErrorKind::NotFound,
+            "the dataset's staged folder is gone (its write was abandoned)",
+        );
+        return Err(errors::io(&gone, Some(&dir)));
+    }
     let e = py
         .allow_threads(|| part::write_model_part(&dir, i, Partition { lo, hi }, m))
         .map_err(partition_error)?;

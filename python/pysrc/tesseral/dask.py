@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import time
 from typing import Any, Iterable, List, Optional, Sequence, Tuple, Union
 
 try:
@@ -455,9 +456,22 @@ def write(parts: Parts, path: Union[str, "os.PathLike[str]"], overwrite: bool = 
     try:
         (out,) = dask.compute(task, **compute_kwargs)
     except BaseException:
-        shutil.rmtree(tmp, ignore_errors=True)
+        _remove_staged(tmp)
         raise
     return out
+
+
+def _remove_staged(tmp: str) -> None:
+    """Removes the staged folder of a failed write. Tasks of the failed graph may
+    still be writing their parts into it (``dask.compute`` raises at the first
+    error): a file they add makes one removal fail, so it is tried again until the
+    folder is gone. Gone, it stays gone: a part task refuses to write without it.
+    """
+    for _ in range(100):
+        shutil.rmtree(tmp, ignore_errors=True)
+        if not os.path.exists(tmp):
+            return
+        time.sleep(0.05)
 
 
 def read(path: Union[str, "os.PathLike[str]"]) -> Parts:
