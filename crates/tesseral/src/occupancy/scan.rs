@@ -54,7 +54,8 @@ fn key_at(inv: f64, p: [f64; 3]) -> [i64; 3] {
 /// sensor (10^17 m at 5 cm), with room for the walk's differences of keys in `i64`.
 const REACH: f64 = (1u64 << 61) as f64;
 
-/// Whether `p`'s cell lies within [`REACH`] on every axis (`inv` = 1 / resolution).
+/// Whether `p`'s cell lies within [`REACH`] on every axis (`inv` = 1 / resolution);
+/// false for a coordinate NaN or infinite.
 #[inline]
 pub(super) fn within_reach(inv: f64, p: [f64; 3]) -> bool {
     p.iter().all(|&c| (c * inv).abs() < REACH)
@@ -110,7 +111,7 @@ pub(super) fn cast_scan(
         ..ScanStats::default()
     };
     let inv = 1.0 / res;
-    if !(origin.iter().all(|c| c.is_finite()) && within_reach(inv, origin)) {
+    if !within_reach(inv, origin) {
         stats.skipped = stats.points;
         return Cast {
             scratches: Vec::new(),
@@ -292,7 +293,7 @@ impl OccupancyMap {
         origin: [f64; 3],
         pending: Option<&Cast>,
     ) -> Option<Arc<[u64]>> {
-        if !(origin.iter().all(|c| c.is_finite()) && within_reach(1.0 / self.resolution, origin)) {
+        if !within_reach(1.0 / self.resolution, origin) {
             return None;
         }
         debug_assert!(self.fixed.miss < 0, "a miss lowers a cell's value");

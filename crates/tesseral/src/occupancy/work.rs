@@ -36,7 +36,7 @@ impl OccupancyMap {
     ) -> ScanWork {
         let mut w = ScanWork::default();
         let inv = 1.0 / self.resolution;
-        if !(origin.iter().all(|c| c.is_finite()) && within_reach(inv, origin)) {
+        if !within_reach(inv, origin) {
             return w;
         }
         let max_range = max_range.filter(|r| *r >= 0.0);
