@@ -453,3 +453,48 @@ fn a_closed_pipe_ends_quietly() {
         quiet_on_broken_pipe(d, args);
     }
 }
+
+/// A reader that leaves early (`tesseral replay ops -o F | head`) ended the replay
+/// before F was written; it ends only what goes to standard output now, and the
+/// files still to write are written.
+#[test]
+fn a_closed_pipe_does_not_stop_the_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 80 KB of answers, more than a pipe holds.
+    let ops: String = (0..40_000)
+        .map(|i| format!("+ {i} 0 0\n? {i} 0 0\n"))
+        .collect();
+    fs::write(d.join("ops.txt"), ops).unwrap();
+    quiet_on_broken_pipe(d, &["replay", "ops.txt", "-o", "r.xyz"]);
+    let saved = fs::read_to_string(d.join("r.xyz")).unwrap();
+    assert_eq!(
+        saved.lines().filter(|l| !l.starts_with('#')).count(),
+        40_000
+    );
+
+    fs::write(d.join("a.xyz"), "0 0 0\n1 0 0\n").unwrap();
+    fs::write(
+        d.join("world.json"),
+        r#"{"environment": "a.xyz", "time_step": 1, "steps": 1000,
+            "objects": [{"name": "b", "octree": "a.xyz", "start": [5, 0, 0], "velocity": [-1, 0, 0]}]}"#,
+    )
+    .unwrap();
+    // Both outputs pass a pipe's 64 KiB buffer, so the closed pipe is met midway
+    // whenever the reader leaves: with --json each step's frame is printed as it
+    // comes.
+    quiet_on_broken_pipe(
+        d,
+        &[
+            "simulate",
+            "world.json",
+            "--json",
+            "--frames",
+            "f",
+            "--size",
+            "16x12",
+        ],
+    );
+    let frames = fs::read_dir(d.join("f")).unwrap().count();
+    assert_eq!(frames, 1001, "the start and every step");
+}

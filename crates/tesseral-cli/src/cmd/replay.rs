@@ -10,6 +10,7 @@
 //! 1), through the output-safety layer; the report then also has `output`. An
 //! octree wider than a model holds (2^21 voxels on an axis) keeps its full range in
 //! a `.tess` of its own (`DynamicOctree::encode_tess_dyn`); other formats refuse it.
+//! A reader that closes standard output early (`| head`) does not stop the save.
 
 use std::fs::File;
 use std::io::{self, BufReader, BufWriter, IsTerminal, Read, Write};
@@ -19,6 +20,7 @@ use anyhow::{bail, Context, Result};
 use tesseral::dynamic::DynamicOctree;
 
 use super::replay_log::{parse_line, read_line, Op};
+use super::stdio::Detachable;
 
 /// Arguments of `tesseral replay`.
 #[derive(clap::Args)]
@@ -63,7 +65,9 @@ pub fn run(args: Args) -> Result<()> {
         (Box::new(f), len)
     };
     let mut reader = BufReader::with_capacity(1 << 16, input);
-    let mut out = BufWriter::new(io::stdout().lock());
+    // A reader that leaves early (`| head`) ends the queries' output, not the
+    // replay: with -o, the octree is still built and saved.
+    let mut out = Detachable::new(BufWriter::new(io::stdout().lock()));
     let mut tree = if args.track_faces {
         DynamicOctree::with_faces()
     } else {
@@ -88,7 +92,7 @@ pub fn run(args: Args) -> Result<()> {
     let mut bytes_read: u64 = 0;
     loop {
         let more = read_line(&mut reader, &mut buf);
-        let fail = |msg: String, out: &mut BufWriter<_>| -> Result<()> {
+        let fail = |msg: String, out: &mut Detachable<_>| -> Result<()> {
             out.flush().context("writing query results")?;
             bail!(
                 "{name}: line {}: {msg} ({line_no} lines applied)",
@@ -114,6 +118,9 @@ pub fn run(args: Args) -> Result<()> {
             }
             Ok(Op::Query(v)) => {
                 writeln!(out, "{}", u8::from(tree.contains(v))).context("writing to stdout")?;
+                if out.closed() && args.output.is_none() {
+                    return Ok(());
+                }
             }
             Ok(Op::Skip) => {}
             Err(msg) => return fail(msg, &mut out),

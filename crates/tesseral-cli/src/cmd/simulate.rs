@@ -11,6 +11,7 @@ use tesseral::render::{Camera, RenderOptions, View};
 
 use super::budget::Budget;
 use super::output::{self, Limits, Size};
+use super::stdio::Detachable;
 
 /// Arguments of `tesseral simulate`.
 #[derive(clap::Args)]
@@ -166,9 +167,11 @@ pub fn run(args: Args) -> Result<()> {
     };
     // Each step is reported and dropped as it comes: a long run keeps one step in
     // memory (the review's depth-10 sphere resting in itself kept them all).
-    let stdout = std::io::stdout().lock();
+    // A reader that leaves early (`| head`) ends the report, not the frames and
+    // the page still to write.
+    let stdout = Detachable::new(std::io::BufWriter::new(std::io::stdout().lock()));
     let mut report = Reporter {
-        out: Budgeted::new(std::io::BufWriter::new(stdout), args.limits.max_output),
+        out: Budgeted::new(stdout, args.limits.max_output),
         json: args.json,
         contacts_json: Vec::new(),
         contacts: 0,
@@ -204,7 +207,9 @@ pub fn run(args: Args) -> Result<()> {
                     _ => Ok(()),
                 });
             bar.inc(1);
+            let files = args.frames.is_some() || anim.is_some();
             match done {
+                Ok(()) if report.out.inner.closed() && !files => ControlFlow::Break(()),
                 Ok(()) => ControlFlow::Continue(()),
                 Err(e) => {
                     failure = Some(e);

@@ -77,3 +77,113 @@ pub fn to_stdout(ext: &str, write: impl FnOnce(&Path) -> Result<()>) -> Result<(
     out.flush().context("<stdout>: writing the output")?;
     Ok(())
 }
+
+/// Standard output that a reader may close early (`tesseral replay ops -o F | head`).
+///
+/// The first broken pipe marks it [`closed`](Self::closed) and every later write is
+/// dropped, so that a command with files still to write goes on and writes them; a
+/// command with nothing else to do asks `closed` and stops. Other errors pass through.
+pub struct Detachable<W: Write> {
+    inner: W,
+    closed: bool,
+}
+
+impl<W: Write> Detachable<W> {
+    pub fn new(inner: W) -> Self {
+        Self {
+            inner,
+            closed: false,
+        }
+    }
+
+    /// Whether the reader has gone (a write or flush met a broken pipe).
+    pub fn closed(&self) -> bool {
+        self.closed
+    }
+
+    /// `Ok` for a broken pipe, which marks the writer closed.
+    fn detach<T>(&mut self, r: std::io::Result<T>, dropped: T) -> std::io::Result<T> {
+        match r {
+            Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+                self.closed = true;
+                Ok(dropped)
+            }
+            r => r,
+        }
+    }
+}
+
+impl<W: Write> Write for Detachable<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.closed {
+            return Ok(buf.len());
+        }
+        let r = self.inner.write(buf);
+        self.detach(r, buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        if self.closed {
+            return Ok(());
+        }
+        let r = self.inner.flush();
+        self.detach(r, ())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Detachable;
+    use std::io::{self, Write};
+
+    /// A pipe whose reader leaves after `keep` bytes.
+    struct Pipe {
+        keep: usize,
+        got: Vec<u8>,
+    }
+
+    impl Write for Pipe {
+        fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+            if self.got.len() >= self.keep {
+                return Err(io::ErrorKind::BrokenPipe.into());
+            }
+            let n = buf.len().min(self.keep - self.got.len());
+            self.got.extend_from_slice(&buf[..n]);
+            Ok(n)
+        }
+        fn flush(&mut self) -> io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_broken_pipe_closes_it_and_later_writes_are_dropped() {
+        let mut out = Detachable::new(Pipe {
+            keep: 4,
+            got: Vec::new(),
+        });
+        out.write_all(b"1\n0\n").unwrap();
+        assert!(!out.closed());
+        out.write_all(b"1\n").unwrap();
+        assert!(out.closed());
+        out.write_all(b"more\n").unwrap();
+        out.flush().unwrap();
+        assert_eq!(out.inner.got, b"1\n0\n");
+    }
+
+    #[test]
+    fn other_errors_pass_through() {
+        struct Full;
+        impl Write for Full {
+            fn write(&mut self, _: &[u8]) -> io::Result<usize> {
+                Err(io::Error::from_raw_os_error(28))
+            }
+            fn flush(&mut self) -> io::Result<()> {
+                Ok(())
+            }
+        }
+        let mut out = Detachable::new(Full);
+        assert!(out.write_all(b"x").is_err());
+        assert!(!out.closed());
+    }
+}

@@ -177,6 +177,12 @@ pub fn extension(path: &Path) -> String {
         .to_ascii_lowercase()
 }
 
+/// The bytes after a UTF-8 byte order mark, if they start with one: text readers
+/// skip it (editors on Windows write one), and count columns after it.
+pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
+}
+
 /// Reads a whole file, refusing files larger than `limit` bytes.
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
     let attach = |e: FormatError| e.with_path(path);

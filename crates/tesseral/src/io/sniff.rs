@@ -31,15 +31,17 @@ pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
         (b"ply\n", "ply"),
         (b"ply\r\n", "ply"),
     ];
-    for (magic, ext) in MAGIC {
-        if bytes.starts_with(magic) {
-            return Some(ext);
-        }
-    }
     if is_binary_stl(bytes) {
         return Some("stl");
     }
-    let head = &bytes[..bytes.len().min(1024)];
+    // Text may start with a UTF-8 byte order mark, which its readers skip.
+    let body = super::strip_bom(bytes);
+    for (magic, ext) in MAGIC {
+        if body.starts_with(magic) {
+            return Some(ext);
+        }
+    }
+    let head = &body[..body.len().min(1024)];
     let text = match std::str::from_utf8(head) {
         Ok(t) => t,
         // A multi-byte character cut at the 1 KiB mark is still text.
@@ -111,6 +113,10 @@ mod tests {
         assert_eq!(sniff_format(b"1 2\n"), None);
         assert_eq!(sniff_format(b"1.5 2 3\n"), None);
         assert_eq!(sniff_format(b""), None);
+        assert_eq!(sniff_format(b"\xef\xbb\xbf1 2 3\n"), Some("xyz"));
+        assert_eq!(sniff_format(b"\xef\xbb\xbfv 0 0 0\n"), Some("obj"));
+        assert_eq!(sniff_format(b"\xef\xbb\xbfsolid a\n"), Some("stl"));
+        assert_eq!(sniff_format(b"\xef\xbb\xbfply\n"), Some("ply"));
         assert_eq!(sniff_format(&[0xff, 0xfe, 0x00, 0x12]), None);
         // 84 bytes claiming one triangle but holding none is not an STL.
         let mut stl = vec![0u8; 84];

@@ -51,7 +51,12 @@ pub fn parse(mut reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
                 message: format!("line longer than {MAX_XYZ_LINE} bytes"),
             });
         }
-        let line = String::from_utf8_lossy(&buf);
+        let text = if index == 0 {
+            crate::io::strip_bom(&buf)
+        } else {
+            &buf
+        };
+        let line = String::from_utf8_lossy(text);
         let syntax = |column: usize, message: String| FormatError::Syntax {
             line: index + 1,
             column,
@@ -144,6 +149,23 @@ mod tests {
         let text = "# header\n\n1 2 3\n  -4\t5 -6   # trailing\n";
         let v = parse(text.as_bytes()).unwrap();
         assert_eq!(v, vec![[1, 2, 3], [-4, 5, -6]]);
+    }
+
+    /// A UTF-8 byte order mark before the first line is skipped; columns count
+    /// after it.
+    #[test]
+    fn a_byte_order_mark_is_skipped() {
+        let v = parse("\u{feff}1 2 3\n4 5 6\n".as_bytes()).unwrap();
+        assert_eq!(v, vec![[1, 2, 3], [4, 5, 6]]);
+        let err = parse("\u{feff}1 y 3\n".as_bytes())
+            .unwrap_err()
+            .with_path("a.xyz");
+        assert_eq!(
+            err.to_string(),
+            "a.xyz:1:3: `y` is not an integer coordinate"
+        );
+        // Only at the start of the file.
+        assert!(parse("1 2 3\n\u{feff}4 5 6\n".as_bytes()).is_err());
     }
 
     #[test]

@@ -2,8 +2,8 @@
 //! one scan in the sensor frame at the identity pose (the sensor at the world origin);
 //! `tesseral map --origin` or `--pose` places it.
 
-use super::{check_budget, strip_bom, syntax, PointFrame, ScanRecord};
-use crate::io::{text_number, FormatError};
+use super::{check_budget, syntax, PointFrame, ScanRecord};
+use crate::io::{strip_bom, text_number, FormatError};
 
 /// Parses `.xyz` points: one point per line, its first three numbers (separated by
 /// white space or commas) its `x y z`; further columns (intensity, colour) are

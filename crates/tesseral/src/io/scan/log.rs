@@ -16,8 +16,8 @@
 //! past `f32` (`1e39`; `inf` written as such is read), and a last line without a
 //! newline is read (OctoMap drops it).
 
-use super::{check_budget, strip_bom, syntax, words, PointFrame, ScanRecord};
-use crate::io::{text_number, FormatError};
+use super::{check_budget, syntax, words, PointFrame, ScanRecord};
+use crate::io::{strip_bom, text_number, FormatError};
 
 /// Parses a scan log.
 ///

@@ -272,11 +272,6 @@ fn check_budget(total: usize) -> Result<(), FormatError> {
     Ok(())
 }
 
-/// The bytes after a UTF-8 byte order mark, if they start with one.
-fn strip_bom(bytes: &[u8]) -> &[u8] {
-    bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
-}
-
 /// A syntax error at a 1-based line and column.
 fn syntax(line: usize, column: usize, message: impl Into<String>) -> FormatError {
     FormatError::Syntax {

@@ -15,8 +15,8 @@
 //! field's size, a 4-byte float within `f32`).
 
 use super::pcd_data;
-use super::{strip_bom, syntax, words, PointFrame, ScanRecord};
-use crate::io::{text_number, FormatError};
+use super::{syntax, words, PointFrame, ScanRecord};
+use crate::io::{strip_bom, text_number, FormatError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kind {

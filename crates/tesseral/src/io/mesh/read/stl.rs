@@ -12,8 +12,9 @@ pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
     if bytes.len() >= 84 {
         let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
         let binary_len = 84 + 50 * n as u64;
-        let looks_ascii = bytes.trim_ascii_start().starts_with(b"solid")
-            && bytes.iter().take(1024).all(|b| b.is_ascii());
+        let text = crate::io::strip_bom(bytes);
+        let looks_ascii = text.trim_ascii_start().starts_with(b"solid")
+            && text.iter().take(1024).all(|b| b.is_ascii());
         if bytes.len() as u64 == binary_len || (!looks_ascii && bytes.len() as u64 > binary_len) {
             return parse_stl_binary(bytes, n);
         }
@@ -24,7 +25,8 @@ pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
             )));
         }
     }
-    parse_stl_ascii(bytes)
+    // A byte order mark before `solid` is skipped.
+    parse_stl_ascii(crate::io::strip_bom(bytes))
 }
 
 fn parse_stl_binary(bytes: &[u8], n: usize) -> Result<TriMesh, FormatError> {

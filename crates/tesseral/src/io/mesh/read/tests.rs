@@ -138,3 +138,18 @@ fn errors_name_line_and_column() {
     stl[80..84].copy_from_slice(&1000u32.to_le_bytes());
     assert!(parse_stl(&stl).is_err());
 }
+
+/// A UTF-8 byte order mark (editors on Windows write one) is skipped, and columns
+/// are counted after it.
+#[test]
+fn a_byte_order_mark_is_skipped() {
+    const BOM: &str = "\u{feff}";
+    let stl = format!("{BOM}solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n");
+    assert_eq!(parse_stl(stl.as_bytes()).unwrap().triangles.len(), 1);
+    let obj = format!("{BOM}{}", cube_obj());
+    assert_eq!(parse_obj(obj.as_bytes()).unwrap().triangles.len(), 12);
+    let e = parse_obj(format!("{BOM}v 1 x 0\n").as_bytes())
+        .unwrap_err()
+        .with_path("a.obj");
+    assert_eq!(e.to_string(), "a.obj:1:5: `x` is not a finite number");
+}
