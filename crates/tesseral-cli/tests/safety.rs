@@ -397,20 +397,25 @@ fn quiet_on_broken_pipe(dir: &Path, args: &[&str]) {
     assert_eq!(stderr(&out), "", "{args:?}");
 }
 
+/// `a.xyz`, two voxels, and `world.json`: a copy of them moving into them for
+/// `steps` steps.
+fn two_voxel_world(d: &Path, steps: u32) {
+    fs::write(d.join("a.xyz"), "0 0 0\n1 0 0\n").unwrap();
+    let world = format!(
+        r#"{{"environment": "a.xyz", "time_step": 1, "steps": {steps},
+            "objects": [{{"name": "b", "octree": "a.xyz", "start": [5, 0, 0], "velocity": [-1, 0, 0]}}]}}"#
+    );
+    fs::write(d.join("world.json"), world).unwrap();
+}
+
 /// Issue 12, item 7: a broken pipe panicked (exit 101) or printed "Broken pipe".
 #[test]
 fn a_closed_pipe_ends_quietly() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     small_scene(d);
-    fs::write(d.join("a.xyz"), "0 0 0\n1 0 0\n").unwrap();
     fs::write(d.join("ops.txt"), "+ 0 0 0\n? 0 0 0\n? 1 0 0\n").unwrap();
-    fs::write(
-        d.join("world.json"),
-        r#"{"environment": "a.xyz", "time_step": 1, "steps": 3,
-            "objects": [{"name": "b", "octree": "a.xyz", "start": [5, 0, 0], "velocity": [-1, 0, 0]}]}"#,
-    )
-    .unwrap();
+    two_voxel_world(d, 3);
     let commands: &[&[&str]] = &[
         &["tables"],
         &["tables", "--json"],
@@ -473,13 +478,7 @@ fn a_closed_pipe_does_not_stop_the_files() {
         40_000
     );
 
-    fs::write(d.join("a.xyz"), "0 0 0\n1 0 0\n").unwrap();
-    fs::write(
-        d.join("world.json"),
-        r#"{"environment": "a.xyz", "time_step": 1, "steps": 1000,
-            "objects": [{"name": "b", "octree": "a.xyz", "start": [5, 0, 0], "velocity": [-1, 0, 0]}]}"#,
-    )
-    .unwrap();
+    two_voxel_world(d, 1000);
     // Both outputs pass a pipe's 64 KiB buffer, so the closed pipe is met midway
     // whenever the reader leaves: with --json each step's frame is printed as it
     // comes.
