@@ -107,6 +107,9 @@ class DynamicOctree:
         max_range: Optional[float] = None,
         max_cells: int = 10_000_000_000,
     ) -> dict[str, int]: ...
+    def write(self, path: Path) -> None: ...
+    @staticmethod
+    def read(path: Path) -> DynamicOctree: ...
 
 class OccupancyMap:
     def __init__(
