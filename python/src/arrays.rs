@@ -5,8 +5,13 @@
 //! where it lies, a float32 one is widened as it is read, and any other dtype, byte
 //! order or a list of tuples goes through `numpy.asarray` first. Errors name the
 //! argument and say what was expected and what came.
+//!
+//! Codes (1-D, u64) are taken likewise: a uint64 array is read where it lies, any
+//! other integer dtype, byte order, a list of ints or a float array of whole numbers
+//! is converted, and a value that is no code (negative, past 2**63 - 1) is named.
 
-use numpy::{IntoPyArray, PyArray2, PyArrayMethods, PyReadonlyArray2};
+use numpy::ndarray::ArrayView1;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -183,6 +188,148 @@ pub fn cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
         _ => {
             let i64s = as_type(numpy::dtype::<i64>(py))?;
             rows_of::<i64, i64>(&i64s, name, |x| x).expect("astype gives int64")
+        }
+    }
+}
+
+/// Codes of a one-dimensional argument: a uint64 array borrowed where it lies, or
+/// the values of any other converted.
+pub enum Codes<'py> {
+    InPlace(PyReadonlyArray1<'py, u64>),
+    Converted(Vec<u64>),
+}
+
+impl Codes<'_> {
+    /// The codes, in order.
+    pub fn view(&self) -> ArrayView1<'_, u64> {
+        match self {
+            Codes::InPlace(a) => a.as_array(),
+            Codes::Converted(v) => ArrayView1::from(v.as_slice()),
+        }
+    }
+}
+
+/// Past the largest code: 21 octal digits take 63 bits.
+const CODE_END: u64 = 1 << 63;
+
+/// The error of `name[i]`, which is `value` and no code.
+fn not_a_code(name: &str, i: usize, value: impl std::fmt::Display, why: &str) -> PyErr {
+    PyValueError::new_err(format!("{name}[{i}] is {value}: {why}"))
+}
+const UNSIGNED: &str = "codes are unsigned";
+const PAST: &str = "past the largest code, 2**63 - 1 (21 octal digits)";
+
+/// The codes of `obj`: a one-dimensional array (or list) of integers, or of floats
+/// that are all whole numbers, every value in [0, 2**63). A uint64 array (native
+/// byte order) is read where it lies; any other is converted. A negative value, one
+/// past 2**63 - 1 or a fraction is refused (ValueError naming `name[i]`), not
+/// wrapped or rounded.
+pub fn codes<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Codes<'py>> {
+    if let Ok(a) = obj.downcast::<PyArray1<u64>>() {
+        let r = a
+            .try_readonly()
+            .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))?;
+        if let Some((i, x)) = r
+            .as_array()
+            .iter()
+            .enumerate()
+            .find(|&(_, &x)| x >= CODE_END)
+        {
+            return Err(not_a_code(name, i, x, PAST));
+        }
+        return Ok(Codes::InPlace(r));
+    }
+    let py = obj.py();
+    let expected = "expected a 1-D array of codes";
+    let arr = py
+        .import("numpy")?
+        .call_method1("asarray", (obj,))
+        .map_err(|e| {
+            PyValueError::new_err(format!(
+                "{name}: {expected}, got {} that numpy cannot make one array of: {}",
+                describe(obj),
+                e.value(py)
+            ))
+        })?;
+    let dtype = arr.getattr("dtype")?;
+    let kind: char = dtype.getattr("kind")?.extract()?;
+    if !matches!(kind, 'i' | 'u' | 'f' | 'O') {
+        return Err(PyTypeError::new_err(format!(
+            "{name}: {expected} (integers, or floats that are whole numbers), got {} of \
+             dtype {}",
+            describe(obj),
+            dtype.str()?
+        )));
+    }
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    if shape.len() != 1 {
+        return Err(PyValueError::new_err(format!(
+            "{name}: {expected}, got {} of shape {}",
+            describe(obj),
+            shape_text(&shape)
+        )));
+    }
+    let as_type = |t| arr.call_method1("astype", (t,));
+    // An array of `T` in native byte order, as astype gives it.
+    fn read<'py, T: numpy::Element>(a: &Bound<'py, PyAny>) -> PyReadonlyArray1<'py, T> {
+        a.downcast::<PyArray1<T>>()
+            .expect("astype gives the dtype asked for")
+            .readonly()
+    }
+    match kind {
+        // Widened to uint64, then read where it lies.
+        'u' => codes(&as_type(numpy::dtype::<u64>(py))?, name),
+        'i' => {
+            let a = as_type(numpy::dtype::<i64>(py))?;
+            let r = read::<i64>(&a);
+            let v = r.as_array();
+            v.iter()
+                .enumerate()
+                .map(|(i, &x)| u64::try_from(x).map_err(|_| not_a_code(name, i, x, UNSIGNED)))
+                .collect::<PyResult<_>>()
+                .map(Codes::Converted)
+        }
+        'f' => {
+            let a = as_type(numpy::dtype::<f64>(py))?;
+            let r = read::<f64>(&a);
+            let v = r.as_array();
+            v.iter()
+                .enumerate()
+                .map(|(i, &x)| {
+                    if x.fract() != 0.0 || x.is_nan() {
+                        Err(not_a_code(name, i, x, "not a whole number"))
+                    } else if x < 0.0 {
+                        Err(not_a_code(name, i, x, UNSIGNED))
+                    } else if x >= CODE_END as f64 {
+                        Err(not_a_code(name, i, x, PAST))
+                    } else {
+                        Ok(x as u64)
+                    }
+                })
+                .collect::<PyResult<_>>()
+                .map(Codes::Converted)
+        }
+        // Python ints past int64 and uint64 (or of both signs) make an object array.
+        _ => {
+            let index = py.import("operator")?.getattr("index")?;
+            arr.try_iter()?
+                .enumerate()
+                .map(|(i, x)| {
+                    let x = x?;
+                    let Ok(x) = index.call1((&x,)) else {
+                        return Err(PyTypeError::new_err(format!(
+                            "{name}[{i}] is {}, not an integer",
+                            x.repr()?
+                        )));
+                    };
+                    match x.extract::<u64>() {
+                        Ok(c) if c < CODE_END => Ok(c),
+                        _ if x.lt(0)? => Err(not_a_code(name, i, x, UNSIGNED)),
+                        _ => Err(not_a_code(name, i, x, PAST)),
+                    }
+                })
+                .collect::<PyResult<_>>()
+                .map(Codes::Converted)
         }
     }
 }

@@ -1,13 +1,14 @@
 //! `tesseral.encode/decode/add/sub`: tesseral codes, vectorised over numpy arrays.
 //! Codes are u64: 21 octal digits, coordinates 0 to 2**21 - 1 (add and sub wrap
-//! per axis, as the bounded space of Ahuja & Nash).
+//! per axis, as the bounded space of Ahuja & Nash). Codes come as any 1-D array or
+//! list of integers (a uint64 array read where it lies), or of whole floats.
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1};
+use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use tesseral::code::Space;
 
-use crate::arrays::{cells, to_array};
+use crate::arrays::{cells, codes as code_array, to_array};
 
 const SIDE: u64 = 1 << 21;
 
@@ -34,13 +35,15 @@ pub fn encode<'py>(
     Ok(codes.into_pyarray(py))
 }
 
-/// The coordinates of a uint64 array of codes: N×3 int64.
+/// The coordinates of a 1-D array of codes (any integer dtype, a list of ints, or
+/// whole floats; each in [0, 2**63)): N×3 int64.
 #[pyfunction]
 pub fn decode<'py>(
     py: Python<'py>,
-    codes: PyReadonlyArray1<'_, u64>,
+    codes: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray2<i64>>> {
-    let c = codes.as_array();
+    let codes = code_array(codes, "codes")?;
+    let c = codes.view();
     let v: Vec<[i64; 3]> = c
         .iter()
         .map(|&k| tesseral::code::decode(k).map(i64::from))
@@ -50,11 +53,12 @@ pub fn decode<'py>(
 
 fn binary<'py>(
     py: Python<'py>,
-    a: PyReadonlyArray1<'_, u64>,
-    b: PyReadonlyArray1<'_, u64>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
     f: impl Fn(&Space<u64>, u64, u64) -> u64,
 ) -> PyResult<Bound<'py, PyArray1<u64>>> {
-    let (a, b) = (a.as_array(), b.as_array());
+    let (a, b) = (code_array(a, "a")?, code_array(b, "b")?);
+    let (a, b) = (a.view(), b.view());
     if a.len() != b.len() {
         return Err(PyValueError::new_err(format!(
             "arrays of {} and {} codes",
@@ -67,22 +71,24 @@ fn binary<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// Tesseral addition of two uint64 code arrays (translation), without decoding.
+/// Tesseral addition of two code arrays (translation), without decoding: a uint64
+/// array. Codes are taken as `decode` takes them.
 #[pyfunction]
 pub fn add<'py>(
     py: Python<'py>,
-    a: PyReadonlyArray1<'_, u64>,
-    b: PyReadonlyArray1<'_, u64>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<u64>>> {
     binary(py, a, b, |s, x, y| s.add(x, y))
 }
 
-/// Tesseral subtraction a - b of two uint64 code arrays, wrapping per axis.
+/// Tesseral subtraction a - b of two code arrays, wrapping per axis: a uint64
+/// array. Codes are taken as `decode` takes them.
 #[pyfunction]
 pub fn sub<'py>(
     py: Python<'py>,
-    a: PyReadonlyArray1<'_, u64>,
-    b: PyReadonlyArray1<'_, u64>,
+    a: &Bound<'py, PyAny>,
+    b: &Bound<'py, PyAny>,
 ) -> PyResult<Bound<'py, PyArray1<u64>>> {
     binary(py, a, b, |s, x, y| s.sub(x, y))
 }

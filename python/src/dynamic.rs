@@ -1,10 +1,13 @@
 //! `tesseral.DynamicOctree`: Libes' unbounded octree, fed whole arrays at a time.
 
+use std::path::{Path, PathBuf};
+
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::dynamic::DynamicOctree as Tree;
+use tesseral::io::FormatError;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use crate::arrays::{cells, points, to_array};
@@ -20,6 +23,28 @@ pub struct DynamicOctree {
 
 /// What the class's borrows are called in their errors.
 const WHAT: &str = "DynamicOctree";
+
+/// The most voxels `read` takes: the class keeps the face list, which a read
+/// rebuilds one voxel at a time (some 15 seconds at the limit), and a model file
+/// holds a solid of up to 2^63 voxels in a few bytes.
+const MAX_READ_VOXELS: u64 = 1 << 26;
+
+/// `read`'s tree (without the face list) as one with it, built voxel by voxel.
+fn with_faces(read: &Tree, path: &Path) -> Result<Tree, FormatError> {
+    let n = read.voxel_count();
+    if n > MAX_READ_VOXELS {
+        return Err(FormatError::TooLarge(format!(
+            "{n} voxels, past the 2^26 ({MAX_READ_VOXELS}) that DynamicOctree.read \
+             takes: it rebuilds the face list one voxel at a time"
+        ))
+        .with_path(path));
+    }
+    let mut t = Tree::with_faces();
+    for v in read.voxels() {
+        t.insert(v);
+    }
+    Ok(t)
+}
 
 #[pymethods]
 impl DynamicOctree {
@@ -107,6 +132,30 @@ impl DynamicOctree {
         d.set_item("inserted", inserted)?;
         d.set_item("removed", removed)?;
         Ok(d)
+    }
+
+    /// Writes the octree, atomically, in the format named by the extension: as a
+    /// model (voxel size 1, the root's corner at its origin) when it fits one (2^21
+    /// voxels on an axis), else to `.tess` as the octree's own file, which keeps its
+    /// full `i64` range (any other format refuses it: FormatError). The face list is
+    /// not written; `DynamicOctree.read` reads either back.
+    fn write(slf: &Bound<'_, Self>, path: PathBuf) -> PyResult<()> {
+        let this = borrow(slf, WHAT)?;
+        let t = &this.tree;
+        slf.py()
+            .allow_threads(|| t.write_file(&path))
+            .map_err(crate::errors::format)
+    }
+
+    /// Reads an octree from a file: an octree's own `.tess` (one wider than a
+    /// model), or any model file (its voxels; the frame is dropped). The face list
+    /// is rebuilt voxel by voxel, so a file of more than 2^26 voxels is refused
+    /// (FormatError).
+    #[staticmethod]
+    fn read(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        py.allow_threads(|| Tree::read_file(&path).and_then(|t| with_faces(&t, &path)))
+            .map(|tree| Self { tree })
+            .map_err(crate::errors::format)
     }
 
     /// Every voxel, N×3 int64.

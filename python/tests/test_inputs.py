@@ -219,3 +219,67 @@ def test_a_map_busy_on_another_thread_says_so():
     assert errors, "the scan ended before the other thread called (make it longer)"
     assert all("in use by a call on another thread" in e for e in errors)
     assert m.stats()["occupied"] > 0
+
+
+SOME = [0, 1, 7, 8, 100, 127]
+
+
+@pytest.mark.parametrize(
+    "dtype",
+    [np.int8, np.int16, np.int32, np.int64, np.uint8, np.uint16, np.uint32, np.uint64,
+     ">i8", ">u8", ">i4", ">u2", np.float32, np.float64, ">f8"],
+)
+def test_calc_takes_codes_of_any_integer_dtype_and_whole_floats(dtype):
+    codes = np.array(SOME, dtype=dtype)
+    want = np.array(SOME, dtype=np.uint64)
+    assert np.array_equal(t.calc.decode(codes), t.calc.decode(want))
+    assert np.array_equal(t.calc.add(codes, codes), t.calc.add(want, want))
+    assert np.array_equal(t.calc.sub(codes, want[::-1]), t.calc.sub(want, want[::-1]))
+
+
+def test_calc_takes_lists_of_ints_and_strided_or_readonly_uint64():
+    big = 2 ** 63 - 1  # the largest code: 21 octal digits of 7
+    assert t.calc.decode([0, 1, big]).tolist() == [[0, 0, 0], [1, 0, 0], [2 ** 21 - 1] * 3]
+    assert t.calc.add([1, 2], (3, 4)).tolist() == t.calc.add(np.array([1, 2], np.uint64),
+                                                             np.array([3, 4], np.uint64)).tolist()
+    assert t.calc.decode([]).shape == (0, 3)
+    codes = np.arange(10, dtype=np.uint64)
+    assert t.calc.decode(codes[::3]).tolist() == t.calc.decode([0, 3, 6, 9]).tolist()
+    codes.flags.writeable = False
+    assert t.calc.sub(codes, codes).tolist() == [0] * 10
+
+
+def test_calc_refuses_what_cannot_be_a_code_and_names_it():
+    with pytest.raises(ValueError, match=r"^codes\[3\] is -1: codes are unsigned"):
+        t.calc.decode(np.array([0, 1, 2, -1], dtype=np.int8))
+    with pytest.raises(ValueError, match=r"^b\[1\] is -5: codes are unsigned"):
+        t.calc.add([1, 2], [0, -5])
+    with pytest.raises(ValueError, match=r"^a\[0\] is -2: codes are unsigned"):
+        t.calc.sub(np.array([-2.0]), [0])
+    past = r"past the largest code, 2\*\*63 - 1"
+    with pytest.raises(ValueError, match=rf"^codes\[1\] is 9223372036854775808: {past}"):
+        t.calc.decode(np.array([0, 2 ** 63], dtype=np.uint64))
+    with pytest.raises(ValueError, match=rf"^codes\[0\] is 18446744073709551615: {past}"):
+        t.calc.decode(np.array([2 ** 64 - 1], dtype=">u8"))
+    with pytest.raises(ValueError, match=rf"^codes\[2\] is 18446744073709551616: {past}"):
+        t.calc.decode([0, 1, 2 ** 64])  # numpy makes an object array of it
+    with pytest.raises(ValueError, match=r"^codes\[0\] is -1: codes are unsigned"):
+        t.calc.decode([-1, 2 ** 63])
+    with pytest.raises(ValueError, match=rf"^codes\[0\] is 9223372036854776000: {past}"):
+        t.calc.decode(np.array([2.0 ** 63]))
+    with pytest.raises(ValueError, match=r"^codes\[1\] is 1.5: not a whole number"):
+        t.calc.decode(np.array([1.0, 1.5]))
+    with pytest.raises(ValueError, match=r"^codes\[0\] is NaN: not a whole number"):
+        t.calc.decode(np.array([np.nan], dtype=np.float32))
+    with pytest.raises(TypeError, match="codes: expected a 1-D array of codes .* of dtype bool"):
+        t.calc.decode(np.array([True, False]))
+    with pytest.raises(TypeError, match="codes: expected a 1-D array of codes .* of dtype <U1"):
+        t.calc.decode(["a"])
+    with pytest.raises(TypeError, match=r"^codes\[1\] is None, not an integer"):
+        t.calc.decode([1, None, 2 ** 64])
+    with pytest.raises(ValueError, match=r"codes: expected a 1-D array of codes, got an array of shape \(2, 3\)"):
+        t.calc.decode(np.zeros((2, 3), dtype=np.uint64))
+    with pytest.raises(ValueError, match=r"codes: expected a 1-D array of codes, got an int of shape \(\)"):
+        t.calc.decode(5)
+    with pytest.raises(ValueError, match="arrays of 2 and 1 codes"):
+        t.calc.add([1, 2], [1])

@@ -103,7 +103,8 @@ pub(crate) fn not_a_model(bytes: &[u8]) -> FormatError {
         FormatError::unsupported(
             "an unbounded dynamic octree wider than a model holds (2^21 voxels on an axis), \
              in the dynamic octree's own .tess (written by tesseral replay -o): read it as a \
-             dynamic octree (DynamicOctree::read_file; tesseral info describes it)",
+             dynamic octree (DynamicOctree::read_file, Python tesseral.DynamicOctree.read; \
+             tesseral info describes it)",
         )
     } else {
         FormatError::corrupt("not a tesseral .tess file (bad magic number)")
