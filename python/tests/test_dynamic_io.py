@@ -117,12 +117,37 @@ def test_a_corrupt_file_is_a_format_error_naming_it(tmp_path):
     assert str(p) in str(e.value)
 
 
-def test_a_model_of_more_voxels_than_read_rebuilds_faces_of_is_refused(tmp_path):
+def test_a_solid_model_reads_whole_and_its_faces_are_counted(tmp_path):
     p = tmp_path / "box.tess"
-    t.Scene.parse("depth 9\nbox(size = [512, 512, 512])\n").build().write(p)  # 2^27 voxels
-    with pytest.raises(t.FormatError, match=r"134217728 voxels, past the 2\^26 .* face list") as e:
-        t.DynamicOctree.read(p)
-    assert str(e.value).startswith(str(p))
+    t.Scene.parse("depth 7\nbox(size = [128, 128, 128])\n").build().write(p)  # 2^21 voxels
+    back = t.DynamicOctree.read(p)
+    assert len(back) == 128**3 and back.face_count == 6 * 128**2
+    back.remove([[0, 0, 0]])  # a corner: three faces gone, three inner ones exposed
+    assert back.face_count == 6 * 128**2
+    back.remove([[1, 1, 1]])  # inside, its six neighbours there: six faces exposed
+    assert back.face_count == 6 * 128**2 + 6
+
+
+def naive_faces(cells):
+    steps = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
+    return sum((x + a, y + b, z + c) not in cells for (x, y, z) in cells for (a, b, c) in steps)
+
+
+def test_the_face_count_follows_edits_as_a_set_model_counts_them():
+    rng = np.random.default_rng(13)
+    d, model = t.DynamicOctree(), set()
+    for step in range(60):
+        v = rng.integers(-3, 4, size=(rng.integers(1, 20), 3))
+        if step % 3 == 2:
+            assert d.remove(v) == len(model & set(map(tuple, v.tolist())))
+            model -= set(map(tuple, v.tolist()))
+        else:
+            assert d.insert(v) == len(set(map(tuple, v.tolist())) - model)
+            model |= set(map(tuple, v.tolist()))
+        assert len(d) == len(model) and d.face_count == naive_faces(model), step
+    # A scan's cells too.
+    d.insert_scan((0.5, 0.5, 0.5), np.array([[6.5, 0.5, 0.5], [0.5, 6.5, 0.5]]))
+    assert d.face_count == naive_faces(set(map(tuple, d.voxels().tolist())))
 
 
 def test_a_map_file_and_a_dynamic_octree_file_are_told_apart(tmp_path):
