@@ -1,12 +1,13 @@
 //! `tesseral.DynamicOctree`: Libes' unbounded octree, fed whole arrays at a time.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use numpy::{IntoPyArray, PyArray1, PyArray2};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::dynamic::DynamicOctree as Tree;
+use tesseral::io::FormatError;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use crate::arrays::{cells, points, to_array};
@@ -25,11 +26,27 @@ pub struct DynamicOctree {
 /// What the class's borrows are called in their errors.
 const WHAT: &str = "DynamicOctree";
 
+/// The most lookups `read` spends counting faces (2^28, some ten seconds): one for
+/// each voxel on a positive face of a stored block or full octant. A model file
+/// holds a solid of up to 2^63 voxels in a few bytes, and a cube of 2^21 a side
+/// would take 3 · 2^42.
+const MAX_FACE_WORK: u64 = 1 << 28;
+
 impl DynamicOctree {
-    /// An octree and its face count.
-    fn of(tree: Tree) -> Self {
+    /// An octree read from `path` and its face count, refused (before the count)
+    /// past [`MAX_FACE_WORK`].
+    fn of(tree: Tree, path: &Path) -> Result<Self, FormatError> {
+        let work = tree.exposed_faces_work();
+        if work > MAX_FACE_WORK {
+            return Err(FormatError::TooLarge(format!(
+                "{} voxels whose faces would take {work} lookups to count, past the 2^28 \
+                 that DynamicOctree.read spends",
+                tree.voxel_count()
+            ))
+            .with_path(path));
+        }
         let faces = tree.exposed_faces();
-        DynamicOctree { tree, faces }
+        Ok(DynamicOctree { tree, faces })
     }
 
     /// Inserts `v`, and counts its faces: each of its six is exposed but where a
@@ -159,11 +176,12 @@ impl DynamicOctree {
 
     /// Reads an octree from a file: an octree's own `.tess` (one wider than a
     /// model), or any model file (its voxels; the frame is dropped). The faces are
-    /// counted as it is read, in time linear in the voxels (some 5 seconds for a
-    /// solid of 2^27).
+    /// counted as it is read, in time that follows the surface of its blocks and
+    /// full octants; a file whose count would take more than 2^28 lookups is
+    /// refused (FormatError).
     #[staticmethod]
     fn read(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        py.allow_threads(|| Tree::read_file(&path).map(Self::of))
+        py.allow_threads(|| Tree::read_file(&path).and_then(|t| Self::of(t, &path)))
             .map_err(crate::errors::format)
     }
 

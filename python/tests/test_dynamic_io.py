@@ -128,6 +128,17 @@ def test_a_solid_model_reads_whole_and_its_faces_are_counted(tmp_path):
     assert back.face_count == 6 * 128**2 + 6
 
 
+def test_a_solid_whose_faces_would_take_too_long_to_count_is_refused(tmp_path):
+    p = tmp_path / "big.tess"
+    # A cube of 2^15 a side, one leaf in a few bytes: 3 * 2^30 lookups on its
+    # faces, past read's 2^28.
+    box = t.Scene.parse("depth 9\nbox(size = [512, 512, 512])\n").build().scale(64)
+    box.write(p)
+    with pytest.raises(t.FormatError, match=r"lookups to count, past the 2\^28") as e:
+        t.DynamicOctree.read(p)
+    assert str(e.value).startswith(str(p))
+
+
 def naive_faces(cells):
     steps = [(1, 0, 0), (-1, 0, 0), (0, 1, 0), (0, -1, 0), (0, 0, 1), (0, 0, -1)]
     return sum((x + a, y + b, z + c) not in cells for (x, y, z) in cells for (a, b, c) in steps)

@@ -146,3 +146,74 @@ fn find_from_any_node_agrees_with_find_from_root() {
         Some(true)
     );
 }
+
+/// The exposed faces of a set of voxels, counted face by face.
+fn naive_exposed(set: &HashSet<Voxel>) -> u64 {
+    let open = |&v: &Voxel| {
+        Direction::ALL
+            .into_iter()
+            .filter(move |d| !set.contains(&d.step(v)))
+    };
+    set.iter().flat_map(open).count() as u64
+}
+
+/// `exposed_faces` without the face list counts pairs piece by piece (inside a
+/// block by popcounts, inside a full octant by its side, across each piece's
+/// positive faces by lookups); against the faces of a `HashSet` counted one by one:
+/// scattered, clustered and far-apart voxels, some removed again, voxels across the
+/// wrapping edge of i64, and solids whose octants are stored full.
+#[test]
+fn exposed_faces_by_pieces_match_a_set_count() {
+    let mut rng = Pcg64::seed_from_u64(24);
+    for case in 0..80 {
+        let spread = [3i64, 9, 40, 1 << 40][case % 4];
+        let origin = match case % 5 {
+            4 => [i64::MAX - 5, i64::MIN + 2, 7],
+            _ => [0, 0, 0],
+        };
+        let (mut set, mut t) = (HashSet::new(), DynamicOctree::new());
+        for k in 0..rng.random_range(1..500) {
+            let v = [0, 1, 2].map(|a| origin[a].wrapping_add(rng.random_range(-spread..spread)));
+            if k % 4 == 3 {
+                assert_eq!(t.remove(v), set.remove(&v));
+            } else {
+                assert_eq!(t.insert(v), set.insert(v));
+            }
+        }
+        t.assert_valid();
+        let want = naive_exposed(&set);
+        assert_eq!(t.exposed_faces(), want, "case {case}");
+        assert!(t.exposed_faces_work() <= 3 * t.voxel_count());
+        let mut tracked = DynamicOctree::with_faces();
+        set.iter().for_each(|&v| assert!(tracked.insert(v)));
+        assert_eq!(tracked.exposed_faces(), want, "case {case}, face list");
+    }
+    // Boxes, some touching: whole octants are stored full.
+    for case in 0..20 {
+        let mut set = HashSet::new();
+        for _ in 0..rng.random_range(1..4) {
+            let lo: [i64; 3] = [0, 1, 2].map(|_| rng.random_range(-20..20));
+            let side: [i64; 3] = [0, 1, 2].map(|_| rng.random_range(1..33));
+            for x in 0..side[0] {
+                for y in 0..side[1] {
+                    for z in 0..side[2] {
+                        set.insert([lo[0] + x, lo[1] + y, lo[2] + z]);
+                    }
+                }
+            }
+        }
+        let t = DynamicOctree::from_voxels(set.iter().copied());
+        t.assert_valid();
+        assert_eq!(t.exposed_faces(), naive_exposed(&set), "box case {case}");
+    }
+    // A solid octant of 2^18 voxels costs lookups on its faces only.
+    let lin = LinearOctree::from_voxels(
+        6,
+        [0, 0, 0],
+        (0..64 * 64 * 64).map(|i| [i % 64, i / 64 % 64, i / 4096]),
+    )
+    .unwrap();
+    let t = DynamicOctree::from_linear(&lin);
+    assert_eq!(t.exposed_faces(), 6 * 64 * 64);
+    assert_eq!(t.exposed_faces_work(), 3 * 64 * 64);
+}
