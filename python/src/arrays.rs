@@ -240,17 +240,20 @@ pub fn codes<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Codes<'py>> {
         return Ok(Codes::InPlace(r));
     }
     let py = obj.py();
+    let numpy = py.import("numpy")?;
     let expected = "expected a 1-D array of codes";
-    let arr = py
-        .import("numpy")?
-        .call_method1("asarray", (obj,))
-        .map_err(|e| {
-            PyValueError::new_err(format!(
-                "{name}: {expected}, got {} that numpy cannot make one array of: {}",
-                describe(obj),
-                e.value(py)
-            ))
-        })?;
+    // Only numpy's own refusals are told as ours; an interrupt or a memory error
+    // passes through.
+    let arr = numpy.call_method1("asarray", (obj,)).map_err(|e| {
+        if !(e.is_instance_of::<PyTypeError>(py) || e.is_instance_of::<PyValueError>(py)) {
+            return e;
+        }
+        PyValueError::new_err(format!(
+            "{name}: {expected}, got {} that numpy cannot make one array of: {}",
+            describe(obj),
+            e.value(py)
+        ))
+    })?;
     let dtype = arr.getattr("dtype")?;
     let kind: char = dtype.getattr("kind")?.extract()?;
     if !matches!(kind, 'i' | 'u' | 'f' | 'O') {
@@ -293,45 +296,69 @@ pub fn codes<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Codes<'py>> {
             let a = as_type(numpy::dtype::<f64>(py))?;
             let r = read::<f64>(&a);
             let v = r.as_array();
+            // A list mixing floats with ints past 2**53 was made floats by numpy,
+            // rounding the ints: read it element by element instead.
+            if !obj.is_instance_of::<numpy::PyUntypedArray>() && v.iter().any(|x| x.abs() >= EXACT)
+            {
+                let objects = numpy.call_method1("array", (obj, "object"))?;
+                return object_codes(&objects, name).map(Codes::Converted);
+            }
             v.iter()
                 .enumerate()
-                .map(|(i, &x)| {
-                    if x.fract() != 0.0 || x.is_nan() {
-                        Err(not_a_code(name, i, x, "not a whole number"))
-                    } else if x < 0.0 {
-                        Err(not_a_code(name, i, x, UNSIGNED))
-                    } else if x >= CODE_END as f64 {
-                        Err(not_a_code(name, i, x, PAST))
-                    } else {
-                        Ok(x as u64)
-                    }
-                })
+                .map(|(i, &x)| float_code(name, i, x))
                 .collect::<PyResult<_>>()
                 .map(Codes::Converted)
         }
         // Python ints past int64 and uint64 (or of both signs) make an object array.
-        _ => {
-            let index = py.import("operator")?.getattr("index")?;
-            arr.try_iter()?
-                .enumerate()
-                .map(|(i, x)| {
-                    let x = x?;
-                    let Ok(x) = index.call1((&x,)) else {
-                        return Err(PyTypeError::new_err(format!(
-                            "{name}[{i}] is {}, not an integer",
-                            x.repr()?
-                        )));
-                    };
-                    match x.extract::<u64>() {
-                        Ok(c) if c < CODE_END => Ok(c),
-                        _ if x.lt(0)? => Err(not_a_code(name, i, x, UNSIGNED)),
-                        _ => Err(not_a_code(name, i, x, PAST)),
-                    }
-                })
-                .collect::<PyResult<_>>()
-                .map(Codes::Converted)
-        }
+        _ => object_codes(&arr, name).map(Codes::Converted),
     }
+}
+
+/// Past the floats that hold every whole number below them exactly (2**53).
+const EXACT: f64 = 9_007_199_254_740_992.0;
+
+/// The code of `name[i]`, a float: a whole number in [0, 2**63).
+fn float_code(name: &str, i: usize, x: f64) -> PyResult<u64> {
+    if x.fract() != 0.0 || x.is_nan() {
+        Err(not_a_code(name, i, x, "not a whole number"))
+    } else if x < 0.0 {
+        Err(not_a_code(name, i, x, UNSIGNED))
+    } else if x >= CODE_END as f64 {
+        Err(not_a_code(name, i, x, PAST))
+    } else {
+        Ok(x as u64)
+    }
+}
+
+/// The codes of a 1-D object array: Python ints of any size, and floats that are
+/// whole numbers; anything else is named.
+fn object_codes(arr: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<u64>> {
+    let py = arr.py();
+    let index = py.import("operator")?.getattr("index")?;
+    arr.try_iter()?
+        .enumerate()
+        .map(|(i, x)| {
+            let x = x?;
+            if let Ok(f) = x.downcast::<pyo3::types::PyFloat>() {
+                return float_code(name, i, f.value());
+            }
+            let x = match index.call1((&x,)) {
+                Ok(x) => x,
+                Err(e) if e.is_instance_of::<PyTypeError>(py) => {
+                    return Err(PyTypeError::new_err(format!(
+                        "{name}[{i}] is {}, not an integer",
+                        x.repr()?
+                    )))
+                }
+                Err(e) => return Err(e),
+            };
+            match x.extract::<u64>() {
+                Ok(c) if c < CODE_END => Ok(c),
+                _ if x.lt(0)? => Err(not_a_code(name, i, x, UNSIGNED)),
+                _ => Err(not_a_code(name, i, x, PAST)),
+            }
+        })
+        .collect()
 }
 
 /// Rows as an N×3 array: the vector is handed to numpy without a copy.

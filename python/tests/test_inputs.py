@@ -283,3 +283,29 @@ def test_calc_refuses_what_cannot_be_a_code_and_names_it():
         t.calc.decode(5)
     with pytest.raises(ValueError, match="arrays of 2 and 1 codes"):
         t.calc.add([1, 2], [1])
+
+
+def test_calc_reads_mixed_lists_exactly_and_lets_interrupts_through():
+    # numpy makes floats of a list mixing ints past 2**53 with floats: read exactly.
+    assert t.calc.decode([2 ** 60 + 1, 1.0]).tolist() == t.calc.decode(
+        np.array([2 ** 60 + 1, 1], dtype=np.uint64)).tolist()
+    past = r"past the largest code, 2\*\*63 - 1"
+    with pytest.raises(ValueError, match=rf"^codes\[0\] is 9223372036854775808: {past}"):
+        t.calc.decode([2 ** 63, 0.0])
+    # Whole floats beside a huge int (an object array): the huge one is named.
+    with pytest.raises(ValueError, match=rf"^codes\[1\] is 18446744073709551616: {past}"):
+        t.calc.decode([1.0, 2 ** 64])
+    assert t.calc.decode([2.0, 2 ** 62]).tolist()[0] == [0, 1, 0]
+
+    class Interrupting:
+        def __index__(self):
+            raise KeyboardInterrupt
+
+    class Exhausting:
+        def __array__(self, dtype=None, copy=None):
+            raise MemoryError
+
+    with pytest.raises(KeyboardInterrupt):
+        t.calc.decode([Interrupting(), 2 ** 64])
+    with pytest.raises(MemoryError):
+        t.calc.decode(Exhausting())
