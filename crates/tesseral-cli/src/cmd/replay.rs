@@ -105,7 +105,12 @@ pub fn run(args: Args) -> Result<()> {
             Err(msg) => return fail(msg, &mut out),
         }
         bytes_read += buf.len() as u64 + 1;
-        let text = match std::str::from_utf8(&buf) {
+        // A UTF-8 byte order mark before the first line is skipped.
+        let line = match line_no {
+            0 => buf.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&buf),
+            _ => &buf,
+        };
+        let text = match std::str::from_utf8(line) {
             Ok(t) => t,
             Err(_) => return fail("not valid UTF-8".to_string(), &mut out),
         };

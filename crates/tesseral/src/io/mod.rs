@@ -183,6 +183,32 @@ pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
     bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
 }
 
+/// A text file's bytes after a UTF-8 byte order mark ([`strip_bom`]); a UTF-16 or
+/// UTF-32 one is refused at line 1, column 1, naming the encoding, rather than read
+/// as bytes that fail somewhere further on.
+pub(crate) fn text_start(bytes: &[u8]) -> Result<&[u8], FormatError> {
+    const WIDE: [(&[u8], &str); 4] = [
+        (
+            b"\xff\xfe\x00\x00",
+            "UTF-32 little-endian (byte order mark FF FE 00 00)",
+        ),
+        (
+            b"\x00\x00\xfe\xff",
+            "UTF-32 big-endian (byte order mark 00 00 FE FF)",
+        ),
+        (b"\xff\xfe", "UTF-16 little-endian (byte order mark FF FE)"),
+        (b"\xfe\xff", "UTF-16 big-endian (byte order mark FE FF)"),
+    ];
+    match WIDE.iter().find(|(mark, _)| bytes.starts_with(mark)) {
+        Some((_, encoding)) => Err(FormatError::Syntax {
+            line: 1,
+            column: 1,
+            message: format!("the text is {encoding}: save it as UTF-8"),
+        }),
+        None => Ok(strip_bom(bytes)),
+    }
+}
+
 /// Reads a whole file, refusing files larger than `limit` bytes.
 pub(crate) fn read_limited(path: &Path, limit: u64) -> Result<Vec<u8>, FormatError> {
     let attach = |e: FormatError| e.with_path(path);

@@ -31,15 +31,19 @@ pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
         (b"ply\n", "ply"),
         (b"ply\r\n", "ply"),
     ];
+    for (magic, ext) in MAGIC {
+        if bytes.starts_with(magic) {
+            return Some(ext);
+        }
+    }
     if is_binary_stl(bytes) {
         return Some("stl");
     }
-    // Text may start with a UTF-8 byte order mark, which its readers skip.
+    // Text may start with a UTF-8 byte order mark, which its readers skip (a PLY
+    // header among them).
     let body = super::strip_bom(bytes);
-    for (magic, ext) in MAGIC {
-        if body.starts_with(magic) {
-            return Some(ext);
-        }
+    if body.starts_with(b"ply\n") || body.starts_with(b"ply\r\n") {
+        return Some("ply");
     }
     let head = &body[..body.len().min(1024)];
     let text = match std::str::from_utf8(head) {

@@ -52,7 +52,7 @@ pub fn parse(mut reader: impl BufRead) -> Result<Vec<Voxel>, FormatError> {
             });
         }
         let text = if index == 0 {
-            crate::io::strip_bom(&buf)
+            crate::io::text_start(&buf)?
         } else {
             &buf
         };
@@ -166,6 +166,8 @@ mod tests {
         );
         // Only at the start of the file.
         assert!(parse("1 2 3\n\u{feff}4 5 6\n".as_bytes()).is_err());
+        let err = parse(&b"\xff\xfe1\x00 \x002\x00"[..]).unwrap_err();
+        assert!(err.to_string().contains("UTF-16 little-endian"), "{err}");
     }
 
     #[test]

@@ -201,7 +201,9 @@ pub fn read_world_limited(
         path: path.to_owned(),
         source,
     })?;
-    let spec: WorldSpec = serde_json::from_str(&text).map_err(|e| WorldError::Syntax {
+    // A UTF-8 byte order mark is skipped; columns count after it.
+    let json = text.strip_prefix('\u{feff}').unwrap_or(&text);
+    let spec: WorldSpec = serde_json::from_str(json).map_err(|e| WorldError::Syntax {
         path: path.to_owned(),
         line: e.line(),
         column: e.column(),

@@ -3,7 +3,7 @@
 //! `tesseral map --origin` or `--pose` places it.
 
 use super::{check_budget, syntax, PointFrame, ScanRecord};
-use crate::io::{strip_bom, text_number, FormatError};
+use crate::io::{text_number, text_start, FormatError};
 
 /// Parses `.xyz` points: one point per line, its first three numbers (separated by
 /// white space or commas) its `x y z`; further columns (intensity, colour) are
@@ -21,7 +21,7 @@ use crate::io::{strip_bom, text_number, FormatError};
 /// ```
 pub fn parse_xyz(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
     let mut points = Vec::new();
-    for (i, raw) in strip_bom(bytes).split(|&b| b == b'\n').enumerate() {
+    for (i, raw) in text_start(bytes)?.split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
         let content = raw.split(|&b| b == b'#').next().unwrap_or_default();
         let line = std::str::from_utf8(content)

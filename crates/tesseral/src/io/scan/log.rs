@@ -17,7 +17,7 @@
 //! newline is read (OctoMap drops it).
 
 use super::{check_budget, syntax, words, PointFrame, ScanRecord};
-use crate::io::{strip_bom, text_number, FormatError};
+use crate::io::{text_number, text_start, FormatError};
 
 /// Parses a scan log.
 ///
@@ -28,7 +28,7 @@ use crate::io::{strip_bom, text_number, FormatError};
 pub fn parse(bytes: &[u8]) -> Result<Vec<ScanRecord>, FormatError> {
     let mut scans: Vec<ScanRecord> = Vec::new();
     let mut total = 0usize;
-    for (i, raw) in strip_bom(bytes).split(|&b| b == b'\n').enumerate() {
+    for (i, raw) in text_start(bytes)?.split(|&b| b == b'\n').enumerate() {
         let line_no = i + 1;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         if raw.is_empty() || raw[0] == b'#' || raw[0] == b' ' {

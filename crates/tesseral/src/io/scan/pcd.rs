@@ -16,7 +16,7 @@
 
 use super::pcd_data;
 use super::{syntax, words, PointFrame, ScanRecord};
-use crate::io::{strip_bom, text_number, FormatError};
+use crate::io::{text_number, text_start, FormatError};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(super) enum Kind {
@@ -144,7 +144,7 @@ pub fn parse(bytes: &[u8]) -> Result<ScanRecord, FormatError> {
 
 /// Reads the header, up to and including its `DATA` line.
 fn header(bytes: &[u8]) -> Result<Header, FormatError> {
-    let mut pos = bytes.len() - strip_bom(bytes).len();
+    let mut pos = bytes.len() - text_start(bytes)?.len();
     let mut line_no = 0usize;
     let mut names: Option<Entries<String>> = None;
     let mut sizes: Option<Entries<usize>> = None;

@@ -301,6 +301,11 @@ fn a_byte_order_mark_is_skipped() {
     assert!(corrupt(pcd::parse(&b)).starts_with(&format!("byte {at}:")));
     b.extend_from_slice(&[0; 12]);
     assert_eq!(pcd::parse(&b).unwrap().points.len(), 2);
+    for bytes in [&b"\xff\xfe1\x00"[..], b"\xfe\xff\x001"] {
+        let e = cloud::parse_xyz(bytes).unwrap_err().to_string();
+        assert!(e.starts_with("1:1: the text is UTF-16"), "{e}");
+        assert!(log::parse(bytes).is_err() && pcd::parse(bytes).is_err());
+    }
 }
 
 #[test]

@@ -68,7 +68,7 @@ fn line_col(bytes: &[u8], offset: usize) -> (usize, usize) {
 /// # Errors
 /// As [`read`](super::read).
 pub fn parse_obj(bytes: &[u8]) -> Result<TriMesh, FormatError> {
-    let bytes = crate::io::strip_bom(bytes);
+    let bytes = crate::io::text_start(bytes)?;
     let text = std::str::from_utf8(bytes).map_err(|e| {
         let (line, column) = line_col(bytes, e.valid_up_to());
         syntax(line, column, "not text (an OBJ file is UTF-8 text)")

@@ -259,12 +259,12 @@ pub(crate) fn parse_ply_points(bytes: &[u8]) -> Result<TriMesh, FormatError> {
 }
 
 fn parse(bytes: &[u8], finite: bool) -> Result<TriMesh, FormatError> {
+    // A UTF-8 byte order mark before `ply` is skipped; a UTF-16 one refused.
+    let bom = bytes.len() - crate::io::text_start(bytes)?.len();
     let end = bytes
         .windows(11)
         .position(|w| w == b"end_header\n" || w == b"end_header\r")
         .ok_or_else(|| syntax(1, 1, "no `end_header` line"))?;
-    // A UTF-8 byte order mark before `ply` is skipped.
-    let bom = bytes.len() - crate::io::strip_bom(bytes).len();
     let header = String::from_utf8_lossy(&bytes[bom.min(end)..end]);
     let mut body_start = end + 11;
     if bytes.get(end + 10) == Some(&b'\r') && bytes.get(body_start) == Some(&b'\n') {

@@ -19,6 +19,7 @@ pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
             return parse_stl_binary(bytes, n);
         }
         if !looks_ascii {
+            crate::io::text_start(bytes)?;
             return Err(FormatError::corrupt(format!(
                 "binary STL header says {n} triangles ({binary_len} bytes), the file has {} bytes",
                 bytes.len()
@@ -26,7 +27,7 @@ pub fn parse_stl(bytes: &[u8]) -> Result<TriMesh, FormatError> {
         }
     }
     // A byte order mark before `solid` is skipped.
-    parse_stl_ascii(crate::io::strip_bom(bytes))
+    parse_stl_ascii(crate::io::text_start(bytes)?)
 }
 
 fn parse_stl_binary(bytes: &[u8], n: usize) -> Result<TriMesh, FormatError> {

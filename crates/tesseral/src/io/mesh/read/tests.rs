@@ -153,3 +153,28 @@ fn a_byte_order_mark_is_skipped() {
         .with_path("a.obj");
     assert_eq!(e.to_string(), "a.obj:1:5: `x` is not a finite number");
 }
+
+/// UTF-16 and UTF-32 text is refused at 1:1 naming its encoding, not read as
+/// bytes that fail further on (a binary STL's triangle count, a NUL in a number).
+#[test]
+fn wide_text_is_named() {
+    let utf16le: Vec<u8> = "\u{feff}solid t\nendsolid t\n"
+        .encode_utf16()
+        .flat_map(u16::to_le_bytes)
+        .collect();
+    let e = parse_stl(&utf16le).unwrap_err().with_path("a.stl");
+    assert_eq!(
+        e.to_string(),
+        "a.stl:1:1: the text is UTF-16 little-endian (byte order mark FF FE): save it as UTF-8"
+    );
+    let utf16be: Vec<u8> = "\u{feff}v 0 0 0\n"
+        .encode_utf16()
+        .flat_map(u16::to_be_bytes)
+        .collect();
+    let e = parse_obj(&utf16be).unwrap_err().to_string();
+    assert!(e.contains("UTF-16 big-endian"), "{e}");
+    let e = parse_ply(b"\xff\xfe\x00\x00p\x00\x00\x00")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("UTF-32 little-endian"), "{e}");
+}
