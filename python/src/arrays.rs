@@ -165,7 +165,15 @@ pub fn cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
     match kind {
         'f' => {
             let f64s = as_type(numpy::dtype::<f64>(py))?;
-            checked(rows_of::<f64, f64>(&f64s, name, |x| x).expect("astype gives float64")?)
+            let rows = rows_of::<f64, f64>(&f64s, name, |x| x).expect("astype gives float64")?;
+            // Rows mixing floats with ints past 2**53 were made floats by numpy,
+            // rounding the ints: read them value by value instead.
+            if !obj.is_instance_of::<numpy::PyUntypedArray>()
+                && rows.iter().flatten().any(|x| x.abs() >= EXACT)
+            {
+                return object_cells(obj, name);
+            }
+            checked(rows)
         }
         'u' => {
             let u64s = as_type(numpy::dtype::<u64>(py))?;
@@ -190,6 +198,42 @@ pub fn cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
             rows_of::<i64, i64>(&i64s, name, |x| x).expect("astype gives int64")
         }
     }
+}
+
+/// The cells of a list of rows whose floats numpy would round: each value an int
+/// within int64 or a float that is a whole number there, read one by one.
+fn object_cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
+    let index = obj.py().import("operator")?.getattr("index")?;
+    let value = |i: usize, x: Bound<'_, PyAny>| -> PyResult<i64> {
+        let refuse = || {
+            PyValueError::new_err(format!(
+                "{name}: expected integers, got {x} in row {i} (a value must be a whole \
+                 number within int64)"
+            ))
+        };
+        if let Ok(f) = x.downcast::<pyo3::types::PyFloat>() {
+            let v = f.value();
+            const PAST: f64 = 9_223_372_036_854_775_808.0;
+            return if v.fract() == 0.0 && (-PAST..PAST).contains(&v) {
+                Ok(v as i64)
+            } else {
+                Err(refuse())
+            };
+        }
+        index.call1((&x,))?.extract::<i64>().map_err(|_| refuse())
+    };
+    obj.try_iter()?
+        .enumerate()
+        .map(|(i, row)| {
+            let values: Vec<Bound<'_, PyAny>> = row?.try_iter()?.collect::<PyResult<_>>()?;
+            // numpy made an N×3 array of the rows: three values each, unless a row
+            // changed since.
+            let [x, y, z] = <[_; 3]>::try_from(values).map_err(|v| {
+                PyValueError::new_err(format!("{name}: row {i} has {} values, not 3", v.len()))
+            })?;
+            Ok([value(i, x)?, value(i, y)?, value(i, z)?])
+        })
+        .collect()
 }
 
 /// Codes of a one-dimensional argument: a uint64 array borrowed where it lies, or

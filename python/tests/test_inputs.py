@@ -309,3 +309,15 @@ def test_calc_reads_mixed_lists_exactly_and_lets_interrupts_through():
         t.calc.decode([Interrupting(), 2 ** 64])
     with pytest.raises(MemoryError):
         t.calc.decode(Exhausting())
+
+
+def test_cells_of_mixed_rows_are_read_exactly():
+    # numpy makes floats of rows mixing ints past 2**53 with floats: read exactly.
+    big = 2 ** 60 + 1
+    d = t.DynamicOctree()
+    d.insert([[big, 0, 1.0]])
+    assert d.voxels().tolist() == [[big, 0, 1]]
+    with pytest.raises(ValueError, match=r"voxels: expected integers, got 0.5 in row 1"):
+        d.insert([[big, 0, 1.0], [1, 2, 0.5]])
+    with pytest.raises(ValueError, match=r"got 9223372036854775808 in row 0"):
+        d.insert([[2 ** 63, 0, 1.0]])
