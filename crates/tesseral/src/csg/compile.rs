@@ -24,6 +24,28 @@ pub(super) struct Prim {
 }
 
 impl Prim {
+    /// A box's class of a cell's centres by their bounding box rather than their
+    /// ball: the centres' box (half-side `r/√3` in world units), mapped to the box's
+    /// frame, bounded by a local box of half-sides `Σⱼ |inv[i][j]| · r/√3`. Exact
+    /// for a box not rotated off the axes, where the ball cannot decide a cell whose
+    /// face lies on the box's (every cell along a box that fills its space); `None`
+    /// when undecided.
+    #[inline]
+    fn box_class(&self, l: [f64; 3], r: f64, half: [f64; 3]) -> Option<CellClass> {
+        let e = r / 3f64.sqrt();
+        let margin = (1e-6 + 1e-9 * r) / self.scale;
+        let mut inside = true;
+        for (i, row) in self.inv.iter().enumerate() {
+            let ext = e * (row[0].abs() + row[1].abs() + row[2].abs());
+            let d = l[i].abs();
+            if d - ext > half[i] + margin {
+                return Some(CellClass::Outside);
+            }
+            inside &= d + ext < half[i] - margin;
+        }
+        inside.then_some(CellClass::Inside)
+    }
+
     #[inline]
     pub(super) fn local(&self, p: [f64; 3]) -> [f64; 3] {
         let d = [p[0] - self.at[0], p[1] - self.at[1], p[2] - self.at[2]];
@@ -35,7 +57,8 @@ impl Prim {
         ]
     }
 
-    /// The class of the ball of radius `r` around `c` (`r == 0`: the point `c`).
+    /// The class of the voxel centres of a cell, given as their ball (`cell_ball`:
+    /// radius `r` around `c`; `r == 0`: the point `c`).
     #[inline]
     pub(super) fn class(&self, c: [f64; 3], r: f64) -> CellClass {
         let l = self.local(c);
@@ -46,9 +69,14 @@ impl Prim {
                 CellClass::Outside
             };
         }
-        let b = self.scale * self.shape.bound(l);
         // The margin absorbs rounding: the bound is decided well clear of the surface.
         let m = r + 1e-6 + 1e-9 * r;
+        if let Shape::Box { half } = self.shape {
+            if let Some(class) = self.box_class(l, r, half) {
+                return class;
+            }
+        }
+        let b = self.scale * self.shape.bound(l);
         if b > m {
             CellClass::Outside
         } else if b < -m {
