@@ -82,21 +82,44 @@ fn shape_text(shape: &[usize]) -> String {
     }
 }
 
-/// `obj` as a numpy array of numbers, N×3 (a zero-length sequence is 0×3), and its
-/// dtype's kind ('b', 'i', 'u', 'f', ...).
-fn numeric<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<(Bound<'py, PyAny>, char)> {
+/// `numpy.asarray(obj)`, its dtype and the dtype's kind ('b', 'i', 'u', 'f', 'O',
+/// ...). numpy's own refusals (TypeError, ValueError) are told as `name: expected
+/// …, got …`; anything else (an interrupt, a MemoryError) passes through.
+fn asarray<'py>(
+    obj: &Bound<'py, PyAny>,
+    name: &str,
+    expected: &str,
+) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, char)> {
     let py = obj.py();
-    let np = py.import("numpy")?;
-    let arr = np.call_method1("asarray", (obj,)).map_err(|e| {
-        PyValueError::new_err(format!(
-            "{name}: expected an N×3 array of numbers, got {} that numpy cannot make \
-             one array of: {}",
-            describe(obj),
-            e.value(py)
-        ))
-    })?;
+    let arr = py
+        .import("numpy")?
+        .call_method1("asarray", (obj,))
+        .map_err(|e| {
+            if !(e.is_instance_of::<PyTypeError>(py) || e.is_instance_of::<PyValueError>(py)) {
+                return e;
+            }
+            PyValueError::new_err(format!(
+                "{name}: {expected}, got {} that numpy cannot make one array of: {}",
+                describe(obj),
+                e.value(py)
+            ))
+        })?;
     let dtype = arr.getattr("dtype")?;
     let kind: char = dtype.getattr("kind")?.extract()?;
+    Ok((arr, dtype, kind))
+}
+
+/// A float that is a whole number within int64, as one.
+fn whole_i64(x: f64) -> Option<i64> {
+    // 2**63: the first float past int64.
+    const PAST: f64 = 9_223_372_036_854_775_808.0;
+    (x.fract() == 0.0 && (-PAST..PAST).contains(&x)).then_some(x as i64)
+}
+
+/// `obj` as a numpy array of numbers, N×3 (a zero-length sequence is 0×3), and its
+/// dtype's kind ('i', 'u' or 'f').
+fn numeric<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<(Bound<'py, PyAny>, char)> {
+    let (arr, dtype, kind) = asarray(obj, name, "expected an N×3 array of numbers")?;
     if !matches!(kind, 'i' | 'u' | 'f') {
         return Err(PyTypeError::new_err(format!(
             "{name}: expected an N×3 array of numbers, got {} of dtype {}",
@@ -144,21 +167,14 @@ pub fn cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
     let as_type = |t| arr.call_method1("astype", (t,));
     // Each row back as i64, or the first value that is not one.
     let checked = |rows: Vec<[f64; 3]>| -> PyResult<Vec<[i64; 3]>> {
-        // 2**63: the first float past int64.
-        const PAST: f64 = 9_223_372_036_854_775_808.0;
         rows.iter()
             .enumerate()
-            .map(|(i, r)| {
-                match r
-                    .iter()
-                    .find(|x| !(x.fract() == 0.0 && (-PAST..PAST).contains(*x)))
-                {
-                    Some(x) => Err(PyValueError::new_err(format!(
-                        "{name}: expected integers, got {x} in row {i} (a float array is \
-                         taken only when every value is a whole number within int64)"
-                    ))),
-                    None => Ok(r.map(|x| x as i64)),
-                }
+            .map(|(i, r)| match r.iter().find(|x| whole_i64(**x).is_none()) {
+                Some(x) => Err(PyValueError::new_err(format!(
+                    "{name}: expected integers, got {x} in row {i} (a float array is \
+                     taken only when every value is a whole number within int64)"
+                ))),
+                None => Ok(r.map(|x| x as i64)),
             })
             .collect()
     };
@@ -212,13 +228,7 @@ fn object_cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
             ))
         };
         if let Ok(f) = x.downcast::<pyo3::types::PyFloat>() {
-            let v = f.value();
-            const PAST: f64 = 9_223_372_036_854_775_808.0;
-            return if v.fract() == 0.0 && (-PAST..PAST).contains(&v) {
-                Ok(v as i64)
-            } else {
-                Err(refuse())
-            };
+            return whole_i64(f.value()).ok_or_else(refuse);
         }
         index.call1((&x,))?.extract::<i64>().map_err(|_| refuse())
     };
@@ -284,22 +294,8 @@ pub fn codes<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Codes<'py>> {
         return Ok(Codes::InPlace(r));
     }
     let py = obj.py();
-    let numpy = py.import("numpy")?;
     let expected = "expected a 1-D array of codes";
-    // Only numpy's own refusals are told as ours; an interrupt or a memory error
-    // passes through.
-    let arr = numpy.call_method1("asarray", (obj,)).map_err(|e| {
-        if !(e.is_instance_of::<PyTypeError>(py) || e.is_instance_of::<PyValueError>(py)) {
-            return e;
-        }
-        PyValueError::new_err(format!(
-            "{name}: {expected}, got {} that numpy cannot make one array of: {}",
-            describe(obj),
-            e.value(py)
-        ))
-    })?;
-    let dtype = arr.getattr("dtype")?;
-    let kind: char = dtype.getattr("kind")?.extract()?;
+    let (arr, dtype, kind) = asarray(obj, name, expected)?;
     if !matches!(kind, 'i' | 'u' | 'f' | 'O') {
         return Err(PyTypeError::new_err(format!(
             "{name}: {expected} (integers, or floats that are whole numbers), got {} of \
@@ -344,7 +340,7 @@ pub fn codes<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<Codes<'py>> {
             // rounding the ints: read it element by element instead.
             if !obj.is_instance_of::<numpy::PyUntypedArray>() && v.iter().any(|x| x.abs() >= EXACT)
             {
-                let objects = numpy.call_method1("array", (obj, "object"))?;
+                let objects = py.import("numpy")?.call_method1("array", (obj, "object"))?;
                 return object_codes(&objects, name).map(Codes::Converted);
             }
             v.iter()

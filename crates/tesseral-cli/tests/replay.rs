@@ -217,6 +217,21 @@ fn missing_file_and_stdin() {
     );
 }
 
+/// `tesseral info --json FILE` in `dir`, which must succeed.
+fn info_json(dir: &std::path::Path, file: &str) -> serde_json::Value {
+    let info = tesseral()
+        .args(["info", "--json", file])
+        .current_dir(dir)
+        .output()
+        .unwrap();
+    assert!(
+        info.status.success(),
+        "{}",
+        String::from_utf8_lossy(&info.stderr)
+    );
+    serde_json::from_slice(&info.stdout).unwrap()
+}
+
 #[test]
 fn replay_o_saves_the_octree_it_built() {
     let body = "+ 0 0 0\n+ 1 0 0\n+ -5 3 2\n+ 7 7 7\n- 7 7 7\n";
@@ -229,19 +244,8 @@ fn replay_o_saves_the_octree_it_built() {
             String::from_utf8_lossy(&out.stderr)
         );
         assert_eq!(report(&out)["output"], serde_json::json!(name));
-        let info = tesseral()
-            .args(["info", "--json", &name])
-            .current_dir(dir.path())
-            .output()
-            .unwrap();
-        assert!(
-            info.status.success(),
-            "{}",
-            String::from_utf8_lossy(&info.stderr)
-        );
-        let text = String::from_utf8_lossy(&info.stdout);
-        let v: serde_json::Value = serde_json::from_str(&text).unwrap();
-        assert_eq!(v["voxels"], 3, "{ext}: {text}");
+        let v = info_json(dir.path(), &name);
+        assert_eq!(v["voxels"], 3, "{ext}: {v}");
     }
 }
 
@@ -282,17 +286,7 @@ fn replay_o_keeps_an_octree_wider_than_a_model_in_its_own_tess() {
     assert!(bytes.starts_with(b"\x89TESSDY\n"));
     // Three blocks: two voxels share one, each other voxel has its own.
     assert_eq!(bytes.len(), 32 + 3 * 65 + 4 + 9 + 12, "{}", bytes.len());
-    let info = tesseral()
-        .args(["info", "--json", "d.tess"])
-        .current_dir(dir.path())
-        .output()
-        .unwrap();
-    assert!(
-        info.status.success(),
-        "{}",
-        String::from_utf8_lossy(&info.stderr)
-    );
-    let v: serde_json::Value = serde_json::from_slice(&info.stdout).unwrap();
+    let v = info_json(dir.path(), "d.tess");
     assert_eq!(v["kind"], "dynamic_octree");
     assert_eq!(v["voxels"], 4);
     assert_eq!(v["blocks"], 3);

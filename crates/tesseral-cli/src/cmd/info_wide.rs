@@ -70,14 +70,7 @@ fn run_dyn(path: &Path, json: bool) -> Result<()> {
         "kind     unbounded dynamic octree, wider than a model holds (2^21 voxels on an axis)"
     )?;
     crate::outln!("voxels   {} in {} blocks of 8^3", info.voxels, info.blocks)?;
-    match bounds {
-        Some((lo, hi)) => crate::outln!(
-            "bbox     {} to {}",
-            super::octree::fmt_voxel(lo),
-            super::octree::fmt_voxel(hi)
-        )?,
-        None => crate::outln!("bbox     (empty)")?,
-    }
+    bbox_line(bounds, "")?;
     crate::outln!("root     2^{} voxels on a side", info.root_size_log2)?;
     crate::outln!("bytes    {} in memory", info.bytes)?;
     Ok(())
@@ -156,14 +149,7 @@ fn run_map(path: &Path, json: bool) -> Result<()> {
         info.leaves,
         info.blocks
     )?;
-    match bounds {
-        Some((lo, hi)) => crate::outln!(
-            "bbox     {} to {} (whole blocks)",
-            super::octree::fmt_voxel(lo),
-            super::octree::fmt_voxel(hi)
-        )?,
-        None => crate::outln!("bbox     (empty)")?,
-    }
+    bbox_line(bounds, " (whole blocks)")?;
     crate::outln!("frame    cells of {res} from the world origin")?;
     crate::outln!(
         "sensor   hit {:.4}, miss {:.4}, clamps {:.4}..{:.4}, occupied from {:.4}",
@@ -174,5 +160,18 @@ fn run_map(path: &Path, json: bool) -> Result<()> {
         info.threshold
     )?;
     crate::outln!("bytes    {} in memory", info.bytes)?;
+    Ok(())
+}
+
+/// The `bbox` line: the box's corners (then `note`), or `(empty)`.
+fn bbox_line(bounds: Option<([i64; 3], [i64; 3])>, note: &str) -> Result<()> {
+    match bounds {
+        Some((lo, hi)) => crate::outln!(
+            "bbox     {} to {}{note}",
+            super::octree::fmt_voxel(lo),
+            super::octree::fmt_voxel(hi)
+        )?,
+        None => crate::outln!("bbox     (empty)")?,
+    }
     Ok(())
 }

@@ -107,7 +107,7 @@ pub fn run(args: Args) -> Result<()> {
         bytes_read += buf.len() as u64 + 1;
         // A UTF-8 byte order mark before the first line is skipped.
         let line = match line_no {
-            0 => buf.strip_prefix(b"\xef\xbb\xbf").unwrap_or(&buf),
+            0 => tesseral::io::strip_bom(&buf),
             _ => &buf,
         };
         let text = match std::str::from_utf8(line) {

@@ -146,20 +146,14 @@ impl DynamicOctree {
             }
         }
         let mut across = 0u128;
-        let mut cross = |bits: u64, z: u64, axis: usize| {
-            let mut m = bits;
+        for (mut m, z, axis) in face_rows(l) {
             while m != 0 {
                 let i = u64::from(m.trailing_zeros());
                 m &= m - 1;
                 let u = [base[0] + (i & 7), base[1] + (i >> 3), base[2] + z];
                 across += u128::from(self.black_after(u, axis));
             }
-        };
-        for z in 0..8 {
-            cross(l[z] & X7, z as u64, 0);
-            cross(l[z] & Y7, z as u64, 1);
         }
-        cross(l[7], 7, 2);
         u128::from(pairs) + across
     }
 
@@ -204,11 +198,17 @@ const NOT_X7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
 const X7: u64 = !NOT_X7;
 const Y7: u64 = 0xff << 56;
 
+/// The black cells of block `l` on its positive faces, by word: (the cells of word
+/// `z` on the face, `z`, the axis the face is across).
+fn face_rows(l: &[u64; 8]) -> impl Iterator<Item = (u64, u64, usize)> + '_ {
+    (0..8u64)
+        .flat_map(move |z| [(l[z as usize] & X7, z, 0), (l[z as usize] & Y7, z, 1)])
+        .chain([(l[7], 7, 2)])
+}
+
 /// The black cells of block `l` on its positive faces, each counted once a face.
 fn face_cells(l: &[u64; 8]) -> u64 {
-    let sides: u32 = l
-        .iter()
-        .map(|w| (w & X7).count_ones() + (w & Y7).count_ones())
-        .sum();
-    u64::from(sides + l[7].count_ones())
+    face_rows(l)
+        .map(|(m, _, _)| u64::from(m.count_ones()))
+        .sum()
 }

@@ -179,7 +179,7 @@ pub fn extension(path: &Path) -> String {
 
 /// The bytes after a UTF-8 byte order mark, if they start with one: text readers
 /// skip it (editors on Windows write one), and count columns after it.
-pub(crate) fn strip_bom(bytes: &[u8]) -> &[u8] {
+pub fn strip_bom(bytes: &[u8]) -> &[u8] {
     bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
 }
 
