@@ -44,10 +44,11 @@ pub fn decode<'py>(
 ) -> PyResult<Bound<'py, PyArray2<i64>>> {
     let codes = code_array(codes, "codes")?;
     let c = codes.view();
-    let v: Vec<[i64; 3]> = c
-        .iter()
-        .map(|&k| tesseral::code::decode(k).map(i64::from))
-        .collect();
+    let v: Vec<[i64; 3]> = py.allow_threads(|| {
+        c.iter()
+            .map(|&k| tesseral::code::decode(k).map(i64::from))
+            .collect()
+    });
     to_array(py, v)
 }
 
@@ -55,7 +56,7 @@ fn binary<'py>(
     py: Python<'py>,
     a: &Bound<'py, PyAny>,
     b: &Bound<'py, PyAny>,
-    f: impl Fn(&Space<u64>, u64, u64) -> u64,
+    f: impl Fn(&Space<u64>, u64, u64) -> u64 + Send + Sync,
 ) -> PyResult<Bound<'py, PyArray1<u64>>> {
     let (a, b) = (code_array(a, "a")?, code_array(b, "b")?);
     let (a, b) = (a.view(), b.view());
@@ -67,7 +68,8 @@ fn binary<'py>(
         )));
     }
     let s = Space::<u64>::full();
-    let out: Vec<u64> = a.iter().zip(b.iter()).map(|(&x, &y)| f(&s, x, y)).collect();
+    let out: Vec<u64> =
+        py.allow_threads(|| a.iter().zip(b.iter()).map(|(&x, &y)| f(&s, x, y)).collect());
     Ok(out.into_pyarray(py))
 }
 

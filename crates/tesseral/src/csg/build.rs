@@ -7,7 +7,8 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use super::compile::{Csg, Known, Op, Prim};
+use super::compile::{Csg, Known, Op};
+use super::prim::Prim;
 use super::DEFAULT_MAX_LEAVES;
 use super::{CsgError, Shape};
 use crate::linear::{push_merging, CellClass, Classifier, Leaf, LinearOctree};

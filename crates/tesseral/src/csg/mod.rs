@@ -27,6 +27,7 @@ mod build;
 mod colours;
 mod compile;
 mod index;
+mod prim;
 pub mod scene;
 mod shape;
 mod stream;
