@@ -5,7 +5,6 @@ import errno
 import inspect
 import os
 import threading
-import time
 
 import numpy as np
 import pytest
@@ -324,27 +323,11 @@ def test_cells_of_mixed_rows_are_read_exactly():
         d.insert([[2 ** 63, 0, 1.0]])
 
 
-def test_calc_releases_the_gil_while_it_computes():
+def test_calc_releases_the_gil_while_it_computes(ticks_during):
     # Another thread keeps running while add, sub and decode work on a native
     # uint64 array (read in place, so the whole call is the computation).
     codes = np.arange(1 << 22, dtype=np.uint64)
     for call in (lambda: t.calc.add(codes, codes), lambda: t.calc.sub(codes, codes),
                  lambda: t.calc.decode(codes)):
-        ticks = []
-        stop = threading.Event()
-
-        def tick():
-            while not stop.is_set():
-                ticks.append(time.perf_counter())
-                time.sleep(0.0005)
-
-        th = threading.Thread(target=tick)
-        th.start()
-        time.sleep(0.01)
-        start = time.perf_counter()
-        call()
-        end = time.perf_counter()
-        stop.set()
-        th.join()
-        during = [x for x in ticks if start < x < end]
-        assert len(during) >= 2, (end - start, len(during))
+        _, during = ticks_during(call, period=0.0005)
+        assert during >= 2, during

@@ -1,8 +1,5 @@
 """Every Octree operation against a numpy / Python set model, with frames and colours."""
 
-import threading
-import time
-
 import numpy as np
 import pytest
 
@@ -168,24 +165,9 @@ def test_errors(tmp_path):
         t.Octree.from_voxels(np.zeros((1, 3), dtype=np.int64)).rotate("w", 1)
 
 
-def test_long_calls_release_the_gil():
+def test_long_calls_release_the_gil(ticks_during):
     s = t.Scene.parse("depth 9\nbounds [0, 0, 0] [512, 512, 512]\nsphere(r = 250) at [256, 256, 256]\n")
-    ticks = []
-    stop = threading.Event()
-
-    def tick():
-        while not stop.is_set():
-            ticks.append(time.perf_counter())
-            time.sleep(0.001)
-
-    th = threading.Thread(target=tick)
-    th.start()
-    start = time.perf_counter()
-    o = s.build()
-    end = time.perf_counter()
-    stop.set()
-    th.join()
+    o, during = ticks_during(s.build)
     assert o.voxel_count > 0
-    during = [x for x in ticks if start < x < end]
     # The other thread kept running while the build held no GIL.
-    assert len(during) >= 3, (end - start, len(during))
+    assert during >= 3, during
