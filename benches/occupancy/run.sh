@@ -26,6 +26,9 @@
 #   issue's sizes; the outdoor map of that size does not fit in memory for Bonxai or
 #   OctoMap here, so pass smaller ones), OCTOMAP_SCANS (the first N scans only, as
 #   OctoMap is slow; default all), WORKLOADS="indoor outdoor", TOOLS="tesseral bonxai octomap".
+#   REPEATS=N runs every tool N times on each workload, the tools taken by turns, one
+#   RESULT line a run (on a noisy machine a 0.1 s run varies by a factor of two:
+#   compare medians, not one run of each).
 #   REAL_SCAN=FILE adds the workload `real`: a real laser scan as text lines `x y z`
 #   in the sensor frame (sensor at the origin), or that file bzip2-compressed, e.g.
 #   OctoMap's own octomap/share/data/scan.dat.bz2 (88,206 points, ranges 0.47-29 m),
@@ -100,18 +103,21 @@ for w in $workloads; do
     [ -f "$dir/$w.scans" ] || "$peer" gen "$dir" "$scans" "$rays"
     echo "== $w: $scans scans x $rays rays, 5 cm, max range $range" >&2
   fi
-  for tool in ${TOOLS:-tesseral bonxai octomap}; do
-    case $tool in
-      tesseral)
-        echo "$w tesseral-1core $(RAYON_NUM_THREADS=1 timed taskset -c 0 "$peer" run "$dir/$w.scans" "$range")"
-        echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
-        ;;
-      bonxai)
-        echo "$w bonxai-1core $(timed taskset -c 0 "$build/bonxai_driver" "$dir/$w.scans" "$range")"
-        ;;
-      octomap)
-        echo "$w octomap-1core $(timed taskset -c 0 "$build/octomap_driver" "$dir/$w.scans" "$range" "${OCTOMAP_SCANS:-1000000}")"
-        ;;
-    esac
+  for rep in $(seq "${REPEATS:-1}"); do
+    [ "${REPEATS:-1}" -gt 1 ] && echo "-- $w: run $rep of $REPEATS" >&2
+    for tool in ${TOOLS:-tesseral bonxai octomap}; do
+      case $tool in
+        tesseral)
+          echo "$w tesseral-1core $(RAYON_NUM_THREADS=1 timed taskset -c 0 "$peer" run "$dir/$w.scans" "$range")"
+          echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
+          ;;
+        bonxai)
+          echo "$w bonxai-1core $(timed taskset -c 0 "$build/bonxai_driver" "$dir/$w.scans" "$range")"
+          ;;
+        octomap)
+          echo "$w octomap-1core $(timed taskset -c 0 "$build/octomap_driver" "$dir/$w.scans" "$range" "${OCTOMAP_SCANS:-1000000}")"
+          ;;
+      esac
+    done
   done
 done
