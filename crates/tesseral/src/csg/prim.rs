@@ -61,13 +61,13 @@ impl Prim {
                 CellClass::Outside
             };
         }
-        // The margin absorbs rounding: the bound is decided well clear of the surface.
-        let m = r + 1e-6 + 1e-9 * r;
         if let Shape::Box { half } = self.shape {
             if let Some(class) = self.box_class(l, r, half) {
                 return class;
             }
         }
+        // The margin absorbs rounding: the bound is decided well clear of the surface.
+        let m = r + 1e-6 + 1e-9 * r;
         let b = self.scale * self.shape.bound(l);
         if b > m {
             CellClass::Outside

@@ -28,9 +28,10 @@ pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
         (b"VOX ", "vox"),
         (b"# Octomap OcTree binary file", "bt"),
         (b"# Octomap OcTree file", "ot"),
-        (b"ply\n", "ply"),
-        (b"ply\r\n", "ply"),
+        (PLY[0], "ply"),
+        (PLY[1], "ply"),
     ];
+    const PLY: [&[u8]; 2] = [b"ply\n", b"ply\r\n"];
     for (magic, ext) in MAGIC {
         if bytes.starts_with(magic) {
             return Some(ext);
@@ -42,7 +43,7 @@ pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
     // Text may start with a UTF-8 byte order mark, which its readers skip (a PLY
     // header among them).
     let body = super::strip_bom(bytes);
-    if body.starts_with(b"ply\n") || body.starts_with(b"ply\r\n") {
+    if PLY.iter().any(|m| body.starts_with(m)) {
         return Some("ply");
     }
     let head = &body[..body.len().min(1024)];
