@@ -28,6 +28,7 @@ use tesseral::io::scan::{self, Placement, ScanFormat, ScanRecord};
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use super::octree::{self, OutArgs};
+use super::output::{human_bytes, plural};
 
 /// Arguments of `tesseral map`.
 #[derive(clap::Args)]
@@ -278,17 +279,17 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
             String::new()
         };
         let line = format!(
-            "wrote {}: {} scans, {} points{skipped}, {} rays in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {} leaves, {} bytes",
+            "wrote {}: {}, {}{skipped}, {} in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {}, {} in memory",
             args.output.display(),
-            t.scans,
-            t.points,
-            t.rays,
+            plural(t.scans, "scan", "scans"),
+            plural(t.points, "point", "points"),
+            plural(t.rays, "ray", "rays"),
             t.seconds,
             rate / 1e6,
             counts.occupied,
             counts.free,
-            counts.leaves,
-            map.bytes()
+            plural(counts.leaves, "leaf", "leaves"),
+            human_bytes(map.bytes() as u64)
         );
         if super::output::is_stdio(&args.output) {
             eprintln!("{line}");

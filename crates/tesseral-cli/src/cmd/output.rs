@@ -99,6 +99,11 @@ pub fn human_bytes(bytes: u64) -> String {
     }
 }
 
+/// A count and its noun for people: `1 leaf`, `2 leaves`.
+pub fn plural(n: u64, one: &str, many: &str) -> String {
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 /// The extensions of every octree format `tesseral::io` writes.
 pub fn octree_formats() -> Vec<&'static str> {
     tesseral::io::KNOWN_WRITE_EXTENSIONS.split(", ").collect()
@@ -411,6 +416,9 @@ mod tests {
         assert_eq!(suggest(44 << 30), "44G");
         assert_eq!(suggest((44 << 30) + 1), "45G");
         assert_eq!(suggest(3 << 40), "3T");
+        assert_eq!(plural(1, "leaf", "leaves"), "1 leaf");
+        assert_eq!(plural(0, "leaf", "leaves"), "0 leaves");
+        assert_eq!(plural(2, "scan", "scans"), "2 scans");
     }
 
     #[test]

@@ -84,15 +84,6 @@ fn name(b: &Body) -> String {
     }
 }
 
-/// `1 object`, `2 objects`.
-fn plural(n: u64, noun: &str) -> String {
-    if n == 1 {
-        format!("1 {noun}")
-    } else {
-        format!("{n} {noun}s")
-    }
-}
-
 /// A `--view` value: a named view for the pictures, or a page to write.
 #[derive(Clone, Debug)]
 enum ViewArg {
@@ -233,10 +224,10 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         let line = format!(
             "{} in {} of {} ({})\n",
-            plural(report.contacts, "contact"),
-            plural(wf.steps, "step"),
+            output::plural(report.contacts, "contact", "contacts"),
+            output::plural(wf.steps, "step", "steps"),
             wf.time_step,
-            plural(world.objects.len() as u64, "object")
+            output::plural(world.objects.len() as u64, "object", "objects")
         );
         report.out.write_all(line.as_bytes())?;
     }
