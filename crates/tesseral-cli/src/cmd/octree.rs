@@ -5,7 +5,7 @@ use std::path::Path;
 
 use anyhow::Result;
 use tesseral::linear::Axis;
-use tesseral::model::Model;
+use tesseral::model::{Frame, Model};
 
 use super::budget::Budget;
 use super::output::{self, Limits};
@@ -175,20 +175,42 @@ pub fn write(path: &Path, model: &Model, out: &OutArgs, report: Report) -> Resul
         crate::outln!("{v}")?;
         return Ok(());
     }
-    let frame = if model.frame.is_unit() {
-        String::new()
-    } else {
-        format!(", {}", model.frame)
-    };
     crate::outln!(
-        "wrote {}: {} voxels, {} leaves, depth {}, origin {}{frame}",
-        path.display(),
-        tree.voxel_count(),
-        tree.leaf_count(),
-        tree.depth(),
-        fmt_voxel(tree.origin())
+        "{}",
+        wrote_line(
+            path,
+            tree.voxel_count(),
+            tree.leaf_count() as u64,
+            tree.depth(),
+            tree.origin(),
+            &model.frame
+        )
     )?;
     Ok(())
+}
+
+/// The line a command prints for an octree it wrote: `wrote PATH: N voxels, N
+/// leaves, depth D, origin (x, y, z)`, then the frame unless it is the unit one.
+pub fn wrote_line(
+    path: &Path,
+    voxels: u64,
+    leaves: u64,
+    depth: u8,
+    origin: [i64; 3],
+    frame: &Frame,
+) -> String {
+    let frame = if frame.is_unit() {
+        String::new()
+    } else {
+        format!(", {frame}")
+    };
+    format!(
+        "wrote {}: {}, {}, depth {depth}, origin {}{frame}",
+        path.display(),
+        output::plural(voxels, "voxel", "voxels"),
+        output::plural(leaves, "leaf", "leaves"),
+        fmt_voxel(origin)
+    )
 }
 
 /// `(x, y, z)`.
@@ -251,5 +273,23 @@ pub fn parse_power_of_two(text: &str) -> Result<i32, String> {
         _ => Err(format!(
             "`{t}` is not a power of two; write `2^K` (for example 2^3 or 2^-1)"
         )),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_written_line_counts_in_words_and_names_a_frame() {
+        let at = Path::new("a.tess");
+        assert_eq!(
+            wrote_line(at, 1, 1, 3, [0, -1, 2], &Frame::default()),
+            "wrote a.tess: 1 voxel, 1 leaf, depth 3, origin (0, -1, 2)"
+        );
+        assert_eq!(
+            wrote_line(at, 8, 2, 4, [0; 3], &Frame::new(0.05, [1.0, 0.0, 0.0])),
+            "wrote a.tess: 8 voxels, 2 leaves, depth 4, origin (0, 0, 0), voxel size 0.05 at (1, 0, 0)"
+        );
     }
 }

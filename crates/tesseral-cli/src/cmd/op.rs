@@ -149,11 +149,15 @@ fn streamed(args: &Args, op: SetOp) -> Result<Option<Result<()>>> {
         crate::outln!("{out}")?;
     } else {
         crate::outln!(
-            "wrote {}: {} voxels, {} leaves, depth {depth}, origin {}",
-            args.output.display(),
-            summary.voxels,
-            summary.leaves,
-            octree::fmt_voxel(origin)
+            "{}",
+            octree::wrote_line(
+                &args.output,
+                summary.voxels,
+                summary.leaves,
+                depth,
+                origin,
+                &a.frame
+            )
         )?;
     }
     Ok(Some(Ok(())))

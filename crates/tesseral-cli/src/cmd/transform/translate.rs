@@ -259,18 +259,16 @@ fn streamed(args: &TranslateArgs) -> Result<bool> {
         });
         crate::outln!("{out}")?;
     } else {
-        let fr = if frame.is_unit() {
-            String::new()
-        } else {
-            format!(", {frame}")
-        };
         crate::outln!(
-            "wrote {}: {} voxels, {} leaves, depth {}, origin {}{fr}",
-            args.output.display(),
-            t.summary.voxels,
-            t.summary.leaves,
-            t.depth,
-            octree::fmt_voxel(t.origin)
+            "{}",
+            octree::wrote_line(
+                &args.output,
+                t.summary.voxels,
+                t.summary.leaves,
+                t.depth,
+                t.origin,
+                &frame
+            )
         )?;
     }
     Ok(true)
