@@ -183,11 +183,6 @@ pub fn strip_bom(bytes: &[u8]) -> &[u8] {
     bytes.strip_prefix(b"\xef\xbb\xbf").unwrap_or(bytes)
 }
 
-/// [`strip_bom`] of text already decoded.
-pub(crate) fn strip_bom_str(text: &str) -> &str {
-    text.strip_prefix('\u{feff}').unwrap_or(text)
-}
-
 /// A text file's bytes after a UTF-8 byte order mark ([`strip_bom`]); a UTF-16 or
 /// UTF-32 one is refused at line 1, column 1, naming the encoding, rather than read
 /// as bytes that fail somewhere further on.

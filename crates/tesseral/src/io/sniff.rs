@@ -22,6 +22,7 @@
 /// ```
 #[must_use]
 pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
+    const PLY: [&[u8]; 2] = [b"ply\n", b"ply\r\n"];
     const MAGIC: &[(&[u8], &str)] = &[
         (b"\x89TESSRL\n", "tess"),
         (b"#binvox", "binvox"),
@@ -31,7 +32,6 @@ pub fn sniff_format(bytes: &[u8]) -> Option<&'static str> {
         (PLY[0], "ply"),
         (PLY[1], "ply"),
     ];
-    const PLY: [&[u8]; 2] = [b"ply\n", b"ply\r\n"];
     for (magic, ext) in MAGIC {
         if bytes.starts_with(magic) {
             return Some(ext);

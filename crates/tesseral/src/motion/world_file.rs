@@ -202,7 +202,7 @@ pub fn read_world_limited(
         source,
     })?;
     // A UTF-8 byte order mark is skipped; columns count after it.
-    let json = crate::io::strip_bom_str(&text);
+    let json = text.strip_prefix('\u{feff}').unwrap_or(&text);
     let spec: WorldSpec = serde_json::from_str(json).map_err(|e| WorldError::Syntax {
         path: path.to_owned(),
         line: e.line(),

@@ -125,7 +125,6 @@ impl Scene {
     /// [`SceneError::Parse`] with the line, column, a caret and a hint.
     pub fn parse(text: &str, path: &Path) -> Result<Scene, SceneError> {
         // A UTF-8 byte order mark is skipped; columns count after it.
-        // (Not `io::strip_bom_str`: `io` reads meshes, which use `csg`.)
         let text = text.strip_prefix('\u{feff}').unwrap_or(text);
         let mut p = Parser::new(text, path)?;
         p.file()
