@@ -12,7 +12,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Arc;
 
-use super::cache::Cache;
+use super::cache::{Cache, Cost};
 use crate::io::tess_colours::{RegionLeaves, RegionPoint};
 use crate::io::{FormatError, TessFile};
 use crate::linear::Leaf;
@@ -191,7 +191,7 @@ impl Colours {
                     // memory: the cache holds what was decoded from them.
                     f.release(0..u64::MAX);
                 }
-                Ok::<_, FormatError>((leaves, n))
+                Ok::<_, FormatError>((leaves, Cost::flat(n)))
             })?;
             let j = block.partition_point(|l| l.code() <= code);
             if j == 0 {

@@ -23,7 +23,7 @@ use std::path::Path;
 use std::sync::atomic::Ordering;
 use std::sync::{Arc, Mutex, PoisonError};
 
-use cache::Cache;
+use cache::{Cache, Cost};
 use colours::Colours;
 use top::{ChunkRef, Top, TopKid};
 
@@ -289,13 +289,16 @@ impl StreamedTree {
             // The chunk's mapped pages leave resident memory: the cache holds
             // what was decoded from them.
             f.release(r.bytes.0..r.bytes.1);
-            let rt = RayTree::from_leaves(self.depth, self.origin, &leaves);
-            // What decoding held at once: the leaves and the nodes (a growing
-            // vector: up to twice their length).
-            let bytes = std::mem::size_of_val(leaves.as_slice()) as u64
-                + 2 * std::mem::size_of_val(rt.nodes.as_slice()) as u64
-                + 256;
-            Ok::<_, FormatError>((rt, bytes))
+            let mut rt = RayTree::from_leaves(self.depth, self.origin, &leaves);
+            // The index keeps its nodes, at their length; decoding held the leaves
+            // and the nodes at once, as a growing vector (up to twice their length).
+            rt.nodes.shrink_to_fit();
+            let nodes = std::mem::size_of_val(rt.nodes.as_slice()) as u64;
+            let cost = Cost {
+                kept: nodes + 256,
+                peak: std::mem::size_of_val(leaves.as_slice()) as u64 + 2 * nodes + 256,
+            };
+            Ok::<_, FormatError>((rt, cost))
         });
         match got {
             Ok(rt) => Some(rt),
