@@ -220,9 +220,9 @@ impl DynamicOctree {
     fn __repr__(slf: &Bound<'_, Self>) -> PyResult<String> {
         let this = borrow(slf, WHAT)?;
         Ok(format!(
-            "DynamicOctree({} voxels, {} faces)",
-            this.tree.voxel_count(),
-            this.faces
+            "DynamicOctree({}, {})",
+            crate::count(this.tree.voxel_count(), "voxel", "voxels"),
+            crate::count(this.faces, "face", "faces")
         ))
     }
 }

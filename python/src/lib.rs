@@ -16,6 +16,13 @@ mod rsmc;
 mod scans;
 mod scene;
 
+/// `n` followed by the noun that agrees with it ("1 voxel", "2 voxels"), for the
+/// classes' `repr`s.
+fn count(n: impl Into<u64>, one: &str, many: &str) -> String {
+    let n = n.into();
+    format!("{n} {}", if n == 1 { one } else { many })
+}
+
 #[pymodule]
 fn _tesseral(m: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = m.py();

@@ -384,9 +384,9 @@ impl Octree {
     fn __repr__(&self) -> String {
         let t = &self.model.tree;
         format!(
-            "Octree({} voxels, {} leaves, depth {}, voxel size {})",
-            t.voxel_count(),
-            t.leaf_count(),
+            "Octree({}, {}, depth {}, voxel size {})",
+            crate::count(t.voxel_count(), "voxel", "voxels"),
+            crate::count(t.leaf_count() as u64, "leaf", "leaves"),
             t.depth(),
             self.model.frame.voxel_size
         )

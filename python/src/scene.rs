@@ -76,8 +76,10 @@ impl Scene {
 
     fn __repr__(&self) -> String {
         format!(
-            "Scene({} objects, depth {}, voxel {})",
-            self.scene.objects, self.scene.depth, self.scene.voxel
+            "Scene({}, depth {}, voxel {})",
+            crate::count(self.scene.objects as u64, "object", "objects"),
+            self.scene.depth,
+            self.scene.voxel
         )
     }
 

@@ -124,3 +124,16 @@ def test_codes_match_bit_interleaving():
     assert np.array_equal(t.calc.decode(t.calc.sub(s, t.calc.encode(d))), c)
     with pytest.raises(ValueError):
         t.calc.encode(np.array([[-1, 0, 0]]))
+
+
+def test_reprs_count_with_the_right_nouns():
+    one = t.Octree.from_voxels(np.array([[0, 0, 0]]))
+    assert repr(one).startswith("Octree(1 voxel, 1 leaf, depth ")
+    two = t.Octree.from_voxels(np.array([[0, 0, 0], [5, 5, 5]]))
+    assert repr(two).startswith("Octree(2 voxels, 2 leaves, depth ")
+    d = t.DynamicOctree()
+    assert repr(d) == "DynamicOctree(0 voxels, 0 faces)"
+    d.insert(np.array([[0, 0, 0]]))
+    assert repr(d) == "DynamicOctree(1 voxel, 6 faces)"
+    s = t.Scene.parse("depth 5\nbounds [0, 0, 0] [32, 32, 32]\nsphere(r = 10) at [16, 16, 16]\n")
+    assert repr(s).startswith("Scene(1 object, depth 5, ")
