@@ -142,20 +142,21 @@ impl Transform {
         at: [0.0; 3],
     };
 
-    /// The rotation by `α, β, γ` degrees about x, then y, then z.
+    /// The rotation by `α, β, γ` degrees about x, then y, then z. A multiple of 90°
+    /// turns exactly (its sine and cosine are 0 and ±1, as OpenSCAD's are), so a
+    /// quarter-turned box's faces stay where they were, not 10⁻¹⁶ off.
     ///
     /// ```
     /// use tesseral::csg::Transform;
     /// let t = Transform::rotation([0.0, 0.0, 90.0]);
+    /// assert_eq!(t.apply([1.0, 0.0, 0.0]), [0.0, 1.0, 0.0]);
+    /// let t = Transform::rotation([0.0, 0.0, 30.0]);
     /// let p = t.apply([1.0, 0.0, 0.0]);
-    /// assert!((p[0]).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12);
+    /// assert!((p[0] - 0.75f64.sqrt()).abs() < 1e-12 && (p[1] - 0.5).abs() < 1e-12);
     /// ```
     #[must_use]
     pub fn rotation(deg: [f64; 3]) -> Self {
-        let [a, b, g] = deg.map(f64::to_radians);
-        let (sa, ca) = a.sin_cos();
-        let (sb, cb) = b.sin_cos();
-        let (sg, cg) = g.sin_cos();
+        let [(sa, ca), (sb, cb), (sg, cg)] = deg.map(crate::linear::sin_cos_degrees);
         let rx = [[1.0, 0.0, 0.0], [0.0, ca, -sa], [0.0, sa, ca]];
         let ry = [[cb, 0.0, sb], [0.0, 1.0, 0.0], [-sb, 0.0, cb]];
         let rz = [[cg, -sg, 0.0], [sg, cg, 0.0], [0.0, 0.0, 1.0]];

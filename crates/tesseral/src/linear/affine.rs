@@ -333,15 +333,13 @@ pub fn affine_space(
     )
 }
 
-/// The matrix of a rotation by `degrees` about the unit vector along `axis`
-/// (Rodrigues), with exact entries for multiples of 90°.
-#[must_use]
-pub fn rotation_matrix(axis: [f64; 3], degrees: f64) -> [[f64; 3]; 3] {
-    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
-    let k = axis.map(|c| c / n);
+/// The sine and cosine of `degrees`, exact (0 and ±1) at multiples of 90°, as
+/// OpenSCAD's are: a quarter turn moves a face onto a face, not 10⁻¹⁶ off it.
+pub(crate) fn sin_cos_degrees(degrees: f64) -> (f64, f64) {
     let turns = degrees / 90.0;
-    let (s, c) = if turns == turns.round() {
-        match (turns as i64).rem_euclid(4) {
+    if turns == turns.round() {
+        // Whole turns and the remainder are exact in floating point, however large.
+        match turns.rem_euclid(4.0) as u8 {
             0 => (0.0, 1.0),
             1 => (1.0, 0.0),
             2 => (0.0, -1.0),
@@ -349,7 +347,16 @@ pub fn rotation_matrix(axis: [f64; 3], degrees: f64) -> [[f64; 3]; 3] {
         }
     } else {
         degrees.to_radians().sin_cos()
-    };
+    }
+}
+
+/// The matrix of a rotation by `degrees` about the unit vector along `axis`
+/// (Rodrigues), with exact entries for multiples of 90°.
+#[must_use]
+pub fn rotation_matrix(axis: [f64; 3], degrees: f64) -> [[f64; 3]; 3] {
+    let n = (axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2]).sqrt();
+    let k = axis.map(|c| c / n);
+    let (s, c) = sin_cos_degrees(degrees);
     let v = 1.0 - c;
     [
         [

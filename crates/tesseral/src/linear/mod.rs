@@ -27,6 +27,7 @@ pub(crate) mod sort;
 mod transform;
 
 pub use crate::code::Axis;
+pub(crate) use affine::sin_cos_degrees;
 pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space};
 pub use box_state::BoxState;
 pub use build::{CellClass, Classifier};
