@@ -197,9 +197,8 @@ fn colours_and_bounding_boxes() {
 /// Boxes whose faces fall on cell faces (sizes in multiples of 4 and whole places,
 /// quarter turns, scales of ½, 1 and 2), alone and combined: the box's own cell test
 /// (`Prim::box_class`, by the centres' bounding box) decides cells the ball cannot,
-/// and must agree with the dense model exactly. (Faces through voxel centres are
-/// left out: there the pruning builder's 4³ masks and the point test round a
-/// quarter turn's 1e-16 differently, before this test and after.)
+/// and must agree with the dense model exactly. (Faces through voxel centres:
+/// `quarter_turned_boxes_with_faces_through_centres_equal_dense`.)
 #[test]
 fn axis_boxes_on_cell_boundaries_equal_dense() {
     let mut rng = Rng(0xb0c5);
