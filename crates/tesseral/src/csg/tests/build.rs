@@ -212,16 +212,7 @@ fn axis_boxes_on_cell_boundaries_equal_dense() {
             .scaled(scale)
             .at(at)
     };
-    for trial in 0..80 {
-        let solid = match trial % 4 {
-            0 => aligned_box(&mut rng),
-            1 => Solid::union(vec![aligned_box(&mut rng), aligned_box(&mut rng)]),
-            2 => Solid::Difference(vec![aligned_box(&mut rng), aligned_box(&mut rng)]),
-            _ => Solid::intersection(vec![aligned_box(&mut rng), aligned_box(&mut rng)]),
-        };
-        let csg = solid.compile().unwrap();
-        check_exact(&csg, 5, [0, 0, 0], &format!("trial {trial}: {solid:?}"));
-    }
+    check_boxes_and_pairs(&mut rng, aligned_box);
 }
 
 /// Boxes whose faces pass through voxel centres (odd sizes at whole places), turned
@@ -238,12 +229,19 @@ fn quarter_turned_boxes_with_faces_through_centres_equal_dense() {
         let turn = [0, 1, 2].map(|_| f64::from((rng.next() % 8) as u32) * 90.0 - 270.0);
         Solid::shape(Shape::cuboid(size)).rotate(turn).at(at)
     };
+    check_boxes_and_pairs(&mut rng, odd_box);
+}
+
+/// 80 trials at depth 5, by turns: a box from `make`, then the union, the difference
+/// and the intersection of two, each built by both builders and checked against the
+/// dense model ([`check_exact`]).
+fn check_boxes_and_pairs(rng: &mut Rng, make: impl Fn(&mut Rng) -> Solid) {
     for trial in 0..80 {
         let solid = match trial % 4 {
-            0 => odd_box(&mut rng),
-            1 => Solid::union(vec![odd_box(&mut rng), odd_box(&mut rng)]),
-            2 => Solid::Difference(vec![odd_box(&mut rng), odd_box(&mut rng)]),
-            _ => Solid::intersection(vec![odd_box(&mut rng), odd_box(&mut rng)]),
+            0 => make(rng),
+            1 => Solid::union(vec![make(rng), make(rng)]),
+            2 => Solid::Difference(vec![make(rng), make(rng)]),
+            _ => Solid::intersection(vec![make(rng), make(rng)]),
         };
         let csg = solid.compile().unwrap();
         check_exact(&csg, 5, [0, 0, 0], &format!("trial {trial}: {solid:?}"));
