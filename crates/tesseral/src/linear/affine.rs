@@ -337,7 +337,9 @@ pub fn affine_space(
 /// OpenSCAD's are: a quarter turn moves a face onto a face, not 10⁻¹⁶ off it.
 pub(crate) fn sin_cos_degrees(degrees: f64) -> (f64, f64) {
     let turns = degrees / 90.0;
-    if turns == turns.round() {
+    // An infinite angle is no quarter turn: its sine and cosine stay NaN, which the
+    // callers refuse as a non-finite transform.
+    if turns.is_finite() && turns == turns.round() {
         // Whole turns and the remainder are exact in floating point, however large.
         match turns.rem_euclid(4.0) as u8 {
             0 => (0.0, 1.0),

@@ -232,6 +232,19 @@ fn quarter_turned_boxes_with_faces_through_centres_equal_dense() {
     check_boxes_and_pairs(&mut rng, odd_box);
 }
 
+/// An infinite angle is refused as a non-finite transform, not taken for a whole
+/// number of quarter turns.
+#[test]
+fn an_infinite_rotation_is_refused() {
+    for deg in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+        let e = Solid::shape(Shape::cuboid([2.0; 3]))
+            .rotate([0.0, deg, 0.0])
+            .compile()
+            .unwrap_err();
+        assert!(e.to_string().contains("finite"), "{deg}: {e}");
+    }
+}
+
 /// 80 trials at depth 5, by turns: a box from `make`, then the union, the difference
 /// and the intersection of two, each built by both builders and checked against the
 /// dense model ([`check_exact`]).
