@@ -97,3 +97,49 @@ fn a_streamed_render_fits_in_a_small_address_space() {
     assert!(!out.status.success());
     assert!(!d.join("m.png").exists());
 }
+
+/// A streamed render's `--memory` is checked before it draws, and held to: too
+/// small a budget for the file is refused with nothing written; a budget just big
+/// enough is not exceeded (the process's peak resident memory, from `wait4`).
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[test]
+fn a_streamed_render_stays_within_its_memory() {
+    use std::process::{Command, Stdio};
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    // 14.5 M leaves: far more decoded chunks than the 16 MiB the cache keeps.
+    // (Without the allocator's thresholds fixed, this render peaked at 40 MB.)
+    build_scene(d, "fig4c-spheroid.tss", "s.tess", 12);
+    let out = run(d, &["render", "s.tess", "-o", "a.png", "--memory", "16M"]);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("rendering s.tess") && err.contains("--memory 16.0 MiB"),
+        "{err}"
+    );
+    assert!(!d.join("a.png").exists());
+    let budget: i64 = 32 << 20;
+    #[expect(clippy::zombie_processes, reason = "reaped by wait4 below")]
+    let child = Command::new(env!("CARGO_BIN_EXE_tesseral"))
+        .current_dir(d)
+        .args(["render", "s.tess", "-o", "b.png", "--size", "320x240"])
+        .args(["--memory", "32M"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: rusage is plain data, filled in by wait4 for this child alone.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: the pid is our child's, not yet waited for; the pointers are live.
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
+    assert!(fs::metadata(d.join("b.png")).unwrap().len() > 1000);
+    // ru_maxrss is in KiB on Linux.
+    let peak = usage.ru_maxrss * 1024;
+    assert!(
+        peak <= budget,
+        "peak resident memory {peak} over --memory 32M"
+    );
+}

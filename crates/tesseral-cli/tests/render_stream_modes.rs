@@ -95,14 +95,15 @@ fn streamed_cuts_and_slices_fit_in_a_small_address_space() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+    // The slice is a picture of 4096 × 4096 pixels: about 156 MiB with the rest.
     for extra in [
-        &["--cut", "x<500"][..],
-        &["--slice", "z=500", "--slice-scale", "1"][..],
-        &["--sheet", "--size", "200x150", "--cut", "y>480"][..],
+        &["--cut", "x<500", "--memory", "64M"][..],
+        &["--slice", "z=500", "--slice-scale", "1", "--memory", "192M"][..],
+        &[
+            "--sheet", "--size", "200x150", "--cut", "y>480", "--memory", "64M",
+        ][..],
     ] {
-        let mut a = vec![
-            "render", "s.tess", "-o", "s.png", "--memory", "64M", "--json",
-        ];
+        let mut a = vec!["render", "s.tess", "-o", "s.png", "--json"];
         a.extend_from_slice(extra);
         let out = run_capped(d, &a, 256);
         assert!(

@@ -225,7 +225,11 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
     if !is_scene && !args.in_memory {
-        if let Some((tree, (unit, lo))) = streamed::open(&args.input, &args.budget)? {
+        let pixels = match (&slice, args.sheet) {
+            (Some(_), _) => u64::MAX,
+            (None, sheet) => (width as u64) * (height as u64) * if sheet { 4 } else { 1 },
+        };
+        if let Some((tree, (unit, lo))) = streamed::open(&args.input, &args.budget, pixels)? {
             let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
             let mode = if let Some((axis, _, c)) = slice {
                 let side = 1usize << tree.depth();
@@ -248,6 +252,7 @@ pub fn run(args: Args) -> Result<()> {
                 }),
                 ..opts
             };
+            streamed::check_memory(&args.input, &tree, &mode, &opts, &args.budget)?;
             if let Some(clip) = opts.clip {
                 let spec = args.cut.as_deref().unwrap_or_default();
                 streamed::note_cut(&tree, clip, spec);

@@ -38,14 +38,95 @@ pub(super) struct Out<'a> {
 /// The world units of the input: (the side of a voxel, the corner of voxel 0).
 type Units = (f64, [f64; 3]);
 
+/// A streamed render's memory besides its cache and its picture: the program, its
+/// threads and the file's index (measured: 7.8 MB for a 5-level file).
+const PROCESS_BYTES: u64 = 12 << 20;
+
+/// The memory a pixel of the picture takes while it is drawn and written (measured:
+/// 5.9 bytes at 2000 × 1500).
+const PIXEL_BYTES: u64 = 8;
+
+/// The cache's bytes a leaf when the whole tree is kept (measured: about 7 for the
+/// depth-12 spheroid, colours included).
+const KEPT_BYTES_PER_LEAF: u64 = 8;
+
+/// Refuses, before any drawing, a streamed render of `tree` in `mode` whose memory
+/// (the program, the cache as far as the tree fills it, the picture) is over
+/// `--memory`. The cache keeps at least 16 MiB when the tree has that much, so a
+/// budget below about 30M is refused for a large file.
+pub(super) fn check_memory(
+    input: &Path,
+    tree: &StreamedTree,
+    mode: &Mode,
+    opts: &RenderOptions,
+    budget: &Budget,
+) -> Result<()> {
+    let pixels = match *mode {
+        Mode::View => (opts.width as u64) * (opts.height as u64),
+        // Four views, two by two, with gaps (render::contact_sheet).
+        Mode::Sheet => (2 * opts.width as u64 + 12) * (2 * opts.height as u64 + 12),
+        Mode::Slice { scale, .. } => ((scale as u64) << tree.depth()).pow(2),
+    };
+    let kept = cache_bytes(budget).min(tree.leaf_count().saturating_mul(KEPT_BYTES_PER_LEAF));
+    let bytes = PROCESS_BYTES
+        .saturating_add(kept)
+        .saturating_add(pixels.saturating_mul(PIXEL_BYTES));
+    budget.check_memory(
+        &format!("rendering {}", input.display()),
+        bytes,
+        " (a streamed render keeps 16 MiB of decoded chunks when the file has that many)",
+    )
+}
+
+/// What glibc's arenas may keep of a rendering thread's freed buffers beyond the
+/// cache (measured: 12 MB for two threads rendering the depth-12 spheroid).
+const ARENA_BYTES_PER_THREAD: u64 = 8 << 20;
+
+/// Makes the allocator give freed blocks over 128 KiB back to the system at once,
+/// when what it would otherwise keep could take a render of `pixels` pixels over
+/// `--memory`.
+///
+/// glibc raises its mmap threshold to the largest block freed (up to 32 MiB), after
+/// which each thread's arena keeps the decoding's freed buffers: 12 MB more resident
+/// memory than the cache in a two-thread render of the depth-12 spheroid (26 MB
+/// against 38 MB at `--memory 32M`). Fixing the thresholds turns that off, for about
+/// a tenth more time under a small cache (munmap and page faults for each decoded
+/// chunk), so it is done only when the budget is tight. Other allocators do not
+/// need it.
+fn return_freed_memory(budget: &Budget, pixels: u64) {
+    let threads = std::thread::available_parallelism().map_or(1, |n| n.get() as u64);
+    let loose = PROCESS_BYTES
+        .saturating_add(cache_bytes(budget))
+        .saturating_add(pixels.saturating_mul(PIXEL_BYTES))
+        .saturating_add(threads.saturating_mul(ARENA_BYTES_PER_THREAD));
+    if loose <= budget.memory {
+        return;
+    }
+    #[cfg(all(target_os = "linux", target_env = "gnu"))]
+    // SAFETY: `mallopt` only sets allocator parameters; glibc allows it at any time.
+    unsafe {
+        libc::mallopt(libc::M_MMAP_THRESHOLD, 128 << 10);
+        libc::mallopt(libc::M_TRIM_THRESHOLD, 128 << 10);
+    }
+}
+
 /// The input opened for a streamed render, with its units, or `None` when it is
 /// not a `.tess` file (either version) or a dataset, or carries layers other than
 /// colours (a version-1 legacy colour list, free space, log-odds: then it is
 /// loaded whole).
-pub(super) fn open(input: &Path, budget: &Budget) -> Result<Option<(StreamedTree, Units)>> {
+///
+/// `pixels` is the picture's size, or `u64::MAX` when it is not known before the
+/// file is opened (a slice): it decides whether the allocator is told to give freed
+/// memory back ([`return_freed_memory`]).
+pub(super) fn open(
+    input: &Path,
+    budget: &Budget,
+    pixels: u64,
+) -> Result<Option<(StreamedTree, Units)>> {
     if output::is_stdio(input) {
         return Ok(None);
     }
+    return_freed_memory(budget, pixels);
     let cache = cache_bytes(budget);
     let units;
     let opened = if tesseral::partition::is_dataset(input) {
@@ -153,6 +234,7 @@ pub(super) fn draw(
             "streamed": true,
             "chunks": s.chunks,
             "chunks_decoded": s.chunks_decoded,
+            "threads": tree.threads(),
             "colour_blocks_decoded": s.colour_blocks_decoded,
             "load_ms": load_ms,
             "render_ms": render_ms,

@@ -26,7 +26,7 @@ pub fn render_streamed(
     surface: Surface<'_>,
     opts: &RenderOptions,
 ) -> Result<Image, FormatError> {
-    let img = match opts.clip {
+    let img = tree.on_threads(|| match opts.clip {
         None => render_cut(tree, surface, opts, None),
         Some(clip) => {
             let kept = Clipped::new(tree, clip);
@@ -37,7 +37,7 @@ pub fn render_streamed(
             };
             render_cut(&kept, surface, opts, Some(cut))
         }
-    };
+    });
     tree.take_error().map_or(Ok(img), Err)
 }
 
@@ -53,7 +53,7 @@ pub fn contact_sheet_streamed(
     views: &[View],
     columns: usize,
 ) -> Result<Image, FormatError> {
-    let img = match opts.clip {
+    let img = tree.on_threads(|| match opts.clip {
         None => sheet_of(tree, None, surface, opts, views, columns),
         Some(clip) => {
             let kept = Clipped::new(tree, clip);
@@ -64,7 +64,7 @@ pub fn contact_sheet_streamed(
             };
             sheet_of(&kept, Some(cut), surface, opts, views, columns)
         }
-    };
+    });
     tree.take_error().map_or(Ok(img), Err)
 }
 
@@ -83,6 +83,6 @@ pub fn section_streamed(
     at: i64,
     pixels: usize,
 ) -> Result<Image, FormatError> {
-    let img = section_of(tree, surface, axis, at, pixels);
+    let img = tree.on_threads(|| section_of(tree, surface, axis, at, pixels));
     tree.take_error().map_or(Ok(img), Err)
 }

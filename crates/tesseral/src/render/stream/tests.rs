@@ -356,3 +356,61 @@ fn a_damaged_chunk_is_named() {
         "{err}"
     );
 }
+
+/// A cache too small for every thread of the pool to hold its chunks: the drawing
+/// runs on fewer threads, the image does not change, and the chunks are decoded
+/// about as often as on that many threads alone.
+#[test]
+fn a_small_cache_draws_on_fewer_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut rng = rand_pcg::Pcg64::seed_from_u64(78);
+    let model = coloured(&mut rng, terrain(64));
+    let path = dir.path().join("m.tess");
+    write_v2(&path, &model, 512);
+    let opts = RenderOptions {
+        width: 96,
+        height: 72,
+        ..Default::default()
+    };
+    let want = in_memory(&model, &opts);
+    let pool = |n| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(n)
+            .build()
+            .unwrap()
+    };
+    // Chunks of 512 leaves: a thread's three at 8,448 bytes each (the estimate),
+    // 25,344 bytes a thread, two thirds of 90,000 (the chunks' three quarters of
+    // the budget) holding two of them.
+    let (tight, decoded) = pool(8).install(|| {
+        let st = StreamedTree::open(&path, 120_000).unwrap();
+        assert!(streamed(&st, &opts) == want);
+        let s = st.stats();
+        (st, s.chunks_decoded)
+    });
+    assert_eq!(tight.threads(), 2);
+    let on_two = pool(2).install(|| {
+        let st = StreamedTree::open(&path, 120_000).unwrap();
+        assert_eq!(st.threads(), 2);
+        assert!(streamed(&st, &opts) == want);
+        st.stats().chunks_decoded
+    });
+    assert!(decoded <= 2 * on_two, "{decoded} decodes against {on_two}");
+    let roomy = pool(8).install(|| StreamedTree::open(&path, 1 << 30).unwrap());
+    assert_eq!(roomy.threads(), 8);
+    assert!(streamed(&roomy, &opts) == want);
+}
+
+#[test]
+fn the_threads_fit_two_thirds_of_the_chunks_budget() {
+    use super::threads_within;
+    // A chunk of 1,000 leaves: 16,256 bytes at its peak, 48,768 a thread.
+    assert_eq!(threads_within(3 * 48_768 / 2, 1_000, 16), 1);
+    assert_eq!(threads_within(3 * 48_768 / 2 * 5, 1_000, 16), 5);
+    assert_eq!(threads_within(3 * 48_768 / 2 * 5, 1_000, 4), 4);
+    // Too small for one thread: still one.
+    assert_eq!(threads_within(1, 1_000, 16), 1);
+    assert_eq!(threads_within(u64::MAX, u64::MAX, 16), 1);
+    assert_eq!(threads_within(u64::MAX, 1_000, 16), 16);
+    assert_eq!(threads_within(1 << 30, 0, 0), 1);
+}
