@@ -7,10 +7,11 @@
 //! `--origin` (the sensor position; the points are world coordinates) or `--pose`
 //! (the points are in the sensor frame, moved by the pose). A PCD's `VIEWPOINT` is
 //! its sensor origin unless either is given. Every file is read and every scan
-//! checked (`--max-cells`; for `.bt` and `.ot`, OctoMap's key range) before any is
-//! cast. Then a file's scans go through
+//! checked (`--max-cells`; for `.bt` and `.ot`, OctoMap's key range; a file's
+//! points against `--memory`) before any is cast. Then a file's scans go through
 //! `tesseral::occupancy::OccupancyMap::insert_scans_each` (each scan cast while the
-//! one before it is applied), with the store's capacity checked after each.
+//! one before it is applied), with the store's capacity and `--memory` (the map
+//! and the scans held) checked after each.
 //!
 //! With `--json` one object is printed with exactly the keys `scans`, `points`,
 //! `rays`, `occupied`, `free`, `leaves`, `bytes`, `seconds` (the insertion time,
@@ -28,7 +29,11 @@ use tesseral::io::scan::{self, Placement, ScanFormat, ScanRecord};
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
 use super::octree::{self, OutArgs};
-use super::output::{human_bytes, plural};
+use super::output::{human_bytes, parse_bytes, plural};
+
+mod checks;
+
+use checks::{check_key_range, check_work, octomap_output};
 
 /// Arguments of `tesseral map`.
 #[derive(clap::Args)]
@@ -84,6 +89,13 @@ pub struct Args {
     /// --max-range, is refused rather than walked for hours.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CELLS, allow_hyphen_values = true)]
     pub max_cells: u64,
+    /// The most memory the map and the scans read for it may take: bytes, or a
+    /// number with K, M, G or T (powers of 1024). A file's scans are refused
+    /// before any is cast when they alone take more; the map is checked after
+    /// each scan (how large it grows is not known before its scans are cast),
+    /// and nothing is written when it is over.
+    #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = parse_bytes)]
+    pub memory: u64,
     /// Print the report as one JSON object.
     #[arg(long)]
     pub json: bool,
@@ -129,7 +141,31 @@ struct Totals {
 
 /// Runs the command.
 pub fn run(args: Args) -> Result<()> {
-    run_holding(args, HELD_POINTS)
+    let by_memory = usize::try_from(args.memory / 4 / POINT_BYTES).unwrap_or(usize::MAX);
+    run_holding(args, HELD_POINTS.min(by_memory))
+}
+
+/// The bytes of a point held between its file's check and its insertion.
+const POINT_BYTES: u64 = std::mem::size_of::<[f64; 3]>() as u64;
+
+/// The bytes of the points of `scans`.
+fn points_bytes(scans: &[ScanRecord]) -> u64 {
+    scans.iter().map(|s| s.points.len() as u64).sum::<u64>() * POINT_BYTES
+}
+
+/// Refuses a map of `map` bytes with `held` bytes of scans read for it, over
+/// `--memory`.
+fn check_memory(map: usize, held: u64, memory: u64) -> Result<()> {
+    let used = (map as u64).saturating_add(held);
+    if used > memory {
+        bail!(
+            "the map ({}) and the scans read for it ({}) take more than --memory {} allows: raise --memory (nothing was written)",
+            human_bytes(map as u64),
+            human_bytes(held),
+            human_bytes(memory)
+        );
+    }
+    Ok(())
 }
 
 /// [`run`], keeping at most `budget` points of the files read before the insertion.
@@ -199,6 +235,15 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
     for (k, path) in args.scans.iter().enumerate() {
         bar.set_message(format!("reading {}", path.display()));
         let scans = read_checked(&map, path, placement, &args, octomap)?;
+        let bytes = points_bytes(&scans);
+        if bytes > args.memory {
+            bail!(
+                "{}: its points take {}, more than --memory {} allows: raise --memory, or split the file",
+                path.display(),
+                human_bytes(bytes),
+                human_bytes(args.memory)
+            );
+        }
         bar.inc_length(scans.len() as u64);
         let points: usize = scans.iter().map(|s| s.points.len()).sum();
         let last = k + 1 == args.scans.len();
@@ -207,11 +252,17 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
             scans
         }));
     }
+    // The bytes of the scans held now: the files kept and the one being inserted.
+    let mut held_bytes: u64 = held.iter().flatten().map(|s| points_bytes(s)).sum();
     for (path, held) in args.scans.iter().zip(held) {
-        let scans = match held {
-            Some(scans) => scans,
-            None => read_checked(&map, path, placement, &args, octomap)?,
+        let (scans, read_again) = match held {
+            Some(scans) => (scans, false),
+            None => (read_checked(&map, path, placement, &args, octomap)?, true),
         };
+        let file_bytes = points_bytes(&scans);
+        if read_again {
+            held_bytes += file_bytes;
+        }
         let at = |i: usize| format!("{}: scan {} of {}", path.display(), i + 1, scans.len());
         bar.set_message(path.display().to_string());
         // Each scan is cast while the one before it is applied (insert_scans).
@@ -224,11 +275,13 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
             t.rays += stats.rays;
             t.skipped += stats.skipped;
             map.check_capacity().with_context(|| at(i))?;
+            check_memory(map.bytes(), held_bytes, args.memory).with_context(|| at(i))?;
             i += 1;
             bar.inc(1);
             anyhow::Ok(())
         })?;
         t.seconds += start.elapsed().as_secs_f64();
+        held_bytes -= file_bytes;
     }
     bar.finish_and_clear();
     if t.points == 0 {
@@ -315,8 +368,9 @@ fn write_map(map: &OccupancyMap, path: &Path, out: &OutArgs) -> Result<()> {
     }
 }
 
-/// The most points that the files read before the insertion keep for it (100 MB),
-/// besides the last file; the rest are read again (see [`run`]).
+/// The most points that the files read before the insertion keep for it (100 MB,
+/// or a quarter of `--memory` when that is less), besides the last file; the rest
+/// are read again (see [`run`]).
 const HELD_POINTS: usize = 1 << 22;
 
 /// A scan file's scans, placed, each checked against `--max-cells` and, when the
@@ -341,148 +395,5 @@ fn read_checked(
     Ok(scans)
 }
 
-/// Whether the map is written as OctoMap's `.bt` or `.ot`, whose keys reach cells
-/// −32768..32767 on each axis.
-fn octomap_output(args: &Args) -> bool {
-    matches!(args.out.format_of(&args.output).as_str(), "bt" | "ot")
-}
-
-/// Refuses, before it is cast, a scan whose rays would reach a cell outside
-/// OctoMap's key range. Every ray lies within `longest` (its length after
-/// `--max-range`) of the sensor, so a box that wide around the sensor inside the
-/// range settles it without moving a point; else each ray's ends are checked (the
-/// sensor, the point cut at `--max-range`: the key range is a box, so the ends
-/// suffice), the points placed in the world.
-fn check_key_range(map: &OccupancyMap, s: &ScanRecord, args: &Args, longest: f64) -> Result<()> {
-    let inside = |p: [f64; 3]| tesseral::io::octomap::in_key_range(map.cell_of(p));
-    let sensor = s.translation;
-    if inside(sensor.map(|c| c - longest)) && inside(sensor.map(|c| c + longest)) {
-        return Ok(());
-    }
-    let points = s.world_points();
-    let end = |p: &[f64; 3]| {
-        let d = [0, 1, 2].map(|a| p[a] - sensor[a]);
-        let len = (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt();
-        match args.max_range {
-            Some(r) if len > r => [0, 1, 2].map(|a| sensor[a] + d[a] * (r / len)),
-            _ => *p,
-        }
-    };
-    let finite = points.iter().filter(|p| p.iter().all(|c| c.is_finite()));
-    if let Some(c) = std::iter::once(sensor)
-        .chain(finite.map(end))
-        .find(|&p| !inside(p))
-        .map(|p| map.cell_of(p))
-    {
-        bail!(
-            "a ray reaches cell ({}, {}, {}), outside OctoMap's key range (cells −32768..32767 on each axis, ±{:?} m at resolution {:?}): write .tess, which keeps the full range, or cut rays with --max-range",
-            c[0],
-            c[1],
-            c[2],
-            32768.0 * args.resolution,
-            args.resolution
-        );
-    }
-    Ok(())
-}
-
-/// A length for people: three decimals from a millimetre to 10,000 km, four
-/// significant digits in scientific notation beyond.
-fn metres(x: f64) -> String {
-    if (1e-3..1e7).contains(&x) {
-        format!("{x:.3}")
-    } else {
-        format!("{x:.3e}")
-    }
-}
-
-/// Refuses a scan whose rays would cross more than `--max-cells` cells, before any
-/// is cast; else gives its longest ray's length (after `--max-range`).
-fn check_work(map: &OccupancyMap, s: &ScanRecord, args: &Args) -> Result<f64> {
-    let work = map.scan_work(s.sensor_in_points_frame(), &s.points, args.max_range);
-    if work.cells > args.max_cells {
-        let hint = if args.max_range.is_some() {
-            "lower --max-range or raise --max-cells"
-        } else {
-            "cut long rays with --max-range M, or raise --max-cells"
-        };
-        let rays = match work.rays {
-            1 => "its ray".to_string(),
-            n => format!("its {n} rays"),
-        };
-        bail!(
-            "{rays} may cross {} cells (the longest is {} m at resolution {:?}), past --max-cells {}: {hint}",
-            work.cells,
-            metres(work.longest),
-            args.resolution,
-            args.max_cells
-        );
-    }
-    Ok(work.longest)
-}
-
 #[cfg(test)]
-mod tests {
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: super::Args,
-    }
-
-    /// Files read again for the insertion (none kept but the last) give the map
-    /// that files kept give, byte for byte; a bad file is refused either way.
-    #[test]
-    fn files_read_again_give_the_same_map() {
-        let dir = tempfile::tempdir().unwrap();
-        let mut files = Vec::new();
-        for k in 0..3 {
-            let path = dir.path().join(format!("c{k}.xyz"));
-            let text: String = (0..400)
-                .map(|i| {
-                    let a = f64::from(i) * 0.37 + f64::from(k);
-                    format!(
-                        "{:.3} {:.3} {:.3}\n",
-                        2.0 * a.cos(),
-                        2.0 * a.sin(),
-                        0.01 * f64::from(i % 50)
-                    )
-                })
-                .collect();
-            std::fs::write(&path, text).unwrap();
-            files.push(path.display().to_string());
-        }
-        let map = |budget: usize, out: &str, files: &[String]| {
-            let out = dir.path().join(out);
-            let mut argv = vec!["map".to_string()];
-            argv.extend(files.iter().cloned());
-            argv.extend(
-                [
-                    "-o",
-                    out.to_str().unwrap(),
-                    "--resolution",
-                    "0.1",
-                    "--origin",
-                    "0,0,1",
-                ]
-                .map(String::from),
-            );
-            super::run_holding(Cli::parse_from(argv).args, budget)
-                .map(|()| std::fs::read(out).unwrap())
-        };
-        let kept = map(usize::MAX, "kept.ot", &files).unwrap();
-        let again = map(0, "again.ot", &files).unwrap();
-        assert!(kept.len() > 1000);
-        assert_eq!(kept, again);
-        let bad = dir.path().join("bad.xyz");
-        std::fs::write(&bad, "1 2 3\n4 5 x\n").unwrap();
-        let mut with_bad = files.clone();
-        with_bad.insert(1, bad.display().to_string());
-        for budget in [0, usize::MAX] {
-            let e = map(budget, "bad.ot", &with_bad).unwrap_err().to_string();
-            assert!(e.contains("bad.xyz:2:5"), "{e}");
-            assert!(!dir.path().join("bad.ot").exists());
-        }
-    }
-}
+mod tests;
