@@ -1,17 +1,7 @@
 # Sourced by the side-by-side benchmark scripts: installs the Debian packages they
-# name (plus g++ and pkg-config to build their C++ harnesses) when missing.
+# name (plus g++ and pkg-config to build their C++ harnesses) when missing, with
+# scripts/debian-install.
 # Usage: . "$(dirname "$0")/../install-peers.sh"; install_peers liboctomap-dev ...
 install_peers() {
-  local need=() pkg
-  for pkg in "$@"; do
-    dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
-  done
-  command -v g++ >/dev/null 2>&1 || need+=(g++)
-  command -v pkg-config >/dev/null 2>&1 || need+=(pkg-config)
-  if [ "${#need[@]}" -gt 0 ]; then
-    local sudo=""
-    [ "$(id -u)" -ne 0 ] && sudo="sudo"
-    $sudo apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq "${need[@]}"
-  fi
+  "$(dirname "${BASH_SOURCE[0]}")/../scripts/debian-install" "$@" g++ pkg-config
 }
