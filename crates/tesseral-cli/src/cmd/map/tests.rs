@@ -8,6 +8,22 @@ struct Cli {
     args: super::Args,
 }
 
+/// 400 points of a helix 2 m around the z axis, turned by `phase` radians, as
+/// `.xyz` text.
+fn helix(phase: f64) -> String {
+    (0..400)
+        .map(|i| {
+            let a = f64::from(i) * 0.37 + phase;
+            format!(
+                "{:.3} {:.3} {:.3}\n",
+                2.0 * a.cos(),
+                2.0 * a.sin(),
+                0.01 * f64::from(i % 50)
+            )
+        })
+        .collect()
+}
+
 /// Files read again for the insertion (none kept but the last) give the map
 /// that files kept give, byte for byte; a bad file is refused either way.
 #[test]
@@ -16,18 +32,7 @@ fn files_read_again_give_the_same_map() {
     let mut files = Vec::new();
     for k in 0..3 {
         let path = dir.path().join(format!("c{k}.xyz"));
-        let text: String = (0..400)
-            .map(|i| {
-                let a = f64::from(i) * 0.37 + f64::from(k);
-                format!(
-                    "{:.3} {:.3} {:.3}\n",
-                    2.0 * a.cos(),
-                    2.0 * a.sin(),
-                    0.01 * f64::from(i % 50)
-                )
-            })
-            .collect();
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(&path, helix(f64::from(k))).unwrap();
         files.push(path.display().to_string());
     }
     let map = |budget: usize, out: &str, files: &[String]| {
@@ -69,19 +74,8 @@ fn files_read_again_give_the_same_map() {
 fn memory_bounds_the_scans_and_the_map() {
     let dir = tempfile::tempdir().unwrap();
     let path = dir.path().join("c.xyz");
-    // 400 points (9,600 bytes held) on a helix 2 m around the sensor.
-    let text: String = (0..400)
-        .map(|i| {
-            let a = f64::from(i) * 0.37;
-            format!(
-                "{:.3} {:.3} {:.3}\n",
-                2.0 * a.cos(),
-                2.0 * a.sin(),
-                0.01 * f64::from(i % 50)
-            )
-        })
-        .collect();
-    std::fs::write(&path, text).unwrap();
+    // 400 points: 9,600 bytes held.
+    std::fs::write(&path, helix(0.0)).unwrap();
     let out = dir.path().join("m.tess");
     let map = |memory: &str| {
         let argv = ["map", path.to_str().unwrap(), "-o", out.to_str().unwrap()]
