@@ -55,6 +55,19 @@ pub fn stream_memory(estimate_leaves: u64, cells: u64, window: usize, colours: u
         .saturating_add(spools)
 }
 
+/// The most work cells built at once, at most [`StreamPlan::default_window`] (two
+/// a thread), whose `memory` fits `--memory`; at least one. A build on many cores
+/// under a tight budget builds fewer cells at once (on fewer threads) rather than
+/// being refused: the depth-12 spheroid at `--memory 96M` needs about 90 MiB on
+/// two threads and 368 MiB on sixteen.
+fn window_within(budget: &Budget, memory: impl Fn(usize) -> u64) -> usize {
+    let mut window = StreamPlan::default_window().max(1);
+    while window > 1 && memory(window) > budget.memory {
+        window -= 1;
+    }
+    window
+}
+
 /// What a streamed build reports.
 pub struct Streamed {
     pub leaves: u64,
@@ -78,8 +91,9 @@ pub fn build_streamed(
     let estimate = scene.estimate_leaves_streamed()?;
     let (csg, plan) = scene.stream_plan(0..u64::MAX)?;
     let colours = scene.colour_csgs()?;
-    let window = StreamPlan::default_window();
-    let memory_estimate = stream_memory(estimate, plan.cell_count(), window, colours.len());
+    let memory = |w| stream_memory(estimate, plan.cell_count(), w, colours.len());
+    let window = window_within(budget, memory);
+    let memory_estimate = memory(window);
     budget.check_memory(&what, memory_estimate, " or lower the depth")?;
     output::check_size(out, file_estimate(estimate, colours.len()), max_output)?;
     // The colour spools' temporary files go next to the output, on its disk.
