@@ -142,30 +142,45 @@ fn cuts_outside_the_solid_keep_all_or_nothing() {
 
 /// A streamed build on many threads under a tight `--memory` builds fewer cells at
 /// once instead of being refused (on 16 threads the depth-11 spheroid's default
-/// window needs about 158 MiB), and writes the same file as on two threads.
+/// window needs about 158 MiB), and writes the same file as on two threads; a
+/// dataset build too.
 #[test]
 fn a_streamed_build_on_many_threads_fits_its_window_to_memory() {
     use std::process::Command;
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     let scene = scenes().join("fig4c-spheroid.tss");
-    let build = |threads: &str, out: &str| {
+    let build = |threads: &str, out: &str, extra: &[&str]| {
         let out = Command::new(env!("CARGO_BIN_EXE_tesseral"))
             .current_dir(d)
             .env("RAYON_NUM_THREADS", threads)
             .args(["build", scene.to_str().unwrap(), "-o", out, "--depth", "11"])
-            .args(["--stream", "--memory", "64M", "--json"])
+            .args(["--memory", "64M"])
+            .args(extra)
             .output()
             .unwrap();
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(out.status.success(), "{threads} threads: {err}");
-        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        out.stdout
+    };
+    let estimate = |json: Vec<u8>| {
+        let v: serde_json::Value = serde_json::from_slice(&json).unwrap();
         v["memory_estimate"].as_u64().unwrap()
     };
-    assert!(build("16", "a.tess") <= 64 << 20);
-    assert!(build("2", "b.tess") <= 64 << 20);
-    assert_eq!(
-        fs::read(d.join("a.tess")).unwrap(),
-        fs::read(d.join("b.tess")).unwrap()
-    );
+    assert!(estimate(build("16", "a.tess", &["--json"])) <= 64 << 20);
+    assert!(estimate(build("2", "b.tess", &["--json"])) <= 64 << 20);
+    let read = |p: &str| fs::read(d.join(p)).unwrap();
+    assert_eq!(read("a.tess"), read("b.tess"));
+    // A dataset build likewise.
+    build("16", "ds16", &["--parts", "3"]);
+    build("2", "ds2", &["--parts", "3"]);
+    for name in [
+        "manifest.json",
+        "part-00000.tess",
+        "part-00001.tess",
+        "part-00002.tess",
+    ] {
+        let (a, b) = (format!("ds16/{name}"), format!("ds2/{name}"));
+        assert_eq!(read(&a), read(&b), "{name}");
+    }
 }

@@ -194,12 +194,9 @@ pub fn build_parts(
     let estimate = scene.estimate_leaves_streamed()?;
     let (_, plan) = scene.stream_plan(0..u64::MAX)?;
     let colours = scene.colour_csgs()?.len();
-    let window = StreamPlan::default_window();
-    budget.check_memory(
-        &what,
-        stream_memory(estimate, plan.cell_count(), window, colours),
-        " or lower the depth",
-    )?;
+    let memory = |w| stream_memory(estimate, plan.cell_count(), w, colours);
+    let window = window_within(budget, memory);
+    budget.check_memory(&what, memory(window), " or lower the depth")?;
     drop(plan);
     // Written into a hidden directory beside DIR and renamed into place at the end
     // (an old dataset there moved aside, then removed); Ctrl-C removes it, and the
