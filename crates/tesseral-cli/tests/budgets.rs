@@ -184,3 +184,44 @@ fn a_streamed_build_on_many_threads_fits_its_window_to_memory() {
         assert_eq!(read(&a), read(&b), "{name}");
     }
 }
+
+/// An in-memory render counts its picture and its tree against `--memory` before
+/// it draws: a picture too big for the budget is refused before the scene is
+/// built, a `.tess` file read whole by its header's leaves, and nothing is written.
+#[test]
+fn an_in_memory_render_counts_its_picture_and_tree() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let tank = scenes().join("tank.tss");
+    let tank = tank.to_str().unwrap();
+    // 12 M pixels: about 96 MB while drawn.
+    let big = ["--size", "4000x3000", "--memory", "64M"];
+    let err = refused(
+        d,
+        &[&["render", tank, "-o", "t.png"][..], &big].concat(),
+        &["rendering"],
+    );
+    assert!(err.contains("more than --memory 64.0 MiB"), "{err}");
+    assert!(!d.join("t.png").exists());
+    common::ok(
+        d,
+        &[
+            "render", tank, "-o", "t.png", "--size", "400x300", "--memory", "64M",
+        ],
+    );
+    // The depth-10 spheroid, 903,334 leaves: about 71 MiB estimated when read
+    // whole (52 MB measured), 19 MB measured when streamed.
+    common::build_scene(d, "fig4c-spheroid.tss", "s.tess", 10);
+    let whole = [
+        "render",
+        "s.tess",
+        "-o",
+        "s.png",
+        "--in-memory",
+        "--memory",
+        "48M",
+    ];
+    refused(d, &whole, &["rendering s.tess", "without --in-memory"]);
+    assert!(!d.join("s.png").exists());
+    common::ok(d, &["render", "s.tess", "-o", "s.png", "--memory", "48M"]);
+}

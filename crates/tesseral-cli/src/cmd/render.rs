@@ -13,6 +13,7 @@ use super::budget::Budget;
 use super::octree;
 use super::output::{self, Size, MAX_SIDE};
 
+mod memory;
 mod streamed;
 
 /// Arguments of `tesseral render`.
@@ -265,6 +266,22 @@ pub fn run(args: Args) -> Result<()> {
             return streamed::draw(&out, &tree, mode, &opts, solid_colour, start);
         }
     }
+    // In memory: the picture and, for a .tess file or a dataset, its leaves from
+    // its header, before anything is built or read; the tree's own leaves after.
+    let hint = if args.in_memory && !is_scene {
+        " (without --in-memory a .tess file or a dataset streams)"
+    } else {
+        ""
+    };
+    let view_pixels = memory::picture_pixels(&opts, args.sheet && slice.is_none());
+    let on_disk = super::streamed::leaves_on_disk(&args.input)?.unwrap_or(0);
+    memory::check_drawing(
+        &args.input,
+        &args.budget,
+        on_disk.saturating_mul(memory::FILE_BYTES_PER_LEAF),
+        if slice.is_some() { 0 } else { view_pixels },
+        hint,
+    )?;
     let mut colors = None;
     // A scene's cut and slice positions are in scene units: (scale, lower corner).
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
@@ -283,6 +300,22 @@ pub fn run(args: Args) -> Result<()> {
         colors = model.colors;
         (model.tree, None, (frame.voxel_size, frame.translate))
     };
+    let scale = match slice {
+        Some(_) => Some(slice_scale(&args, tree.side() as usize)?),
+        None => None,
+    };
+    let per_leaf = if is_scene {
+        memory::SCENE_BYTES_PER_LEAF
+    } else {
+        memory::FILE_BYTES_PER_LEAF
+    };
+    memory::check_drawing(
+        &args.input,
+        &args.budget,
+        (tree.leaf_count() as u64).saturating_mul(per_leaf),
+        scale.map_or(view_pixels, |k| memory::slice_pixels(tree.side(), k)),
+        hint,
+    )?;
     let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
     if let Some((axis, op, c)) = cut {
         // A plane outside the solid keeps all of it or none of it; say which, since
@@ -333,9 +366,8 @@ pub fn run(args: Args) -> Result<()> {
         ..opts
     };
     let start = Instant::now();
-    let image = if let Some((axis, _, c)) = slice {
+    let image = if let (Some((axis, _, c)), Some(scale)) = (slice, scale) {
         let layer = to_voxel(axis, c).floor() as i64;
-        let scale = slice_scale(&args, tree.side() as usize)?;
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)

@@ -64,6 +64,27 @@ pub fn is_version_1(path: &Path) -> Result<bool> {
     Ok(u16::from_le_bytes([head[8], head[9]]) == 1)
 }
 
+/// The leaves of a `.tess` file or a dataset, from its header or manifest without
+/// reading the leaves (a version-1 file: its length, since a leaf takes at least one
+/// byte of it); `None` for other inputs.
+pub fn leaves_on_disk(path: &Path) -> Result<Option<u64>> {
+    if super::output::is_stdio(path) {
+        return Ok(None);
+    }
+    Ok(Some(if tesseral::partition::is_dataset(path) {
+        let m = tesseral::partition::read_manifest(path)?;
+        m.parts.iter().map(|p| p.leaves).sum::<u64>()
+    } else if path.is_file() && tesseral::io::extension(path) == "tess" {
+        if is_version_1(path)? {
+            file_len(path)?
+        } else {
+            TessFile::open(path)?.leaf_count()
+        }
+    } else {
+        return Ok(None);
+    }))
+}
+
 /// Before a version-1 `.tess` file is read whole (the in-memory paths, taken
 /// when it has layers that do not stream or the command cannot stream): its
 /// memory, at most 24 bytes a byte of the file, against `--memory`. Nothing for

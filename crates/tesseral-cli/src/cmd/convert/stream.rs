@@ -182,17 +182,7 @@ pub fn to_xyz(args: &Args, out: &Path) -> Result<bool> {
 /// streamed paths count it).
 pub fn check_in_memory(args: &Args) -> Result<()> {
     let input = &args.input;
-    let leaves = if tesseral::partition::is_dataset(input) {
-        let m = tesseral::partition::read_manifest(input)?;
-        m.parts.iter().map(|p| p.leaves).sum::<u64>()
-    } else if input.is_file() && io::extension(input) == "tess" {
-        if streamed::is_version_1(input)? {
-            // A leaf takes at least one byte of the file.
-            std::fs::metadata(input).map_or(0, |m| m.len())
-        } else {
-            io::TessFile::open(input)?.leaf_count()
-        }
-    } else {
+    let Some(leaves) = streamed::leaves_on_disk(input)? else {
         return Ok(());
     };
     args.budget.check_memory(

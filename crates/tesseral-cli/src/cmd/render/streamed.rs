@@ -11,6 +11,7 @@ use tesseral::render::{self, Clip, RenderOptions, StreamedTree, View};
 
 use super::super::budget::Budget;
 use super::super::output;
+use super::memory::{check_drawing, picture_pixels, slice_pixels, PIXEL_BYTES, PROCESS_BYTES};
 
 /// The decoded chunks and colour blocks kept: a quarter of `--memory`, between
 /// 16 MiB and 1 GiB (the rest of a streamed render is the image and the index).
@@ -38,14 +39,6 @@ pub(super) struct Out<'a> {
 /// The world units of the input: (the side of a voxel, the corner of voxel 0).
 type Units = (f64, [f64; 3]);
 
-/// A streamed render's memory besides its cache and its picture: the program, its
-/// threads and the file's index (measured: 7.8 MB for a 5-level file).
-const PROCESS_BYTES: u64 = 12 << 20;
-
-/// The memory a pixel of the picture takes while it is drawn and written (measured:
-/// 5.9 bytes at 2000 × 1500).
-const PIXEL_BYTES: u64 = 8;
-
 /// The cache's bytes a leaf when the whole tree is kept (measured: about 7 for the
 /// depth-12 spheroid, colours included).
 const KEPT_BYTES_PER_LEAF: u64 = 8;
@@ -62,18 +55,16 @@ pub(super) fn check_memory(
     budget: &Budget,
 ) -> Result<()> {
     let pixels = match *mode {
-        Mode::View => (opts.width as u64) * (opts.height as u64),
-        // Four views, two by two, with gaps (render::contact_sheet).
-        Mode::Sheet => (2 * opts.width as u64 + 12) * (2 * opts.height as u64 + 12),
-        Mode::Slice { scale, .. } => ((scale as u64) << tree.depth()).pow(2),
+        Mode::View => picture_pixels(opts, false),
+        Mode::Sheet => picture_pixels(opts, true),
+        Mode::Slice { scale, .. } => slice_pixels(1 << tree.depth(), scale),
     };
     let kept = cache_bytes(budget).min(tree.leaf_count().saturating_mul(KEPT_BYTES_PER_LEAF));
-    let bytes = PROCESS_BYTES
-        .saturating_add(kept)
-        .saturating_add(pixels.saturating_mul(PIXEL_BYTES));
-    budget.check_memory(
-        &format!("rendering {}", input.display()),
-        bytes,
+    check_drawing(
+        input,
+        budget,
+        kept,
+        pixels,
         " (a streamed render keeps 16 MiB of decoded chunks when the file has that many)",
     )
 }
