@@ -225,10 +225,13 @@ pub fn run(args: Args) -> Result<()> {
     // Load: a scene is built; an octree file is read as it is.
     let start = Instant::now();
     let is_scene = io::extension(&args.input) == "tss";
+    // The picture's pixels (a slice's are known once its tree's side is).
+    let view_pixels = memory::picture_pixels(&opts, args.sheet && slice.is_none());
     if !is_scene && !args.in_memory {
-        let pixels = match (&slice, args.sheet) {
-            (Some(_), _) => u64::MAX,
-            (None, sheet) => (width as u64) * (height as u64) * if sheet { 4 } else { 1 },
+        let pixels = if slice.is_some() {
+            u64::MAX
+        } else {
+            view_pixels
         };
         if let Some((tree, (unit, lo))) = streamed::open(&args.input, &args.budget, pixels)? {
             let to_voxel = |a: usize, c: f64| (c - lo[a]) / unit;
@@ -273,7 +276,6 @@ pub fn run(args: Args) -> Result<()> {
     } else {
         ""
     };
-    let view_pixels = memory::picture_pixels(&opts, args.sheet && slice.is_none());
     let on_disk = super::streamed::leaves_on_disk(&args.input)?.unwrap_or(0);
     memory::check_drawing(
         &args.input,
@@ -290,11 +292,6 @@ pub fn run(args: Args) -> Result<()> {
         let tree = args.budget.build_scene(&args.input, &scene)?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
-        if !args.in_memory {
-            // A version-1 file that cannot stream (a legacy colour list, free space
-            // or log-odds) is decoded whole: its memory is checked first.
-            super::streamed::check_version_1_in_memory(&args.input, &args.budget)?;
-        }
         let model = octree::read(&args.input)?;
         let frame = model.frame;
         colors = model.colors;
