@@ -225,3 +225,27 @@ fn an_in_memory_render_counts_its_picture_and_tree() {
     assert!(!d.join("s.png").exists());
     common::ok(d, &["render", "s.tess", "-o", "s.png", "--memory", "48M"]);
 }
+
+/// An in-memory render of a scene whose estimated leaves, with the picture, are
+/// over `--memory` is refused before the scene is built: the depth-11 spheroid
+/// (3.6 M leaves, about 130 MB drawn; within the 4.4 M leaves that 100M allows a
+/// build alone) is refused with the process's peak far below its build's.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+#[test]
+fn a_scene_over_the_render_budget_is_refused_before_its_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spheroid = fs::read_to_string(scenes().join("fig4c-spheroid.tss")).unwrap();
+    fs::write(d.join("s11.tss"), spheroid.replace("depth 6", "depth 11")).unwrap();
+    let args = ["render", "s11.tss", "-o", "s.png", "--memory", "100M"];
+    let (code, err, peak) = common::run_peak(d, &args);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("rendering s11.tss") && err.contains("--memory 100.0 MiB"),
+        "{err}"
+    );
+    assert!(!d.join("s.png").exists());
+    // The estimate's build, three levels coarser, takes a few MB; the build
+    // itself over 80 MB.
+    assert!(peak < 40 << 20, "peak resident memory {peak}: built first?");
+}

@@ -5,6 +5,8 @@ mod common;
 
 use std::fs;
 
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+use common::run_peak;
 use common::{build_scene, ok, run, run_capped, scenes};
 
 #[test]
@@ -104,7 +106,6 @@ fn a_streamed_render_fits_in_a_small_address_space() {
 #[cfg(all(target_os = "linux", target_env = "gnu"))]
 #[test]
 fn a_streamed_render_stays_within_its_memory() {
-    use std::process::{Command, Stdio};
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
     // 14.5 M leaves: far more decoded chunks than the 16 MiB the cache keeps.
@@ -119,25 +120,10 @@ fn a_streamed_render_stays_within_its_memory() {
     );
     assert!(!d.join("a.png").exists());
     let budget: i64 = 32 << 20;
-    #[expect(clippy::zombie_processes, reason = "reaped by wait4 below")]
-    let child = Command::new(env!("CARGO_BIN_EXE_tesseral"))
-        .current_dir(d)
-        .args(["render", "s.tess", "-o", "b.png", "--size", "320x240"])
-        .args(["--memory", "32M"])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
-    let mut status = 0;
-    // SAFETY: rusage is plain data, filled in by wait4 for this child alone.
-    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
-    // SAFETY: the pid is our child's, not yet waited for; the pointers are live.
-    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
-    assert_eq!(pid, child.id() as i32);
-    assert!(libc::WIFEXITED(status) && libc::WEXITSTATUS(status) == 0);
+    let args = ["render", "s.tess", "-o", "b.png", "--size", "320x240"];
+    let (code, err, peak) = run_peak(d, &[&args[..], &["--memory", "32M"]].concat());
+    assert_eq!(code, Some(0), "{err}");
     assert!(fs::metadata(d.join("b.png")).unwrap().len() > 1000);
-    // ru_maxrss is in KiB on Linux.
-    let peak = usage.ru_maxrss * 1024;
     assert!(
         peak <= budget,
         "peak resident memory {peak} over --memory 32M"

@@ -91,12 +91,28 @@ impl Budget {
     /// # Errors
     /// An error naming the scene and the flag that raises the budget.
     pub fn build_scene(&self, path: &Path, scene: &Scene) -> Result<LinearOctree> {
+        self.build_scene_checked(path, scene, |_| Ok(()))
+    }
+
+    /// [`Budget::build_scene`], with `check` run on the leaf estimate (once it is
+    /// within the leaf cap) before the build: a command whose own memory grows with
+    /// the leaves (`render`) refuses there rather than after the build.
+    ///
+    /// # Errors
+    /// As [`Budget::build_scene`], and `check`'s.
+    pub fn build_scene_checked(
+        &self,
+        path: &Path,
+        scene: &Scene,
+        check: impl FnOnce(u64) -> Result<()>,
+    ) -> Result<LinearOctree> {
         let cap = self.leaf_cap();
         let what = format!("{} at depth {}", path.display(), scene.depth);
         let estimate = scene.estimate_leaves(cap)?;
         if estimate > cap as u64 {
             return Err(self.refuse(&what, estimate));
         }
+        check(estimate)?;
         match scene.build_limited(cap) {
             Ok(tree) => Ok(tree),
             Err(tesseral::csg::SceneError::Build {

@@ -289,7 +289,20 @@ pub fn run(args: Args) -> Result<()> {
     let (tree, csg, (unit, lo)): (LinearOctree, Option<Csg>, (f64, [f64; 3])) = if is_scene {
         let scene = Scene::read(&args.input)?;
         let csg = scene.csg()?;
-        let tree = args.budget.build_scene(&args.input, &scene)?;
+        // The leaves estimated before the build, as they are counted after it.
+        let pixels = match slice {
+            Some(_) => {
+                let side = 1usize << scene.depth;
+                memory::slice_pixels(side as u64, slice_scale(&args, side)?)
+            }
+            None => view_pixels,
+        };
+        let tree = args
+            .budget
+            .build_scene_checked(&args.input, &scene, |leaves| {
+                let tree = leaves.saturating_mul(memory::SCENE_BYTES_PER_LEAF);
+                memory::check_drawing(&args.input, &args.budget, tree, pixels, hint)
+            })?;
         (tree, Some(csg), (scene.voxel, scene.bounds_min))
     } else {
         let model = octree::read(&args.input)?;

@@ -154,3 +154,35 @@ pub fn stdout_of(out: Output, what: &str) -> Vec<u8> {
     );
     out.stdout
 }
+
+/// Runs `tesseral args...` in `dir` (its standard output discarded) and gives its
+/// exit code, its standard error and its peak resident memory in bytes, from
+/// `wait4`.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+pub fn run_peak(dir: &Path, args: &[&str]) -> (Option<i32>, String, i64) {
+    use std::io::Read as _;
+    #[expect(clippy::zombie_processes, reason = "reaped by wait4 below")]
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tesseral"))
+        .current_dir(dir)
+        .args(args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("run tesseral");
+    let mut err = String::new();
+    child
+        .stderr
+        .take()
+        .unwrap()
+        .read_to_string(&mut err)
+        .unwrap();
+    let mut status = 0;
+    // SAFETY: rusage is plain data, filled in by wait4 for this child alone.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: the pid is our child's, not yet waited for; the pointers are live.
+    let pid = unsafe { libc::wait4(child.id() as i32, &mut status, 0, &mut usage) };
+    assert_eq!(pid, child.id() as i32);
+    let code = libc::WIFEXITED(status).then(|| libc::WEXITSTATUS(status));
+    // ru_maxrss is in KiB on Linux.
+    (code, err, usage.ru_maxrss * 1024)
+}
