@@ -1,6 +1,6 @@
 //! Step 2: boundary squares merged greedily into rectangles.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use super::squares::Square;
 
@@ -59,7 +59,7 @@ pub(super) fn rectangles(squares: &[Square], merge: bool) -> Vec<Rect> {
     // Stack identical runs of consecutive rows.
     // (axis, orientation, plane, u0, u1) -> (first row, last row)
     type RunKey = (usize, bool, i64, i64, i64);
-    let mut open: HashMap<RunKey, (i64, i64)> = HashMap::new();
+    let mut open: FxHashMap<RunKey, (i64, i64)> = FxHashMap::default();
     let mut out = Vec::new();
     let emit = |key: RunKey, span: (i64, i64), out: &mut Vec<Rect>| {
         out.push(Rect {

@@ -1,6 +1,6 @@
 //! Step 4: each rectangle, with every vertex on its sides, fanned into triangles.
 
-use std::collections::{HashMap, HashSet};
+use rustc_hash::{FxHashMap, FxHashSet};
 
 use super::rects::rectangles;
 use super::squares::boundary_squares;
@@ -10,20 +10,20 @@ use crate::mesh::TriMesh;
 use crate::Voxel;
 
 /// A mesh with, per vertex, its lattice point and group, and the groups per point.
-pub(super) type Built = (TriMesh, Vec<(Voxel, i8)>, HashMap<Voxel, [i8; 12]>);
+pub(super) type Built = (TriMesh, Vec<(Voxel, i8)>, FxHashMap<Voxel, [i8; 12]>);
 
 pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     let squares = boundary_squares(tree);
     let rects = rectangles(&squares, merge);
     let mut verts = Vertices {
         tree,
-        config: HashMap::new(),
-        groups: HashMap::new(),
-        ids: HashMap::new(),
+        config: FxHashMap::default(),
+        groups: FxHashMap::default(),
+        ids: FxHashMap::default(),
         keys: Vec::new(),
     };
     // Corners first: they are the vertices every side must include.
-    let mut corners: HashSet<Voxel> = HashSet::new();
+    let mut corners: FxHashSet<Voxel> = FxHashSet::default();
     for r in &rects {
         for (pu, pv) in [(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)] {
             let p = point(r, pu, pv);

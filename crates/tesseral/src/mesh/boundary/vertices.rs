@@ -1,7 +1,7 @@
 //! Step 3 applied: the vertices of the mesh, one per lattice point and group,
 //! numbered as they are first met.
 
-use std::collections::HashMap;
+use rustc_hash::FxHashMap;
 
 use super::groups::{group_table, is_pinch_edge, joined_by_black};
 use super::rects::Rect;
@@ -10,9 +10,9 @@ use crate::Voxel;
 
 pub(super) struct Vertices<'t> {
     pub(super) tree: &'t LinearOctree,
-    pub(super) config: HashMap<Voxel, u8>,
-    pub(super) groups: HashMap<Voxel, [i8; 12]>,
-    pub(super) ids: HashMap<(Voxel, i8), u32>,
+    pub(super) config: FxHashMap<Voxel, u8>,
+    pub(super) groups: FxHashMap<Voxel, [i8; 12]>,
+    pub(super) ids: FxHashMap<(Voxel, i8), u32>,
     pub(super) keys: Vec<(Voxel, i8)>,
 }
 
