@@ -249,3 +249,38 @@ fn a_scene_over_the_render_budget_is_refused_before_its_build() {
     // itself over 80 MB.
     assert!(peak < 40 << 20, "peak resident memory {peak}: built first?");
 }
+
+/// `--max-leaves` binds a streamed build (a `.tess` output) and a dataset build
+/// too, though their memory does not grow with the leaves: refused from the
+/// estimate, nothing written.
+#[test]
+fn max_leaves_binds_a_streamed_build() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let sphere = scenes().join("sphere.tss");
+    let sphere = sphere.to_str().unwrap();
+    for out in [&["-o", "s.tess"][..], &["-o", "ds", "--parts", "2"]] {
+        let args = [
+            &["build", sphere, "--depth", "8", "--max-leaves", "1000"][..],
+            out,
+        ]
+        .concat();
+        refused(d, &args, &["more than --max-leaves 1000 allows"]);
+    }
+    assert!(!d.join("s.tess").exists() && !d.join("ds").exists());
+    let v = common::json(
+        d,
+        &[
+            "build",
+            sphere,
+            "-o",
+            "s.tess",
+            "--depth",
+            "4",
+            "--max-leaves",
+            "1000",
+            "--json",
+        ],
+    );
+    assert!(v["leaves"].as_u64().unwrap() <= 1000, "{v}");
+}

@@ -125,11 +125,22 @@ fn streamed_conversions_equal_the_in_memory_ones() {
             let bbox = model.tree.bbox();
             assert_eq!(v["bbox_min"], serde_json::json!(bbox.map(|b| b.0)));
             assert_eq!(v["bbox_max"], serde_json::json!(bbox.map(|b| b.1)));
+            assert_eq!(mem["bbox_min"], v["bbox_min"], "{what}");
+            assert_eq!(mem["bbox_max"], v["bbox_max"], "{what}");
+            assert_eq!(mem["colored_voxels"], v["colored_voxels"], "{what}");
+            // `colors` counts the distinct colours, as `info` and `build` do;
+            // `colored_voxels` the voxels they cover.
             assert_eq!(
                 v["colors"],
+                serde_json::json!(model.colors.as_ref().map(|c| c.region_count())),
+                "{what}"
+            );
+            assert_eq!(
+                v["colored_voxels"],
                 serde_json::json!(model.colors.as_ref().map(|c| c.voxel_count())),
                 "{what}"
             );
+            assert_eq!(v["colors"], mem["colors"], "{what}");
             // Into a .tess (a version-1 file too): the model's own file.
             let v = json(d, &["convert", input, "-o", "t.tess", "--json"]);
             assert_eq!(v["streamed"], true, "{what}");

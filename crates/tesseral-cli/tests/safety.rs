@@ -447,6 +447,8 @@ fn a_closed_pipe_ends_quietly() {
             "--json",
         ],
         &["build", "good.tss", "-o", "g.tess", "--json"],
+        // A .tess file into .xyz streams (it said "writing <stdout>: Broken pipe").
+        &["convert", "g.tess", "-o", "-", "--format", "xyz"],
         &["translate", "a.xyz", "--by", "1,0,0", "-o", "t.xyz"],
         &["plan", "a.xyz", "a.xyz", "--from", "5,0,0", "--to", "9,0,0"],
         &["convert", "a.xyz", "-o", "-", "--format", "xyz"],

@@ -33,9 +33,9 @@ pub struct Args {
     /// part streamed as with --stream.
     #[arg(long, value_name = "K")]
     parts: Option<usize>,
-    /// Build at this depth instead of the scene's: the same space, voxels 2^k times
-    /// smaller or larger.
-    #[arg(long, value_name = "D")]
+    /// Build at this depth (1 to 16) instead of the scene's: the same space, voxels
+    /// 2^k times smaller or larger.
+    #[arg(long, value_name = "D", value_parser = clap::value_parser!(u8).range(1..=16))]
     depth: Option<u8>,
     #[command(flatten)]
     limits: octree::OutArgs,
@@ -85,6 +85,9 @@ pub fn run(args: Args) -> Result<()> {
             "scene": args.scene,
             "output": args.output,
             "depth": tree.depth(),
+            "origin": tree.origin(),
+            "bbox_min": tree.bbox().map(|b| b.0),
+            "bbox_max": tree.bbox().map(|b| b.1),
             "voxel_size": scene.voxel,
             "bounds_min": scene.bounds_min,
             "objects": scene.objects,
@@ -114,6 +117,7 @@ fn run_streamed(args: &Args, scene: &Scene) -> Result<()> {
             "scene": args.scene,
             "output": args.output,
             "depth": scene.depth,
+            "origin": [0, 0, 0],
             "voxel_size": scene.voxel,
             "bounds_min": scene.bounds_min,
             "objects": scene.objects,

@@ -21,7 +21,7 @@ pub struct Args {
     #[arg(long, value_parser = parse_voxel, allow_hyphen_values = true, default_value = "0,0,0")]
     offset: Voxel,
     /// Rotation of B by quarter turns about the origin, applied left to right, such
-    /// as `z90,x180`, or an index 0..24.
+    /// as `z90,x180`, or an index 0 to 23.
     #[arg(long, default_value = "", allow_hyphen_values = true)]
     rotate: Rotation,
     /// Also list the boxes where the two overlap.

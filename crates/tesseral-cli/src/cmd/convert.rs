@@ -130,7 +130,8 @@ pub fn run(mut args: Args) -> Result<()> {
             "bbox_max": bbox.map(|b| b.1),
             "voxel_size": model.frame.voxel_size,
             "translate": model.frame.translate,
-            "colors": model.colors.as_ref().map(|c| c.voxel_count()),
+            "colors": model.colors.as_ref().map(|c| c.region_count()),
+            "colored_voxels": model.colors.as_ref().map(|c| c.voxel_count()),
             "free_voxels": model.free.as_ref().map(|f| f.voxel_count()),
         });
         crate::outln!("{summary}")?;

@@ -168,8 +168,8 @@ pub fn is_stdio(path: &Path) -> bool {
 }
 
 /// Checks an output path before any work: its extension must be one of `formats`
-/// (lower case, no dot), and it must not be, or link to, one of `inputs`. `flag`
-/// names the option in errors (`--output`).
+/// (lower case, no dot), it must not be, or link to, one of `inputs`, and its
+/// folder must exist. `flag` names the option in errors (`--output`).
 ///
 /// # Errors
 /// An error naming the flag and the path.
@@ -203,6 +203,23 @@ pub fn guard(flag: &str, output: &Path, formats: &[&str], inputs: &[&Path]) -> R
                 input.display()
             );
         }
+    }
+    // Checked here, before the work, rather than when the file is made after it.
+    let folder = match output.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !folder.is_dir() {
+        let why = if folder.exists() {
+            "not a folder"
+        } else {
+            "no such folder"
+        };
+        bail!(
+            "{flag} {}: cannot create a file in {}: {why}",
+            output.display(),
+            folder.display()
+        );
     }
     Ok(())
 }

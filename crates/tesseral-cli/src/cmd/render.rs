@@ -134,6 +134,18 @@ fn slice_scale(args: &Args, side: usize) -> Result<usize> {
     Ok(scale)
 }
 
+/// Notes on stderr a `--slice` layer outside the space (`side` voxels from world
+/// coordinate `lo` on its axis, `unit` a voxel), whose picture is blank: a blank
+/// picture alone looks like a failure.
+fn note_slice(spec: &str, layer: i64, side: u64, lo: f64, unit: f64) {
+    if layer < 0 || layer as u64 >= side {
+        let hi = lo + side as f64 * unit;
+        eprintln!(
+            "note: --slice '{spec}' lies outside the space ({lo} to {hi} on that axis); the picture is empty"
+        );
+    }
+}
+
 fn parse_colour(flag: &str, s: &str) -> Result<[u8; 3]> {
     Colour::parse(s)
         .map(|c| c.0)
@@ -238,6 +250,14 @@ pub fn run(args: Args) -> Result<()> {
             let mode = if let Some((axis, _, c)) = slice {
                 let side = 1usize << tree.depth();
                 let scale = slice_scale(&args, side)?;
+                let spec = args.slice.as_deref().unwrap_or_default();
+                note_slice(
+                    spec,
+                    to_voxel(axis, c).floor() as i64,
+                    side as u64,
+                    lo[axis],
+                    unit,
+                );
                 streamed::Mode::Slice {
                     axis,
                     at: to_voxel(axis, c).floor() as i64,
@@ -378,6 +398,8 @@ pub fn run(args: Args) -> Result<()> {
     let start = Instant::now();
     let image = if let (Some((axis, _, c)), Some(scale)) = (slice, scale) {
         let layer = to_voxel(axis, c).floor() as i64;
+        let spec = args.slice.as_deref().unwrap_or_default();
+        note_slice(spec, layer, tree.side(), lo[axis], unit);
         render::section(&tree, surface, axis, layer, scale)
     } else if args.sheet {
         render::contact_sheet(&tree, surface, &opts, &View::ALL, 2)

@@ -54,6 +54,19 @@ pub struct RotateArgs {
 }
 
 pub fn rotate(args: RotateArgs) -> Result<()> {
+    // clap lets `requires = "degrees"` pass when --turns, which conflicts with
+    // --degrees, is given.
+    if args.degrees.is_none() {
+        if let Some(flag) = [
+            (args.about.is_some(), "--about"),
+            (args.roundtrip, "--roundtrip"),
+        ]
+        .into_iter()
+        .find_map(|(given, flag)| given.then_some(flag))
+        {
+            anyhow::bail!("{flag} applies only with --degrees, not with --turns");
+        }
+    }
     octree::guard(&args.output, &[&args.input], &args.limits)?;
     let model = octree::read(&args.input)?;
     if let Some(degrees) = args.degrees {

@@ -120,8 +120,16 @@ pub fn read_model_with(path: &Path, options: &ReadOptions) -> Result<Model, Form
         "vox" => vox::read(path),
         "bt" | "ot" => octomap::read(path),
         "stl" | "obj" | "ply" => mesh::read_voxelized(path, &options.mesh),
-        _ => Err(FormatError::UnknownFormat {
-            known: KNOWN_EXTENSIONS,
+        // A name with no known extension: say first when there is no such file, or
+        // a folder, rather than that the format is unknown.
+        _ => Err(match std::fs::metadata(path) {
+            Err(e) => FormatError::io(e),
+            Ok(m) if m.is_dir() => FormatError::unsupported(
+                "a folder, not an octree file (a dataset's folder holds a manifest.json)",
+            ),
+            Ok(_) => FormatError::UnknownFormat {
+                known: KNOWN_EXTENSIONS,
+            },
         }),
     }
     .map_err(|e| e.with_path(path))

@@ -17,7 +17,30 @@ pub fn read(path: &Path) -> Result<LinearOctree, FormatError> {
     let attach = |e: FormatError| e.with_path(path);
     let file = std::fs::File::open(path).map_err(|e| attach(FormatError::Io(e)))?;
     let voxels = parse(io::BufReader::new(file)).map_err(attach)?;
-    LinearOctree::from_voxels_fitted(&voxels).map_err(|e| attach(FormatError::Octree(e)))
+    LinearOctree::from_voxels_fitted(&voxels).map_err(|e| {
+        attach(match (e, widest_span(&voxels)) {
+            (crate::linear::OctreeError::DepthTooLarge(_), Some((axis, lo, hi))) => {
+                FormatError::unsupported(format!(
+                    "the voxels span {lo} to {hi} in {}, more than the {} voxels a side that a tree holds",
+                    ["x", "y", "z"][axis],
+                    1u64 << crate::linear::MAX_DEPTH
+                ))
+            }
+            (e, _) => FormatError::Octree(e),
+        })
+    })
+}
+
+/// The axis on which `voxels` span the most, with their lowest and highest
+/// coordinates on it.
+fn widest_span(voxels: &[Voxel]) -> Option<(usize, i64, i64)> {
+    (0..3)
+        .filter_map(|a| {
+            let lo = voxels.iter().map(|v| v[a]).min()?;
+            let hi = voxels.iter().map(|v| v[a]).max()?;
+            Some((a, lo, hi))
+        })
+        .max_by_key(|&(_, lo, hi)| hi.abs_diff(lo))
 }
 
 /// The most voxels an `.xyz` file may list (24 bytes each in memory, 800 MB at the

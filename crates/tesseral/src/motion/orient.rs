@@ -44,7 +44,7 @@ pub enum RotationError {
     #[error("bad rotation {0:?}: expected parts like x90, y-90, z180 separated by commas")]
     Syntax(String),
     /// An index outside `0..24`.
-    #[error("rotation index {0} is outside 0..24")]
+    #[error("rotation index {0} is outside 0 to 23")]
     Index(usize),
 }
 

@@ -68,6 +68,25 @@ fn window_within(budget: &Budget, memory: impl Fn(usize) -> u64) -> usize {
     window
 }
 
+/// Refuses a streamed build of `leaves` leaves (estimated, or counted once built)
+/// over `--max-leaves`, when given: a stream's memory does not grow with its leaves,
+/// so only the flag bounds them.
+fn check_max_leaves(budget: &Budget, what: &str, leaves: u64, counted: bool) -> Result<()> {
+    match budget.max_leaves {
+        Some(max) if leaves > max as u64 => {
+            let (about, after) = if counted {
+                ("", " (nothing was written)")
+            } else {
+                ("about ", "")
+            };
+            anyhow::bail!(
+                "{what}: the octree would have {about}{leaves} leaves, more than --max-leaves {max} allows{after}; raise --max-leaves or lower the depth"
+            )
+        }
+        _ => Ok(()),
+    }
+}
+
 /// What a streamed build reports.
 pub struct Streamed {
     pub leaves: u64,
@@ -89,6 +108,7 @@ pub fn build_streamed(
 ) -> Result<Streamed> {
     let what = format!("{} at depth {}", path.display(), scene.depth);
     let estimate = scene.estimate_leaves_streamed()?;
+    check_max_leaves(budget, &what, estimate, false)?;
     let (csg, plan) = scene.stream_plan(0..u64::MAX)?;
     let colours = scene.colour_csgs()?;
     let memory = |w| stream_memory(estimate, plan.cell_count(), w, colours.len());
@@ -119,11 +139,17 @@ pub fn build_streamed(
                 }
             },
         )?;
+        // The estimate can be low: the leaves counted are checked before the
+        // file is committed (an error here leaves no file).
+        if check_max_leaves(budget, &what, summary.leaves, true).is_err() {
+            return Err(std::io::Error::other("over --max-leaves"));
+        }
         Ok(())
     });
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
+    check_max_leaves(budget, &what, summary.leaves, true)?;
     written.with_context(|| format!("writing {}", out.display()))?;
     Ok(Streamed {
         leaves: summary.leaves,
@@ -192,6 +218,7 @@ pub fn build_parts(
         }
     }
     let estimate = scene.estimate_leaves_streamed()?;
+    check_max_leaves(budget, &what, estimate, false)?;
     let (_, plan) = scene.stream_plan(0..u64::MAX)?;
     let colours = scene.colour_csgs()?.len();
     let memory = |w| stream_memory(estimate, plan.cell_count(), w, colours);
@@ -226,6 +253,8 @@ pub fn build_parts(
         b.finish_and_clear();
     }
     let parts = built?;
+    let leaves = parts.iter().map(|p| p.leaves).sum();
+    check_max_leaves(budget, &what, leaves, true)?;
     staged.commit(dir)?;
     Ok(parts)
 }

@@ -37,6 +37,19 @@ fn colour_count(op: &Operand) -> Result<usize> {
     Ok(seen.len())
 }
 
+/// The voxels of the input's colour regions.
+fn colour_voxels(op: &Operand) -> Result<u64> {
+    let mut n = 0u64;
+    for f in &op.files {
+        for (_, region) in f.colour_leaves()?.unwrap_or_default() {
+            for l in region {
+                n += l?.voxel_count();
+            }
+        }
+    }
+    Ok(n)
+}
+
 /// Opens the input for streaming when it is a `.tess` file or a dataset whose
 /// only layer is colours, after checking the streamed memory against `--memory`;
 /// `None` (read it in memory) otherwise.
@@ -91,6 +104,10 @@ pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
     .map_err(|e| anyhow::anyhow!("writing {}: {e}", out.display()))?;
     if args.json {
         let (depth, origin) = op.space();
+        // The report's bounding box and coloured voxels: one more pass over the
+        // input, only when asked.
+        let facts = tesseral::partition::leaf_facts(&op.files)?;
+        let colours = summary.colours;
         let summary = serde_json::json!({
             "input": args.input,
             "output": out,
@@ -98,8 +115,12 @@ pub fn to_tess(args: &Args, out: &Path) -> Result<bool> {
             "leaves": summary.leaves,
             "depth": depth,
             "origin": origin,
+            "bbox_min": facts.bbox.map(|b| b.0),
+            "bbox_max": facts.bbox.map(|b| b.1),
             "voxel_size": op.frame.voxel_size,
             "translate": op.frame.translate,
+            "colors": (colours > 0).then_some(colours),
+            "colored_voxels": if colours > 0 { Some(colour_voxels(&op)?) } else { None },
             "streamed": true,
         });
         crate::outln!("{summary}")?;
@@ -126,7 +147,7 @@ pub fn to_xyz(args: &Args, out: &Path) -> Result<bool> {
         |w: &mut dyn std::io::Write| tesseral::partition::write_xyz(&op.files, facts.voxels, w);
     if output::is_stdio(out) {
         let mut w = std::io::BufWriter::new(std::io::stdout().lock());
-        write(&mut w).map_err(|e| anyhow::anyhow!("writing <stdout>: {e}"))?;
+        write(&mut w).map_err(|e| anyhow::Error::new(e).context("writing <stdout>"))?;
         std::io::Write::flush(&mut w)?;
         return Ok(true);
     }
@@ -148,14 +169,6 @@ pub fn to_xyz(args: &Args, out: &Path) -> Result<bool> {
     }
     written.map_err(|e| anyhow::anyhow!("{e}"))?;
     if args.json {
-        let mut colour_voxels = 0u64;
-        for f in &op.files {
-            for (_, region) in f.colour_leaves()?.unwrap_or_default() {
-                for l in region {
-                    colour_voxels += l?.voxel_count();
-                }
-            }
-        }
         let (depth, origin) = op.space();
         let summary = serde_json::json!({
             "input": args.input,
@@ -168,7 +181,8 @@ pub fn to_xyz(args: &Args, out: &Path) -> Result<bool> {
             "bbox_max": facts.bbox.map(|b| b.1),
             "voxel_size": op.frame.voxel_size,
             "translate": op.frame.translate,
-            "colors": (colours > 0).then_some(colour_voxels),
+            "colors": (colours > 0).then_some(colours),
+            "colored_voxels": if colours > 0 { Some(colour_voxels(&op)?) } else { None },
             "free_voxels": null,
             "streamed": true,
         });

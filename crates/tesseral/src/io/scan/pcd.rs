@@ -316,6 +316,16 @@ fn header(bytes: &[u8]) -> Result<Header, FormatError> {
             .position(|f| f.name == *axis)
             .ok_or_else(|| syntax(names.line, names.end, format!("`FIELDS` lacks `{axis}`")))?;
     }
+    if let (Some((p, (line, col))), Some((w, _)), Some((h, _))) = (points, width, height) {
+        // PCL refuses this too: which count would be the points?
+        if w.checked_mul(h) != Some(p) {
+            return Err(syntax(
+                line,
+                col,
+                format!("`POINTS` {p} disagrees with `WIDTH` × `HEIGHT` = {w} × {h}"),
+            ));
+        }
+    }
     let (declared, count_at) = match (points, width, height) {
         (Some(p), _, _) => p,
         (None, Some((w, at)), Some((h, _))) => (w.saturating_mul(h), at),

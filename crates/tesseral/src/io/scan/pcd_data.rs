@@ -79,6 +79,17 @@ pub(super) fn ascii(bytes: &[u8], h: &Header) -> Result<Vec<[f64; 3]>, FormatErr
         }
         out.push(p);
     }
+    // Past the declared points, only blank lines: more points mean a wrong count.
+    if let Some((k, _)) = lines.find(|(_, raw)| raw.iter().any(|b| !b.is_ascii_whitespace())) {
+        return Err(syntax(
+            h.body_line + k,
+            1,
+            format!(
+                "more points than the {declared} the header declares (the count is on line {})",
+                h.count_at.0
+            ),
+        ));
+    }
     Ok(out)
 }
 

@@ -347,3 +347,21 @@ fn text_numbers_out_of_range_or_of_the_wrong_kind_are_errors() {
     assert!(cloud::parse_ply(ply("uchar", "255").as_bytes()).is_ok());
     assert!(cloud::parse_ply(ply("double", "nan").as_bytes()).is_ok());
 }
+
+#[test]
+fn pcd_counts_that_disagree_are_refused() {
+    // POINTS 2 against WIDTH 3 × HEIGHT 1: the POINTS line (10), its number.
+    let h = xyz_header(3, "ascii").replace("POINTS 3", "POINTS 2");
+    let (l, c, m) = syntax_at(pcd::parse((h + "1 2 3\n4 5 6\n7 8 9\n").as_bytes()));
+    assert_eq!((l, c), (10, 8), "{m}");
+    assert!(m.contains("`WIDTH` × `HEIGHT` = 3 × 1"), "{m}");
+    // Three points for a declared two: the third's line (15) named; blank lines
+    // after the last point are fine.
+    let (l, _, m) = syntax_at(pcd::parse(
+        (xyz_header(2, "ascii") + "1 2 3\n4 5 6\n\n7 8 9\n").as_bytes(),
+    ));
+    assert_eq!(l, 15, "{m}");
+    assert!(m.contains("more points than the 2"), "{m}");
+    let s = pcd::parse((xyz_header(2, "ascii") + "1 2 3\n4 5 6\n\n \n").as_bytes()).unwrap();
+    assert_eq!(s.points.len(), 2);
+}
