@@ -15,6 +15,9 @@ pub(super) type Built = (TriMesh, Vec<(Voxel, i8)>, FxHashMap<Voxel, [i8; 12]>);
 pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     let squares = boundary_squares(tree);
     let rects = rectangles(&squares, merge);
+    // The squares are larger than the rectangles they became: freed before the
+    // vertices' maps grow.
+    drop(squares);
     let mut verts = Vertices {
         tree,
         config: FxHashMap::default(),
@@ -88,9 +91,12 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
             }
         }
     }
-    let shared = verts.keys.len() as u32;
-    let mut positions: Vec<[f64; 3]> = verts
-        .keys
+    // Only the keys and groups are given back: the rest goes before the positions
+    // are made.
+    drop(corners);
+    let Vertices { keys, groups, .. } = verts;
+    let shared = keys.len() as u32;
+    let mut positions: Vec<[f64; 3]> = keys
         .iter()
         .map(|(p, _)| p.map(|x| x as f64))
         .collect();
@@ -108,7 +114,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
             triangles,
             colors: Vec::new(),
         },
-        verts.keys,
-        verts.groups,
+        keys,
+        groups,
     )
 }
