@@ -109,11 +109,41 @@ fn asarray<'py>(
     Ok((arr, dtype, kind))
 }
 
+/// 2**63: the first float past int64.
+const PAST_I64: f64 = 9_223_372_036_854_775_808.0;
+
 /// A float that is a whole number within int64, as one.
 fn whole_i64(x: f64) -> Option<i64> {
-    // 2**63: the first float past int64.
-    const PAST: f64 = 9_223_372_036_854_775_808.0;
-    (x.fract() == 0.0 && (-PAST..PAST).contains(&x)).then_some(x as i64)
+    (x.fract() == 0.0 && (-PAST_I64..PAST_I64).contains(&x)).then_some(x as i64)
+}
+
+/// Checks that point `p`, row `row` of argument `name`, lies in a cell: `lattice` is
+/// its position in cells (fractional), whose floors must be within int64 (a cast
+/// would saturate, or make NaN cell 0). The error names the row, the point and the
+/// coordinate; `unit` is what a cell is called ("voxel", "cell").
+pub fn check_cell(
+    name: &str,
+    unit: &str,
+    row: usize,
+    p: [f64; 3],
+    lattice: [f64; 3],
+) -> Result<(), String> {
+    for (a, (&x, &c)) in ["x", "y", "z"].iter().zip(p.iter().zip(&lattice)) {
+        if !x.is_finite() {
+            return Err(format!(
+                "{name}: row {row} is {p:?}, whose {a} is {x:?} (every coordinate must \
+                 be a finite number)"
+            ));
+        }
+        if !(-PAST_I64..PAST_I64).contains(&c) {
+            return Err(format!(
+                "{name}: row {row} is {p:?}, whose {a} = {x:?} lies in {unit} {:?}, \
+                 past the range of int64 (-2**63 to 2**63 - 1)",
+                c.floor()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `obj` as a numpy array of numbers, N×3 (a zero-length sequence is 0×3), and its

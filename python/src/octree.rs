@@ -9,7 +9,7 @@ use pyo3::types::{PyBytes, PyDict};
 use tesseral::linear::{Axis, LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
 
-use crate::arrays::{cells, points, to_array};
+use crate::arrays::{cells, check_cell, points, to_array};
 use crate::errors;
 
 /// A voxel as Python sees it.
@@ -65,7 +65,9 @@ impl Octree {
     }
 
     /// The voxels of size `voxel_size` holding the points of an N×3 array of numbers
-    /// (world units; voxel i spans [i·h, (i+1)·h)).
+    /// (world units; voxel i spans [i·h, (i+1)·h)). A point with a coordinate NaN or
+    /// infinite, or in a voxel past the range of int64, is refused (OctreeError
+    /// naming its row), not clamped.
     #[staticmethod]
     fn from_points(py: Python<'_>, points: &Bound<'_, PyAny>, voxel_size: f64) -> PyResult<Octree> {
         if !(voxel_size.is_finite() && voxel_size > 0.0) {
@@ -77,11 +79,9 @@ impl Octree {
         let frame = Frame::new(voxel_size, [0.0; 3]);
         let tree = py.allow_threads(|| {
             let mut v = Vec::with_capacity(p.len());
-            for q in &p {
-                if !q.iter().all(|c| c.is_finite()) {
-                    return Err(format!("point {q:?} is not finite"));
-                }
-                v.push(frame.voxel_of_point(*q));
+            for (i, &q) in p.iter().enumerate() {
+                check_cell("points", "voxel", i, q, frame.to_lattice(q))?;
+                v.push(frame.voxel_of_point(q));
             }
             LinearOctree::from_voxels_fitted(&v).map_err(|e| e.to_string())
         });

@@ -1,0 +1,68 @@
+"""Arguments the bindings refuse rather than misread, and how they say so: points in
+no cell of the lattice, render's angles and colours, paths, masks, depths, plans."""
+
+import numpy as np
+import pytest
+
+import tesseral as t
+
+# 2**63: the first float past int64.
+PAST_I64 = 2.0**63
+
+
+@pytest.mark.parametrize(
+    "x, said",
+    [
+        (1e30, r"points: row 1 is \[1e30, 0.2, 0.3\], whose x = 1e30 lies in voxel 1e30, "
+               r"past the range of int64"),
+        (9.3e18, r"whose x = 9.3e18 lies in voxel 9.3e18, past the range of int64"),
+        (-PAST_I64 * 2, r"whose x = -1.8446744073709552e19 lies in voxel"),
+        (np.nan, r"row 1 is \[NaN, 0.2, 0.3\], whose x is NaN"),
+        (np.inf, r"whose x is inf"),
+    ],
+)
+def test_from_points_refuses_points_in_no_voxel(x, said):
+    points = np.array([[0.1, 0.2, 0.3], [x, 0.2, 0.3]])
+    with pytest.raises(t.OctreeError, match=said):
+        t.Octree.from_points(points, 1.0)
+    # The same through the voxel size: a fine voxel puts a far point past int64.
+    said = r"points: row 0 is \[0.0, 0.0, 10000000000.0\], whose z .* voxel 1e20"
+    with pytest.raises(t.OctreeError, match=said):
+        t.Octree.from_points([[0.0, 0.0, 1e10]], 1e-10)
+
+
+def test_from_points_keeps_points_within_int64():
+    # The largest floats below 2**63 and from -2**63 have voxels: exactly themselves.
+    big = float(np.nextafter(PAST_I64, 0))
+    assert t.Octree.from_points([[big, 0, 0]], 1.0).voxels().tolist() == [[int(big), 0, 0]]
+    low = t.Octree.from_points([[-PAST_I64, 0, 0]], 1.0).voxels().tolist()
+    assert low == [[-(2**63), 0, 0]]
+
+
+@pytest.mark.parametrize(
+    "x, said",
+    [
+        (np.nan, r"points: row 1 is \[NaN, 0.0, 0.0\], whose x is NaN"),
+        (np.inf, r"points: row 1 is \[inf, 0.0, 0.0\], whose x is inf"),
+        (-np.inf, r"whose x is -inf"),
+        (1e30, r"points: row 1 is \[1e30, 0.0, 0.0\], whose x = 1e30 lies in cell 1e31"),
+    ],
+)
+def test_cells_of_refuses_points_in_no_cell(x, said):
+    m = t.OccupancyMap(0.1)
+    with pytest.raises(ValueError, match=said):
+        m.cells_of(np.array([[0.0, 0.0, 0.0], [x, 0.0, 0.0]]))
+    with pytest.raises(ValueError, match=r"row 0 .* whose y"):
+        m.cells_of([[0.0, x, 0.0]])
+
+
+def test_cells_of_keeps_far_points_within_int64():
+    m = t.OccupancyMap(1.0)
+    big = float(np.nextafter(PAST_I64, 0))
+    assert m.cells_of([[big, -PAST_I64, 0.5]]).tolist() == [[int(big), -(2**63), 0]]
+
+
+def test_insert_scan_still_skips_and_counts_points_in_no_cell():
+    m = t.OccupancyMap(0.1)
+    s = m.insert_scan((0, 0, 0), [[np.nan, 0, 0], [np.inf, 0, 0], [1e30, 0, 0], [0.5, 0, 0]])
+    assert (s["points"], s["skipped"], s["rays"]) == (4, 3, 1)
