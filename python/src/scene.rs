@@ -212,10 +212,42 @@ pub fn png<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyBytes>> {
     Ok(PyBytes::new(py, &buf))
 }
 
+/// The camera's numbers checked as the CLI checks `--azimuth`, `--elevation`,
+/// `--zoom` and `--fov`, each error naming its argument: NaN, an infinity or a
+/// field of view of 0 or 180 degrees would draw a blank or a wrong picture.
+fn check_camera(
+    azimuth: Option<f64>,
+    elevation: Option<f64>,
+    zoom: f64,
+    perspective: Option<f64>,
+) -> PyResult<()> {
+    let refuse = |why: String| Err(PyValueError::new_err(why));
+    for (name, value) in [("azimuth", azimuth), ("elevation", elevation)] {
+        if let Some(v) = value.filter(|v| !v.is_finite()) {
+            return refuse(format!("{name} {v}: must be a finite number of degrees"));
+        }
+    }
+    if let Some(e) = elevation.filter(|e| e.abs() > 90.0) {
+        return refuse(format!(
+            "elevation {e}: must lie between -90 and 90 degrees"
+        ));
+    }
+    if !(zoom.is_finite() && zoom > 0.0) {
+        return refuse(format!("zoom {zoom}: must be a positive finite number"));
+    }
+    if let Some(f) = perspective.filter(|f| !(*f > 0.0 && *f < 180.0)) {
+        return refuse(format!(
+            "perspective {f}: the field of view must lie between 0 and 180 degrees"
+        ));
+    }
+    Ok(())
+}
+
 /// Renders an Octree, a Scene or an OccupancyMap (its `to_octree()`) as an H×W×3
 /// uint8 array. Keyword arguments are the CLI's options: size=(w, h), view ('iso',
-/// 'front', 'top', 'side'), azimuth, elevation, zoom, outline, shadows, perspective
-/// (field of view in degrees), background (r, g, b).
+/// 'front', 'top', 'side'), azimuth, elevation (-90 to 90), zoom (positive),
+/// outline, shadows, perspective (field of view in degrees, between 0 and 180),
+/// background (r, g, b). A NaN or infinite angle or zoom raises ValueError naming it.
 #[pyfunction]
 #[pyo3(signature = (obj, size = (800, 600), view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = (255, 255, 255)),
        text_signature = "(obj, size=(800, 600), view='iso', azimuth=None, elevation=None, zoom=1.0, outline=False, shadows=True, perspective=None, background=(255, 255, 255))")]
@@ -251,12 +283,7 @@ pub fn render<'py>(
             "size {size:?}: each side must be 16 to 8192 pixels"
         )));
     }
-    let finite = |x: Option<f64>| x.is_none_or(f64::is_finite);
-    if !(finite(azimuth) && finite(elevation) && zoom.is_finite() && zoom > 0.0) {
-        return Err(PyValueError::new_err(
-            "azimuth, elevation and zoom must be finite (zoom positive)",
-        ));
-    }
+    check_camera(azimuth, elevation, zoom, perspective)?;
     let o = Options {
         size,
         view,

@@ -66,3 +66,37 @@ def test_insert_scan_still_skips_and_counts_points_in_no_cell():
     m = t.OccupancyMap(0.1)
     s = m.insert_scan((0, 0, 0), [[np.nan, 0, 0], [np.inf, 0, 0], [1e30, 0, 0], [0.5, 0, 0]])
     assert (s["points"], s["skipped"], s["rays"]) == (4, 3, 1)
+
+
+@pytest.fixture(scope="module")
+def dot():
+    return t.Octree.from_voxels([[0, 0, 0]])
+
+
+@pytest.mark.parametrize(
+    "kwargs, said",
+    [
+        ({"perspective": float("nan")}, "perspective NaN: the field of view must lie between 0 "
+                                        "and 180 degrees"),
+        ({"perspective": 0}, "perspective 0: the field of view must lie between 0 and 180"),
+        ({"perspective": 180}, "perspective 180: "),
+        ({"perspective": 200}, "perspective 200: "),
+        ({"perspective": -40}, "perspective -40: "),
+        ({"perspective": float("inf")}, "perspective inf: "),
+        ({"azimuth": float("nan")}, "azimuth NaN: must be a finite number of degrees"),
+        ({"azimuth": float("-inf")}, "azimuth -inf: must be a finite number of degrees"),
+        ({"elevation": float("inf")}, "elevation inf: must be a finite number of degrees"),
+        ({"elevation": 90.5}, "elevation 90.5: must lie between -90 and 90 degrees"),
+        ({"zoom": float("nan")}, "zoom NaN: must be a positive finite number"),
+        ({"zoom": 0}, "zoom 0: must be a positive finite number"),
+    ],
+)
+def test_render_refuses_angles_the_cli_refuses(dot, kwargs, said):
+    with pytest.raises(ValueError, match=said):
+        t.render(dot, size=(32, 32), **kwargs)
+
+
+def test_render_takes_angles_within_their_ranges(dot):
+    for kwargs in ({"perspective": 1}, {"perspective": 179.9}, {"elevation": -90},
+                   {"elevation": 90, "azimuth": -720.0}, {"zoom": 1e-3}):
+        assert t.render(dot, size=(32, 32), **kwargs).shape == (32, 32, 3)
