@@ -123,12 +123,14 @@ pub fn plan<'py>(
 }
 
 /// Runs a world file (see docs/motion.md): a dict with steps, time_step, objects and
-/// contacts (each a dict of time, step, a, b, between_steps).
+/// contacts (each a dict of time, step, a, b, between_steps). A file the system
+/// will not read (the world, or an octree or scene it names) raises the `OSError`
+/// of its errno (`FileNotFoundError`, `IsADirectoryError`, ...), as `Octree.read`.
 #[pyfunction]
 pub fn simulate<'py>(py: Python<'py>, world: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let wf = py
         .allow_threads(|| motion::read_world(&world))
-        .map_err(|e| errors::FormatError::new_err(e.to_string()))?;
+        .map_err(|e| errors::world(py, e))?;
     let contacts = PyList::empty(py);
     let names: Vec<String> = wf.world.objects.iter().map(|o| o.name.clone()).collect();
     let name = |b: &motion::Body| match b {

@@ -1,6 +1,8 @@
 """Arguments the bindings refuse rather than misread, and how they say so: points in
 no cell of the lattice, render's angles and colours, paths, masks, depths, plans."""
 
+import errno
+
 import numpy as np
 import pytest
 
@@ -100,3 +102,44 @@ def test_render_takes_angles_within_their_ranges(dot):
     for kwargs in ({"perspective": 1}, {"perspective": 179.9}, {"elevation": -90},
                    {"elevation": 90, "azimuth": -720.0}, {"zoom": 1e-3}):
         assert t.render(dot, size=(32, 32), **kwargs).shape == (32, 32, 3)
+
+
+def _world(tmp_path, environment="wall.xyz", octree="dot.xyz"):
+    (tmp_path / "wall.xyz").write_text("".join(f"6 {y} 0\n" for y in range(4)))
+    (tmp_path / "dot.xyz").write_text("0 0 0\n")
+    (tmp_path / "w.json").write_text(
+        f'{{"environment": "{environment}", "steps": 8, "objects": '
+        f'[{{"name": "dot", "octree": "{octree}", "start": [0, 0, 0], '
+        f'"velocity": [1, 0, 0]}}]}}'
+    )
+    return tmp_path / "w.json"
+
+
+def test_simulate_raises_the_oserror_of_its_errno(tmp_path):
+    missing = tmp_path / "nope.json"
+    with pytest.raises(FileNotFoundError) as e:
+        t.simulate(missing)
+    assert e.value.errno == errno.ENOENT and e.value.filename == str(missing)
+    for folder in (tmp_path, tmp_path / "d.json"):
+        folder.mkdir(exist_ok=True)
+        with pytest.raises(IsADirectoryError) as e:
+            t.simulate(folder)
+        assert e.value.errno == errno.EISDIR and e.value.filename == str(folder)
+    # An octree or scene the world names, missing: the same, naming that file.
+    for env, obj, gone in (("gone.xyz", "dot.xyz", "gone.xyz"),
+                           ("wall.xyz", "gone.tss", "gone.tss")):
+        with pytest.raises(FileNotFoundError) as e:
+            t.simulate(_world(tmp_path, env, obj))
+        assert e.value.filename == str(tmp_path / gone)
+
+
+def test_simulate_keeps_format_and_scene_errors(tmp_path):
+    (tmp_path / "bad.json").write_text('{"environment": 3}')
+    with pytest.raises(t.FormatError, match=r"bad.json:1:"):
+        t.simulate(tmp_path / "bad.json")
+    (tmp_path / "bad.tss").write_text(
+        "depth 5\nbounds [0, 0, 0] [8, 8, 8]\nsphere(r = ) at [1, 2, 3]\n")
+    with pytest.raises(t.SceneError) as e:
+        t.simulate(_world(tmp_path, octree="bad.tss"))
+    assert (e.value.line, e.value.column) == (3, 12)
+    assert t.simulate(_world(tmp_path))["contacts"][0]["time"] == 5.0
