@@ -11,7 +11,10 @@
 //! is converted, and a value that is no code (negative, past 2**63 - 1) is named.
 
 use numpy::ndarray::ArrayView1;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -274,6 +277,34 @@ fn object_cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
             Ok([value(i, x)?, value(i, y)?, value(i, z)?])
         })
         .collect()
+}
+
+/// A mask indexed [x, y, z]: a 3-D bool array read where it lies, or one that
+/// `numpy.asarray` makes (nested lists of bools). Another dtype is a TypeError
+/// (integers are not taken for bools), another number of dimensions a ValueError;
+/// both name `name` and say the dtype and dimensions that came.
+pub fn mask3<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArray3<'py, bool>> {
+    let expected = "expected a 3-D bool array";
+    let (arr, dtype, kind) = asarray(obj, name, expected)?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    let got = format!(
+        "got {} of dtype {}, {}-D (shape {})",
+        describe(obj),
+        dtype.str()?,
+        shape.len(),
+        shape_text(&shape)
+    );
+    if kind != 'b' {
+        return Err(PyTypeError::new_err(format!("{name}: {expected}, {got}")));
+    }
+    if shape.len() != 3 {
+        return Err(PyValueError::new_err(format!("{name}: {expected}, {got}")));
+    }
+    let a = arr
+        .downcast_into::<PyArray3<bool>>()
+        .map_err(|e| PyTypeError::new_err(format!("{name}: {expected}: {e}")))?;
+    a.try_readonly()
+        .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
 }
 
 /// Codes of a one-dimensional argument: a uint64 array borrowed where it lies, or

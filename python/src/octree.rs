@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use tesseral::linear::{Axis, LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
 
-use crate::arrays::{cells, check_cell, points, to_array};
+use crate::arrays::{cells, check_cell, mask3, points, to_array};
 use crate::errors;
 
 /// A voxel as Python sees it.
@@ -90,14 +90,16 @@ impl Octree {
     }
 
     /// The voxels where a 3-D boolean array (indexed [x, y, z]) is true, the array's
-    /// element [0, 0, 0] at voxel `origin`.
+    /// element [0, 0, 0] at voxel `origin`. Another dtype (integers too) is a
+    /// TypeError, another number of dimensions a ValueError.
     #[staticmethod]
     #[pyo3(signature = (mask, origin = (0, 0, 0)))]
     fn from_dense(
         py: Python<'_>,
-        mask: PyReadonlyArray3<'_, bool>,
+        mask: &Bound<'_, PyAny>,
         origin: (i64, i64, i64),
     ) -> PyResult<Octree> {
+        let mask = mask3(mask, "mask")?;
         let a = mask.as_array();
         let o = [origin.0, origin.1, origin.2];
         let v: Vec<[i64; 3]> = a

@@ -143,3 +143,55 @@ def test_simulate_keeps_format_and_scene_errors(tmp_path):
         t.simulate(_world(tmp_path, octree="bad.tss"))
     assert (e.value.line, e.value.column) == (3, 12)
     assert t.simulate(_world(tmp_path))["contacts"][0]["time"] == 5.0
+
+
+@pytest.mark.parametrize(
+    "mask, error, said",
+    [
+        (np.ones((2, 2, 2), int), TypeError,
+         r"mask: expected a 3-D bool array, got an array of dtype int64, 3-D "
+         r"\(shape \(2, 2, 2\)\)"),
+        (np.ones((2, 2, 2)), TypeError, r"got an array of dtype float64, 3-D"),
+        (np.ones((2, 2), bool), ValueError,
+         r"mask: expected a 3-D bool array, got an array of dtype bool, 2-D \(shape \(2, 2\)\)"),
+        (np.ones((1, 2, 2, 2), bool), ValueError, r"of dtype bool, 4-D"),
+        ("abc", TypeError, r"got a str of dtype <U3, 0-D"),
+    ],
+)
+def test_from_dense_says_it_wants_a_3d_bool_array(mask, error, said):
+    with pytest.raises(error, match=said):
+        t.Octree.from_dense(mask)
+
+
+def test_from_dense_takes_any_layout_and_nested_lists_of_bools():
+    mask = np.zeros((4, 3, 2), bool)
+    mask[1, 2, 1] = mask[3, 0, 0] = True
+    want = [[1, 2, 1], [3, 0, 0]]
+    for m in (mask, np.asfortranarray(mask), mask.tolist()):
+        assert sorted(t.Octree.from_dense(m).voxels().tolist()) == want
+    flipped = np.zeros((4, 3, 4), bool)[:, :, ::2]
+    flipped[1, 2, 1] = flipped[3, 0, 0] = True
+    assert sorted(t.Octree.from_dense(flipped).voxels().tolist()) == want
+
+
+def test_render_and_build_name_integers_out_of_range(dot):
+    for bad in ((300, 0, 0), (0, -1, 0), (0, 0, 2**70)):
+        with pytest.raises(ValueError, match=r"background \(.*\): each channel \(r, g, b\) must "
+                                             r"be 0 to 255"):
+            t.render(dot, size=(32, 32), background=bad)
+    for bad in ((-1, 20), (20, 10**30), (8193, 20), (15, 16)):
+        with pytest.raises(ValueError, match=r"size \(.*\): each side must be 16 to 8192 pixels"):
+            t.render(dot, size=bad)
+    with pytest.raises(TypeError, match="background: expected 3 integers"):
+        t.render(dot, size=(32, 32), background=(1, 2))
+    with pytest.raises(TypeError, match="background: expected an integer, got 0.5"):
+        t.render(dot, size=(32, 32), background=(0.5, 2, 3))
+    img = t.render(dot, size=(32, 16), background=(0, np.uint8(255), 7), shadows=False)
+    assert img.shape == (16, 32, 3) and img[0, 0].tolist() == [0, 255, 7]
+    s = t.Scene.parse("depth 5\nbounds [0, 0, 0] [8, 8, 8]\nsphere(r = 2) at [4, 4, 4]\n")
+    for bad in (-1, 0, 17, 300, 2**70):
+        with pytest.raises(ValueError, match=f"depth {bad}: expected 1 to 16"):
+            s.build(depth=bad)
+    with pytest.raises(TypeError, match="depth: expected an integer, got 2.5"):
+        s.build(depth=2.5)
+    assert s.build(depth=3).depth == 3 and s.build(None).depth == s.depth
