@@ -195,3 +195,20 @@ def test_render_and_build_name_integers_out_of_range(dot):
     with pytest.raises(TypeError, match="depth: expected an integer, got 2.5"):
         s.build(depth=2.5)
     assert s.build(depth=3).depth == 3 and s.build(None).depth == s.depth
+
+
+def test_plan_refuses_a_region_too_large_to_search():
+    a = t.Octree.from_voxels([[0, 0, 0]])
+    with pytest.raises(ValueError, match=r"the planning region is too large to search: depth 31 "
+                                         r"exceeds the maximum of 21 .* margin=1000000000 voxels"):
+        t.plan(a, a, (2, 0, 0), (5, 0, 0), margin=10**9)
+    with pytest.raises(ValueError, match=r"too large to search: .* margin=1000000000"):
+        t.plan(a, a, (2, 0, 0), (5, 0, 0), margin=10**9, rotations=True)
+    with pytest.raises(ValueError, match=r"too large to search: .* margin=0 voxels"):
+        t.plan(a, a, (2, 0, 0), (2**40, 0, 0))
+    with pytest.raises(ValueError, match="margin -1: expected 0 or more voxels"):
+        t.plan(a, a, (2, 0, 0), (5, 0, 0), margin=-1)
+    # A real "no path" is still a finding, and a wide margin within the limit plans.
+    assert t.plan(a, a, (0, 0, 0), (5, 0, 0))["reason"].startswith("no path: at the start")
+    assert t.plan(a, a, (2, 0, 0), (5, 0, 0), margin=1000)["found"]
+
