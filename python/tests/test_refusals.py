@@ -212,3 +212,9 @@ def test_plan_refuses_a_region_too_large_to_search():
     assert t.plan(a, a, (0, 0, 0), (5, 0, 0))["reason"].startswith("no path: at the start")
     assert t.plan(a, a, (2, 0, 0), (5, 0, 0), margin=1000)["found"]
 
+
+def test_plan_of_start_at_goal_has_length_plus_zero():
+    a = t.Octree.from_voxels([[0, 0, 0]])
+    p = t.plan(a, a, (2, 0, 0), (2, 0, 0))
+    assert p["found"] and p["steps"] == 0 and p["waypoints"] == [[2, 0, 0]]
+    assert p["length"] == 0.0 and str(p["length"]) == "0.0"
