@@ -218,3 +218,13 @@ def test_plan_of_start_at_goal_has_length_plus_zero():
     p = t.plan(a, a, (2, 0, 0), (2, 0, 0))
     assert p["found"] and p["steps"] == 0 and p["waypoints"] == [[2, 0, 0]]
     assert p["length"] == 0.0 and str(p["length"]) == "0.0"
+
+
+def test_calc_add_and_sub_wrap_per_axis_and_say_so():
+    edge = t.calc.encode([[2**21 - 1, 5, 0]])
+    moved = t.calc.add(edge, t.calc.encode([[3, 2**21 - 2, 0]]))
+    assert t.calc.decode(moved).tolist() == [[2, 3, 0]]     # the carries dropped
+    assert t.calc.decode(t.calc.sub([0], [1])).tolist() == [[2**21 - 1, 0, 0]]
+    for f in (t.calc.add, t.calc.sub):
+        doc = " ".join(f.__doc__.split())
+        assert "wrapping per axis" in doc and "modulo 2**21" in doc
