@@ -11,7 +11,10 @@
 //! is converted, and a value that is no code (negative, past 2**63 - 1) is named.
 
 use numpy::ndarray::ArrayView1;
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{
+    IntoPyArray, PyArray1, PyArray2, PyArray3, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2,
+    PyReadonlyArray3,
+};
 use pyo3::exceptions::{PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
@@ -109,11 +112,41 @@ fn asarray<'py>(
     Ok((arr, dtype, kind))
 }
 
+/// 2**63: the first float past int64.
+const PAST_I64: f64 = 9_223_372_036_854_775_808.0;
+
 /// A float that is a whole number within int64, as one.
 fn whole_i64(x: f64) -> Option<i64> {
-    // 2**63: the first float past int64.
-    const PAST: f64 = 9_223_372_036_854_775_808.0;
-    (x.fract() == 0.0 && (-PAST..PAST).contains(&x)).then_some(x as i64)
+    (x.fract() == 0.0 && (-PAST_I64..PAST_I64).contains(&x)).then_some(x as i64)
+}
+
+/// Checks that point `p`, row `row` of argument `name`, lies in a cell: `lattice` is
+/// its position in cells (fractional), whose floors must be within int64 (a cast
+/// would saturate, or make NaN cell 0). The error names the row, the point and the
+/// coordinate; `unit` is what a cell is called ("voxel", "cell").
+pub fn check_cell(
+    name: &str,
+    unit: &str,
+    row: usize,
+    p: [f64; 3],
+    lattice: [f64; 3],
+) -> Result<(), String> {
+    for (a, (&x, &c)) in ["x", "y", "z"].iter().zip(p.iter().zip(&lattice)) {
+        if !x.is_finite() {
+            return Err(format!(
+                "{name}: row {row} is {p:?}, whose {a} is {x:?} (every coordinate must \
+                 be a finite number)"
+            ));
+        }
+        if !(-PAST_I64..PAST_I64).contains(&c) {
+            return Err(format!(
+                "{name}: row {row} is {p:?}, whose {a} = {x:?} lies in {unit} {:?}, \
+                 past the range of int64 (-2**63 to 2**63 - 1)",
+                c.floor()
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// `obj` as a numpy array of numbers, N×3 (a zero-length sequence is 0×3), and its
@@ -244,6 +277,34 @@ fn object_cells(obj: &Bound<'_, PyAny>, name: &str) -> PyResult<Vec<[i64; 3]>> {
             Ok([value(i, x)?, value(i, y)?, value(i, z)?])
         })
         .collect()
+}
+
+/// A mask indexed [x, y, z]: a 3-D bool array read where it lies, or one that
+/// `numpy.asarray` makes (nested lists of bools). Another dtype is a TypeError
+/// (integers are not taken for bools), another number of dimensions a ValueError;
+/// both name `name` and say the dtype and dimensions that came.
+pub fn mask3<'py>(obj: &Bound<'py, PyAny>, name: &str) -> PyResult<PyReadonlyArray3<'py, bool>> {
+    let expected = "expected a 3-D bool array";
+    let (arr, dtype, kind) = asarray(obj, name, expected)?;
+    let shape: Vec<usize> = arr.getattr("shape")?.extract()?;
+    let got = format!(
+        "got {} of dtype {}, {}-D (shape {})",
+        describe(obj),
+        dtype.str()?,
+        shape.len(),
+        shape_text(&shape)
+    );
+    if kind != 'b' {
+        return Err(PyTypeError::new_err(format!("{name}: {expected}, {got}")));
+    }
+    if shape.len() != 3 {
+        return Err(PyValueError::new_err(format!("{name}: {expected}, {got}")));
+    }
+    let a = arr
+        .downcast_into::<PyArray3<bool>>()
+        .map_err(|e| PyTypeError::new_err(format!("{name}: {expected}: {e}")))?;
+    a.try_readonly()
+        .map_err(|e| PyValueError::new_err(format!("{name}: {e}")))
 }
 
 /// Codes of a one-dimensional argument: a uint64 array borrowed where it lies, or

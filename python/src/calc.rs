@@ -73,8 +73,10 @@ fn binary<'py>(
     Ok(out.into_pyarray(py))
 }
 
-/// Tesseral addition of two code arrays (translation), without decoding: a uint64
-/// array. Codes are taken as `decode` takes them.
+/// Tesseral addition of two code arrays (translation), without decoding, wrapping
+/// per axis: a uint64 array. The carry out of the 21st digit is dropped, so each
+/// coordinate is added modulo 2**21 (2**21 - 1 plus 1 is 0). Codes are taken as
+/// `decode` takes them.
 #[pyfunction]
 pub fn add<'py>(
     py: Python<'py>,
@@ -85,7 +87,8 @@ pub fn add<'py>(
 }
 
 /// Tesseral subtraction a - b of two code arrays, wrapping per axis: a uint64
-/// array. Codes are taken as `decode` takes them.
+/// array. Each coordinate is subtracted modulo 2**21 (0 minus 1 is 2**21 - 1).
+/// Codes are taken as `decode` takes them.
 #[pyfunction]
 pub fn sub<'py>(
     py: Python<'py>,

@@ -77,6 +77,20 @@ pub fn scene(py: Python<'_>, e: tesseral::csg::SceneError) -> PyErr {
     err
 }
 
+/// A world file's error (`simulate`): a file the system would not read (the world
+/// file, or an octree or scene it names) as an `OSError` subclass, as for `format`
+/// and `scene`; a bad octree file it names as `FormatError`, a bad scene as
+/// `SceneError`; the rest (bad JSON, bad values, the leaf budget) as `FormatError`.
+pub fn world(py: Python<'_>, e: tesseral::motion::WorldError) -> PyErr {
+    use tesseral::motion::WorldError as W;
+    match e {
+        W::Io { path, source } => io(&source, Some(&path)),
+        W::Octree(f) => format(f),
+        W::Scene(s) => scene(py, s),
+        other => FormatError::new_err(other.to_string()),
+    }
+}
+
 /// Any octree or model error.
 pub fn octree(e: impl std::fmt::Display) -> PyErr {
     OctreeError::new_err(e.to_string())

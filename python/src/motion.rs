@@ -57,6 +57,8 @@ pub fn collide<'py>(
 /// A collision-free path for `obj` through `env` from offset `start` to `goal`
 /// (voxels of env); `rotations=True` lets it turn by quarter turns. A dict with
 /// found, and waypoints/length/steps (or moves/turns/orientations), or reason.
+/// A negative `margin`, or a planning region too large to search (past 2**21
+/// voxels a side), raises ValueError.
 #[pyfunction]
 #[pyo3(signature = (env, obj, start, goal, margin = 0, turns = "", rotations = false))]
 #[allow(clippy::too_many_arguments)]
@@ -76,9 +78,14 @@ pub fn plan<'py>(
         .offset_to(&obj.model.frame)
         .map_err(errors::octree)?;
     let obj_tree = obj.model.tree.translate(placed).map_err(errors::octree)?;
+    if margin < 0 {
+        return Err(PyValueError::new_err(format!(
+            "margin {margin}: expected 0 or more voxels"
+        )));
+    }
     let opts = PlanOptions {
         rotation: rotation(turns)?,
-        margin: margin.max(0),
+        margin,
         ..PlanOptions::default()
     };
     let (from, to) = ([start.0, start.1, start.2], [goal.0, goal.1, goal.2]);
@@ -101,7 +108,7 @@ pub fn plan<'py>(
             }
             Err(why) => {
                 d.set_item("found", false)?;
-                d.set_item("reason", why.to_string())?;
+                d.set_item("reason", no_path(why, margin)?)?;
             }
         }
         return Ok(d);
@@ -116,19 +123,36 @@ pub fn plan<'py>(
         }
         Err(why) => {
             d.set_item("found", false)?;
-            d.set_item("reason", why.to_string())?;
+            d.set_item("reason", no_path(why, margin)?)?;
         }
     }
     Ok(d)
 }
 
+/// The reason there is no path, or a ValueError when there is no answer: a
+/// planning region wider than an octree holds is a limit of the search, not a
+/// finding about the solids (the CLI refuses it before planning).
+fn no_path(why: motion::NoPath, margin: i64) -> PyResult<String> {
+    match why {
+        motion::NoPath::Octree(e) => Err(PyValueError::new_err(format!(
+            "the planning region is too large to search: {e} (at most 2**21 voxels a \
+             side); it is the bounding box of env and of obj at start and at goal, \
+             widened by margin={margin} voxels on every side: lower margin, or plan \
+             between nearer start and goal"
+        ))),
+        other => Ok(other.to_string()),
+    }
+}
+
 /// Runs a world file (see docs/motion.md): a dict with steps, time_step, objects and
-/// contacts (each a dict of time, step, a, b, between_steps).
+/// contacts (each a dict of time, step, a, b, between_steps). A file the system
+/// will not read (the world, or an octree or scene it names) raises the `OSError`
+/// of its errno (`FileNotFoundError`, `IsADirectoryError`, ...), as `Octree.read`.
 #[pyfunction]
 pub fn simulate<'py>(py: Python<'py>, world: PathBuf) -> PyResult<Bound<'py, PyDict>> {
     let wf = py
         .allow_threads(|| motion::read_world(&world))
-        .map_err(|e| errors::FormatError::new_err(e.to_string()))?;
+        .map_err(|e| errors::world(py, e))?;
     let contacts = PyList::empty(py);
     let names: Vec<String> = wf.world.objects.iter().map(|o| o.name.clone()).collect();
     let name = |b: &motion::Body| match b {

@@ -8,7 +8,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::occupancy::{CellState, OccupancyMap as Map, SensorModel};
 
-use crate::arrays::{cells, points};
+use crate::arrays::{cells, check_cell, points};
 use crate::errors::{borrow, borrow_mut};
 use crate::octree::Octree;
 use crate::scans::DEFAULT_MAX_CELLS;
@@ -176,14 +176,28 @@ impl OccupancyMap {
         Ok(out.into_pyarray(py))
     }
 
-    /// The cell holding each point of an N×3 array of numbers, N×3 int64.
+    /// The cell holding each point of an N×3 array of numbers, N×3 int64. A point
+    /// with a coordinate NaN or infinite, or in a cell past the range of int64, is
+    /// refused (ValueError naming its row), not clamped.
     fn cells_of<'py>(
         slf: &Bound<'py, Self>,
         points: &Bound<'py, PyAny>,
     ) -> PyResult<Bound<'py, numpy::PyArray2<i64>>> {
         let p = self::points(points, "points")?;
         let this = borrow(slf, WHAT)?;
-        crate::arrays::to_array(slf.py(), p.iter().map(|&q| this.map.cell_of(q)).collect())
+        let m = &this.map;
+        // The position in cells as `cell_of` computes it (p × (1 / res)), checked.
+        let inv = 1.0 / m.resolution();
+        let cells = p
+            .iter()
+            .enumerate()
+            .map(|(i, &q)| {
+                check_cell("points", "cell", i, q, q.map(|c| c * inv))?;
+                Ok(m.cell_of(q))
+            })
+            .collect::<Result<Vec<_>, String>>()
+            .map_err(PyValueError::new_err)?;
+        crate::arrays::to_array(slf.py(), cells)
     }
 
     /// The side of a cell, in world units.

@@ -2,14 +2,14 @@
 
 use std::path::PathBuf;
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray3};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods};
 use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
 use tesseral::linear::{Axis, LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
 
-use crate::arrays::{cells, points, to_array};
+use crate::arrays::{cells, check_cell, mask3, points, to_array};
 use crate::errors;
 
 /// A voxel as Python sees it.
@@ -65,7 +65,9 @@ impl Octree {
     }
 
     /// The voxels of size `voxel_size` holding the points of an N×3 array of numbers
-    /// (world units; voxel i spans [i·h, (i+1)·h)).
+    /// (world units; voxel i spans [i·h, (i+1)·h)). A point with a coordinate NaN or
+    /// infinite, or in a voxel past the range of int64, is refused (OctreeError
+    /// naming its row), not clamped.
     #[staticmethod]
     fn from_points(py: Python<'_>, points: &Bound<'_, PyAny>, voxel_size: f64) -> PyResult<Octree> {
         if !(voxel_size.is_finite() && voxel_size > 0.0) {
@@ -77,11 +79,9 @@ impl Octree {
         let frame = Frame::new(voxel_size, [0.0; 3]);
         let tree = py.allow_threads(|| {
             let mut v = Vec::with_capacity(p.len());
-            for q in &p {
-                if !q.iter().all(|c| c.is_finite()) {
-                    return Err(format!("point {q:?} is not finite"));
-                }
-                v.push(frame.voxel_of_point(*q));
+            for (i, &q) in p.iter().enumerate() {
+                check_cell("points", "voxel", i, q, frame.to_lattice(q))?;
+                v.push(frame.voxel_of_point(q));
             }
             LinearOctree::from_voxels_fitted(&v).map_err(|e| e.to_string())
         });
@@ -90,14 +90,16 @@ impl Octree {
     }
 
     /// The voxels where a 3-D boolean array (indexed [x, y, z]) is true, the array's
-    /// element [0, 0, 0] at voxel `origin`.
+    /// element [0, 0, 0] at voxel `origin`. Another dtype (integers too) is a
+    /// TypeError, another number of dimensions a ValueError.
     #[staticmethod]
     #[pyo3(signature = (mask, origin = (0, 0, 0)))]
     fn from_dense(
         py: Python<'_>,
-        mask: PyReadonlyArray3<'_, bool>,
+        mask: &Bound<'_, PyAny>,
         origin: (i64, i64, i64),
     ) -> PyResult<Octree> {
+        let mask = mask3(mask, "mask")?;
         let a = mask.as_array();
         let o = [origin.0, origin.1, origin.2];
         let v: Vec<[i64; 3]> = a

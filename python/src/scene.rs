@@ -10,9 +10,13 @@ use tesseral::csg::Scene as CsgScene;
 use tesseral::model::Model;
 use tesseral::render::{self as draw, Camera, Image, Projection, RenderOptions, View};
 
+use crate::args::{int_within, ints_within};
 use crate::errors;
 use crate::occupancy::OccupancyMap;
 use crate::octree::Octree;
+
+/// The depths a scene may be built at.
+const DEPTHS: std::ops::RangeInclusive<i64> = 1..=16;
 
 /// A parsed `.tss` scene (see docs/scenes.md).
 #[pyclass(module = "tesseral", frozen)]
@@ -53,9 +57,19 @@ impl Scene {
     }
 
     /// Builds the scene's octree with its frame and colours, at the scene's depth or
-    /// at `depth` (the same bounds, coarser or finer voxels).
+    /// at `depth` (1 to 16: the same bounds, coarser or finer voxels; ValueError
+    /// outside).
     #[pyo3(signature = (depth = None))]
-    fn build(&self, py: Python<'_>, depth: Option<u8>) -> PyResult<Octree> {
+    fn build(&self, py: Python<'_>, depth: Option<&Bound<'_, PyAny>>) -> PyResult<Octree> {
+        // Checked here, not converted by pyo3, whose OverflowError names neither.
+        let depth = match depth {
+            Some(d) => Some(
+                int_within(d, "depth", DEPTHS)?
+                    .ok_or_else(|| PyValueError::new_err(format!("depth {d}: expected 1 to 16")))?
+                    as u8,
+            ),
+            None => None,
+        };
         let scene = self.at_depth(depth)?;
         py.allow_threads(|| scene.build_model_limited(tesseral::csg::DEFAULT_MAX_LEAVES))
             .map(Octree::new)
@@ -101,7 +115,7 @@ impl Scene {
     pub fn at_depth(&self, depth: Option<u8>) -> PyResult<CsgScene> {
         let mut s = self.scene.clone();
         if let Some(d) = depth {
-            if !(1..=16).contains(&d) {
+            if !DEPTHS.contains(&i64::from(d)) {
                 return Err(PyValueError::new_err(format!(
                     "depth {d}: expected 1 to 16"
                 )));
@@ -212,18 +226,51 @@ pub fn png<'py>(py: Python<'py>, img: &Image) -> PyResult<Bound<'py, PyBytes>> {
     Ok(PyBytes::new(py, &buf))
 }
 
+/// The camera's numbers checked as the CLI checks `--azimuth`, `--elevation`,
+/// `--zoom` and `--fov`, each error naming its argument: NaN, an infinity or a
+/// field of view of 0 or 180 degrees would draw a blank or a wrong picture.
+fn check_camera(
+    azimuth: Option<f64>,
+    elevation: Option<f64>,
+    zoom: f64,
+    perspective: Option<f64>,
+) -> PyResult<()> {
+    let refuse = |why: String| Err(PyValueError::new_err(why));
+    for (name, value) in [("azimuth", azimuth), ("elevation", elevation)] {
+        if let Some(v) = value.filter(|v| !v.is_finite()) {
+            return refuse(format!("{name} {v}: must be a finite number of degrees"));
+        }
+    }
+    if let Some(e) = elevation.filter(|e| e.abs() > 90.0) {
+        return refuse(format!(
+            "elevation {e}: must lie between -90 and 90 degrees"
+        ));
+    }
+    if !(zoom.is_finite() && zoom > 0.0) {
+        return refuse(format!("zoom {zoom}: must be a positive finite number"));
+    }
+    if let Some(f) = perspective.filter(|f| !(*f > 0.0 && *f < 180.0)) {
+        return refuse(format!(
+            "perspective {f}: the field of view must lie between 0 and 180 degrees"
+        ));
+    }
+    Ok(())
+}
+
 /// Renders an Octree, a Scene or an OccupancyMap (its `to_octree()`) as an H×W×3
 /// uint8 array. Keyword arguments are the CLI's options: size=(w, h), view ('iso',
-/// 'front', 'top', 'side'), azimuth, elevation, zoom, outline, shadows, perspective
-/// (field of view in degrees), background (r, g, b).
+/// 'front', 'top', 'side'), azimuth, elevation (-90 to 90), zoom (positive),
+/// outline, shadows, perspective (field of view in degrees, between 0 and 180),
+/// background (r, g, b, each 0 to 255). A value out of its range, or a NaN or
+/// infinite angle or zoom, raises ValueError naming it.
 #[pyfunction]
-#[pyo3(signature = (obj, size = (800, 600), view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = (255, 255, 255)),
+#[pyo3(signature = (obj, size = None, view = "iso", azimuth = None, elevation = None, zoom = 1.0, outline = false, shadows = true, perspective = None, background = None),
        text_signature = "(obj, size=(800, 600), view='iso', azimuth=None, elevation=None, zoom=1.0, outline=False, shadows=True, perspective=None, background=(255, 255, 255))")]
 #[allow(clippy::too_many_arguments)]
 pub fn render<'py>(
     py: Python<'py>,
     obj: &Bound<'py, PyAny>,
-    size: (usize, usize),
+    size: Option<&Bound<'py, PyAny>>,
     view: &str,
     azimuth: Option<f64>,
     elevation: Option<f64>,
@@ -231,7 +278,7 @@ pub fn render<'py>(
     outline: bool,
     shadows: bool,
     perspective: Option<f64>,
-    background: (u8, u8, u8),
+    background: Option<&Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyArray3<u8>>> {
     // What is drawn is checked first: a wrong object is a TypeError whatever the options.
     let octree = obj.downcast::<Octree>().ok();
@@ -246,19 +293,24 @@ pub fn render<'py>(
     let view = View::parse(view).ok_or_else(|| {
         PyValueError::new_err(format!("view {view:?}: expected iso, front, top or side"))
     })?;
-    if !(16..=8192).contains(&size.0) || !(16..=8192).contains(&size.1) {
-        return Err(PyValueError::new_err(format!(
-            "size {size:?}: each side must be 16 to 8192 pixels"
-        )));
-    }
-    let finite = |x: Option<f64>| x.is_none_or(f64::is_finite);
-    if !(finite(azimuth) && finite(elevation) && zoom.is_finite() && zoom > 0.0) {
-        return Err(PyValueError::new_err(
-            "azimuth, elevation and zoom must be finite (zoom positive)",
-        ));
-    }
+    // Checked here, not converted by pyo3, whose OverflowError names neither.
+    let [width, height] = match size {
+        Some(s) => ints_within(s, "size", 16..=8192, "each side must be 16 to 8192 pixels")?,
+        None => [800, 600],
+    };
+    let [r, g, b] = match background {
+        Some(c) => ints_within(
+            c,
+            "background",
+            0..=255,
+            "each channel (r, g, b) must be 0 to 255",
+        )?,
+        None => [255; 3],
+    };
+    check_camera(azimuth, elevation, zoom, perspective)?;
+    // In range, checked above.
     let o = Options {
-        size,
+        size: (width as usize, height as usize),
         view,
         azimuth,
         elevation,
@@ -266,7 +318,7 @@ pub fn render<'py>(
         outline,
         shadows,
         perspective,
-        background: [background.0, background.1, background.2],
+        background: [r as u8, g as u8, b as u8],
     };
     let img = if let Some(t) = octree {
         render_model(py, &t.get().model, &o)?

@@ -345,6 +345,8 @@ pub fn plan(
     } else {
         raw.clone()
     };
+    // Summed from +0.0: `Sum` for f64 starts at -0.0, which a path of one waypoint
+    // (the start at the goal) would keep as its length, written -0.0 in JSON.
     let length = waypoints
         .windows(2)
         .map(|w| {
@@ -353,7 +355,7 @@ pub fn plan(
                 .sum::<f64>()
                 .sqrt()
         })
-        .sum();
+        .fold(0.0, |total, d| total + d);
     let clearance = path_clearance(environment, object, rotation, &waypoints);
     Ok(Plan {
         waypoints,
