@@ -61,40 +61,31 @@ fn streamed_build_budgets_and_refusals() {
     fails(
         d,
         &["build", s, "-o", "s.tess", "--depth", "30"],
-        "depth 30",
+        "'30' for '--depth <D>': 30 is not in 1..=16",
     );
     assert!(!d.join("s.tess").exists() && !d.join("s.xyz").exists());
-    // Over the leaf limit in memory: the refusal says a .tess file streams; the
-    // .tess build streams past it.
+    // Over --max-leaves, in memory or streamed: refused (a streamed build's memory
+    // does not grow with the leaves, but the flag is a limit on them), and the
+    // refusal does not suggest a .tess, which --max-leaves binds as well.
+    for out in ["s.xyz", "s.tess"] {
+        let args = ["build", s, "-o", out, "--depth", "9", "--max-leaves", "100"];
+        let out = common::run(d, &args);
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(
+            err.contains("more than --max-leaves 100")
+                || err.contains("that --max-leaves 100 allows"),
+            "{err}"
+        );
+        assert!(!err.contains("which streams"), "{err}");
+    }
+    assert!(!d.join("s.tess").exists() && !d.join("s.xyz").exists());
+    // Over --memory in memory: the refusal says a .tess file streams.
     fails(
         d,
-        &[
-            "build",
-            s,
-            "-o",
-            "s.xyz",
-            "--depth",
-            "9",
-            "--max-leaves",
-            "100",
-        ],
+        &["build", s, "-o", "s.xyz", "--depth", "9", "--memory", "8M"],
         ".tess file, which streams",
     );
-    let v = json(
-        d,
-        &[
-            "build",
-            s,
-            "-o",
-            "s.tess",
-            "--depth",
-            "9",
-            "--max-leaves",
-            "100",
-            "--json",
-        ],
-    );
-    assert!(v["leaves"].as_u64().unwrap() > 100);
     // No fixed leaf limit in memory: the memory budget decides, before the work.
     fails(
         d,

@@ -2,10 +2,14 @@
 //!
 //! A scene build is estimated first (`Scene::estimate_leaves`, a build three levels
 //! coarser), and refused at once when the estimate is over budget; the real build
-//! then stops at the same budget if the estimate was low. An in-memory build may
-//! hold `--memory` / 24 bytes leaves (there is no fixed leaf limit); a streamed
-//! build's memory is estimated from its plan instead (`build/stream.rs`). `plan` estimates its
-//! configuration space from the region's box (`motion::estimate_plan_bytes`).
+//! then stops at the same budget if the estimate was low. A model held whole (a
+//! scene built in memory, a file read whole) may hold `--memory` / 48 bytes leaves,
+//! fewer when the command's work on it takes more a leaf ([`Budget::for_work`]:
+//! a mesh written, a viewer's page); there is no fixed leaf limit. A `.tess` file
+//! or dataset is checked from its header before it is read, another file once read,
+//! before the work. A streamed build's memory is estimated from its plan instead
+//! (`build/stream.rs`). `plan` estimates its configuration space from the region's
+//! box (`motion::estimate_plan_bytes`).
 
 use std::path::Path;
 
@@ -15,10 +19,29 @@ use tesseral::linear::LinearOctree;
 
 use super::output::{human_bytes, parse_bytes};
 
-/// Memory per leaf while a scene is built in memory: the leaf itself, its copy in
-/// the per-thread chunks before they are joined, and the colour regions (measured:
-/// about 21 bytes a leaf for the showcase at depth 12).
-const BUILD_BYTES_PER_LEAF: u64 = 24;
+/// Memory per leaf of a model held whole: a scene built in memory (the leaf, its
+/// copy in the per-thread chunks before they are joined, the colour regions) or a
+/// file read whole. Peak resident memory measured: 41 bytes a leaf for the
+/// showcase at depth 10 (1.69 M leaves), 46 for the spheroid of
+/// `fig4c-spheroid.tss` at depth 10 and 44 at depth 11 (3.6 M); reading either
+/// from a `.tess` the same.
+pub const MODEL_BYTES_PER_LEAF: u64 = 48;
+
+/// Memory per leaf that writing a model in format `ext` takes beside the model:
+/// the boundary mesh of `.stl`, `.obj`, `.ply`, `.glb` (its vertex maps), the
+/// OctoMap tree of `.bt`, `.ot`, the runs of `.binvox`; nothing for the formats
+/// written leaf by leaf. Measured as the peak beyond [`MODEL_BYTES_PER_LEAF`] on the
+/// showcase and the spheroid at depth 10: 300–355 bytes (meshes), 38–48 (`.bt`),
+/// 54–58 (`.ot`), 66–68 (`.binvox`).
+pub fn write_bytes_per_leaf(ext: &str) -> u64 {
+    match ext {
+        "stl" | "obj" | "ply" | "glb" => 400,
+        "binvox" => 80,
+        "ot" => 64,
+        "bt" => 48,
+        _ => 0,
+    }
+}
 
 /// The budget flags of commands that build scenes or plan.
 #[derive(clap::Args, Clone, Copy, Debug)]
@@ -31,6 +54,10 @@ pub struct Budget {
     /// number with K, M, G or T (powers of 1024).
     #[arg(long, value_name = "SIZE", default_value = "8G", value_parser = parse_bytes)]
     pub memory: u64,
+    /// Memory per leaf of the command's work on the model, beside the model itself
+    /// (not a flag: see [`Budget::for_work`]).
+    #[arg(skip)]
+    pub work_per_leaf: u64,
 }
 
 impl Default for Budget {
@@ -38,15 +65,33 @@ impl Default for Budget {
         Self {
             max_leaves: None,
             memory: 8 << 30,
+            work_per_leaf: 0,
         }
     }
 }
 
 impl Budget {
+    /// This budget for a command whose work on the model takes `bytes_per_leaf`
+    /// bytes a leaf beside it (a mesh written: [`write_bytes_per_leaf`]), so that
+    /// a model too large for the work is refused before it is built or read.
+    #[must_use]
+    pub fn for_work(self, bytes_per_leaf: u64) -> Self {
+        Self {
+            work_per_leaf: bytes_per_leaf,
+            ..self
+        }
+    }
+
+    /// The bytes a leaf of a model held whole and worked on.
+    fn bytes_per_leaf(&self) -> u64 {
+        MODEL_BYTES_PER_LEAF.saturating_add(self.work_per_leaf)
+    }
+
     /// The leaf cap: `--max-leaves`, or fewer if `--memory` cannot hold that many.
     pub fn leaf_cap(&self) -> usize {
-        let by_memory = usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX);
-        self.max_leaves.unwrap_or(usize::MAX).min(by_memory)
+        self.max_leaves
+            .unwrap_or(usize::MAX)
+            .min(self.memory_leaf_cap())
     }
 
     /// The error for `leaves` over the cap (`u64::MAX`: over, by an unmeasured
@@ -57,7 +102,7 @@ impl Budget {
 
     /// The leaf cap of a world's bodies (`simulate`): `--max-leaves`, by default
     /// the library's [`DEFAULT_MAX_LEAVES`] (a body costs far more than a leaf's
-    /// 24 bytes once collision structures are built), or fewer if `--memory`
+    /// 48 bytes once collision structures are built), or fewer if `--memory`
     /// cannot hold that many.
     pub fn world_leaf_cap(&self) -> usize {
         self.max_leaves
@@ -66,7 +111,19 @@ impl Budget {
     }
 
     fn memory_leaf_cap(&self) -> usize {
-        usize::try_from(self.memory / BUILD_BYTES_PER_LEAF).unwrap_or(usize::MAX)
+        usize::try_from(self.memory / self.bytes_per_leaf()).unwrap_or(usize::MAX)
+    }
+
+    /// Refuses a model of `leaves` leaves (`what`: the input) over the leaf cap:
+    /// a file to be read whole, from its header, or one just read, before the work.
+    ///
+    /// # Errors
+    /// An error naming the input and the flag that binds.
+    pub fn check_leaves(&self, what: &str, leaves: u64) -> Result<()> {
+        if leaves > self.leaf_cap() as u64 {
+            return Err(self.refuse(what, leaves));
+        }
+        Ok(())
     }
 
     /// As [`Budget::refuse`], for the cap `cap`: `--memory` binds when it allows no
@@ -77,10 +134,19 @@ impl Budget {
         } else {
             ("--max-leaves", cap.to_string())
         };
-        let count = if leaves == u64::MAX {
-            format!("more than the {cap} leaves that {flag} {limit} allows")
+        // The bytes a leaf, when the command's work on the model counts.
+        let rate = if flag == "--memory" && self.work_per_leaf > 0 {
+            format!(
+                " (at {} bytes a leaf with the work on it)",
+                self.bytes_per_leaf()
+            )
         } else {
-            format!("about {leaves} leaves, more than the {cap} that {flag} {limit} allows")
+            String::new()
+        };
+        let count = if leaves == u64::MAX {
+            format!("more than the {cap} leaves that {flag} {limit} allows{rate}")
+        } else {
+            format!("about {leaves} leaves, more than the {cap} that {flag} {limit} allows{rate}")
         };
         anyhow::anyhow!("{what}: the octree would have {count}; raise {flag} or lower the depth")
     }

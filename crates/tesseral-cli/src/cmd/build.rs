@@ -67,11 +67,19 @@ pub fn run(args: Args) -> Result<()> {
         return run_streamed(&args, &scene);
     }
     let start = Instant::now();
-    let tree = args
-        .budget
-        .build_scene(&args.scene, &scene)
-        .map_err(|e| anyhow::anyhow!("{e}; or build to a .tess file, which streams"))?;
-    let colors = scene.colour_layer(&tree, args.budget.leaf_cap())?;
+    // The model, and the writing of its output (a mesh's vertex maps, ...).
+    let budget = args.budget.for_work(super::budget::write_bytes_per_leaf(
+        &args.limits.format_of(&args.output),
+    ));
+    let tree = budget.build_scene(&args.scene, &scene).map_err(|e| {
+        // A .tess build streams within --memory; --max-leaves binds it too.
+        if e.to_string().contains("--memory") {
+            anyhow::anyhow!("{e}; or build to a .tess file, which streams")
+        } else {
+            e
+        }
+    })?;
+    let colors = scene.colour_layer(&tree, budget.leaf_cap())?;
     let model = tesseral::model::Model {
         colors,
         ..tesseral::model::Model::new(tree).with_frame(scene.frame())

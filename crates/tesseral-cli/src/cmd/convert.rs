@@ -114,8 +114,12 @@ pub fn run(mut args: Args) -> Result<()> {
     if stream::to_tess(&args, &out)? || stream::to_xyz(&args, &out)? {
         return Ok(());
     }
-    stream::check_in_memory(&args)?;
-    let model = octree::read_model(&args.input, &args.budget, &read)?;
+    // The model, and the writing of its output (a mesh's vertex maps, ...).
+    let budget = args.budget.for_work(super::budget::write_bytes_per_leaf(
+        &args.limits.format_of(&out),
+    ));
+    stream::check_in_memory(&args, &budget)?;
+    let model = octree::read_model(&args.input, &budget, &read)?;
     octree::save(&out, &model, &args.limits, &write)?;
     if args.json {
         let bbox = model.tree.bbox();

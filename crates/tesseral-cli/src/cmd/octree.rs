@@ -26,13 +26,22 @@ pub fn read_model(
     if tesseral::io::extension(path) == "tss" {
         return budget.build_scene_model(path);
     }
-    if tesseral::partition::is_dataset(path) {
-        // A partitioned dataset (a directory with manifest.json) reads as one model.
-        return tesseral::partition::read_dataset_model(path).map_err(|e| anyhow::anyhow!("{e}"));
+    // A `.tess` file or a dataset is checked against the budget from its header
+    // before it is read; any other file once read, before the work.
+    let what = format!("{} (read whole)", path.display());
+    if let Some(leaves) = super::streamed::leaves_on_disk(path)? {
+        budget.check_leaves(&what, leaves)?;
     }
-    // The library's message already names the file and its cause; keep it as one
-    // line rather than repeating the cause from the error chain.
-    tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))
+    let model = if tesseral::partition::is_dataset(path) {
+        // A partitioned dataset (a directory with manifest.json) reads as one model.
+        tesseral::partition::read_dataset_model(path).map_err(|e| anyhow::anyhow!("{e}"))?
+    } else {
+        // The library's message already names the file and its cause; keep it as
+        // one line rather than repeating the cause from the error chain.
+        tesseral::io::read_model_with(path, options).map_err(|e| anyhow::anyhow!("{e}"))?
+    };
+    budget.check_leaves(&what, model.tree.leaf_count() as u64)?;
+    Ok(model)
 }
 
 /// Reads a model from an octree file (any format `tesseral::io` knows by the

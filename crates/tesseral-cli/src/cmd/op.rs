@@ -58,15 +58,20 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(done) = streamed(&args, op)? {
         return done;
     }
+    // Each operand, with the result and the writing of the output beside it (each
+    // checked alone against --memory: the two together can take up to twice).
+    let ext = args.limits.format_of(&args.output);
     let budget = super::budget::Budget {
         max_leaves: None,
         memory: args.memory,
-    };
+        ..Default::default()
+    }
+    .for_work(super::budget::MODEL_BYTES_PER_LEAF + super::budget::write_bytes_per_leaf(&ext));
     for input in [&args.a, &args.b] {
         super::streamed::check_version_1_in_memory(input, &budget)?;
     }
-    let a = octree::read(&args.a)?;
-    let b = octree::read(&args.b)?;
+    let a = octree::read_model(&args.a, &budget, &Default::default())?;
+    let b = octree::read_model(&args.b, &budget, &Default::default())?;
     let r = a.set_op(&b, op).with_context(|| {
         format!(
             "combining {} ({}) and {} ({})",

@@ -80,7 +80,7 @@ pub fn run(args: &Args, dir: &Path, k: usize, read: &ReadOptions) -> Result<()> 
             (parts, op.space(), op.frame)
         }
         None => {
-            super::stream::check_in_memory(args)?;
+            super::stream::check_in_memory(args, &args.budget)?;
             let model = octree::read_model(&args.input, &args.budget, read)?;
             let tree = &model.tree;
             let tess = tesseral::io::estimate_output_bytes(tree, "tess").unwrap_or(0);

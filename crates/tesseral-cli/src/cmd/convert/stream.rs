@@ -8,13 +8,10 @@ use std::path::Path;
 use anyhow::Result;
 use tesseral::io;
 
+use super::super::budget::Budget;
 use super::super::output;
 use super::super::streamed::{self, Operand};
 use super::Args;
-
-/// Memory an in-memory `convert` holds per leaf of the input: the leaf, its
-/// colour region's copy and the decoder's buffers (as an in-memory build).
-const READ_BYTES_PER_LEAF: u64 = 24;
 
 /// Memory a streamed `convert` holds whatever the input's size: the program, two
 /// decoded chunks and the writer's, and a spool buffer per colour.
@@ -191,17 +188,19 @@ pub fn to_xyz(args: &Args, out: &Path) -> Result<bool> {
     Ok(true)
 }
 
-/// Before an in-memory conversion of a `.tess` file or a dataset: its leaves, at
-/// 24 bytes each, against `--memory` (a version-1 file by its size, as the
-/// streamed paths count it).
-pub fn check_in_memory(args: &Args) -> Result<()> {
+/// Before an in-memory conversion of a `.tess` file or a dataset: its leaves
+/// against `budget` (the model and the writing of the output; a version-1 file by
+/// its size, as the streamed paths count it), with the outputs that stream named.
+pub fn check_in_memory(args: &Args, budget: &Budget) -> Result<()> {
     let input = &args.input;
     let Some(leaves) = streamed::leaves_on_disk(input)? else {
         return Ok(());
     };
-    args.budget.check_memory(
-        &format!("reading {} whole", input.display()),
-        leaves.saturating_mul(READ_BYTES_PER_LEAF),
-        " (or convert it into a .tess, .xyz or a dataset with --parts, which stream)",
-    )
+    budget
+        .check_leaves(&format!("reading {} whole", input.display()), leaves)
+        .map_err(|e| {
+            anyhow::anyhow!(
+                "{e} (or convert it into a .tess, .xyz or a dataset with --parts, which stream)"
+            )
+        })
 }

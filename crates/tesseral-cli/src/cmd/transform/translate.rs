@@ -80,6 +80,7 @@ pub fn translate(args: TranslateArgs) -> Result<()> {
             crate::cmd::budget::Budget {
                 max_leaves: None,
                 memory: args.memory,
+                ..Default::default()
             }
             .check_memory(
                 &format!("translating {} in memory", args.input.display()),

@@ -96,10 +96,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     drop(corners);
     let Vertices { keys, groups, .. } = verts;
     let shared = keys.len() as u32;
-    let mut positions: Vec<[f64; 3]> = keys
-        .iter()
-        .map(|(p, _)| p.map(|x| x as f64))
-        .collect();
+    let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
     positions.extend_from_slice(&centres);
     for t in &mut triangles {
         for i in t.iter_mut() {
