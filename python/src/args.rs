@@ -4,7 +4,7 @@
 
 use std::ops::RangeInclusive;
 
-use pyo3::exceptions::{PyOverflowError, PyTypeError};
+use pyo3::exceptions::{PyOverflowError, PyTypeError, PyValueError};
 use pyo3::prelude::*;
 
 /// `obj` as an integer: `Some` when it lies in `range`, `None` when it lies outside
@@ -52,4 +52,77 @@ pub fn ints_within<const N: usize>(
         })?;
     }
     Ok(out)
+}
+
+/// An integer argument as Python gave it: its value when it fits an `i128` (every
+/// `i64` and `u64` does), else its decimal text, so that a value of any size can be
+/// checked against a range and shown. Anything but an integer is pyo3's TypeError
+/// naming the argument, as before.
+#[derive(Clone, Debug)]
+pub enum Int {
+    Fits(i128),
+    Huge(String),
+}
+
+/// The range of `u64`, of counts and seeds.
+pub const U64: RangeInclusive<i128> = 0..=u64::MAX as i128;
+/// The range of `i64`, of voxel coordinates and offsets.
+pub const I64: RangeInclusive<i128> = i64::MIN as i128..=i64::MAX as i128;
+/// What a coordinate triple outside [`I64`] is told.
+pub const I64_RULE: &str = "each of x, y, z must lie in int64 (-2**63 to 2**63 - 1)";
+/// The triple (0, 0, 0), a default.
+pub const ZERO3: (Int, Int, Int) = (Int::Fits(0), Int::Fits(0), Int::Fits(0));
+
+impl<'py> FromPyObject<'py> for Int {
+    fn extract_bound(obj: &Bound<'py, PyAny>) -> PyResult<Self> {
+        match obj.extract::<i128>() {
+            Ok(n) => Ok(Int::Fits(n)),
+            Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => {
+                Ok(Int::Huge(obj.str()?.to_string()))
+            }
+            Err(e) => Err(e),
+        }
+    }
+}
+
+impl std::fmt::Display for Int {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Int::Fits(n) => write!(f, "{n}"),
+            Int::Huge(s) => f.write_str(s),
+        }
+    }
+}
+
+impl Int {
+    /// The value as a `T` when it lies in `range` (a range `T` holds), else the
+    /// ValueError "`name` `value`: `rule`".
+    pub fn within<T: TryFrom<i128>>(
+        &self,
+        name: &str,
+        range: RangeInclusive<i128>,
+        rule: &str,
+    ) -> PyResult<T> {
+        match self {
+            Int::Fits(n) if range.contains(n) => T::try_from(*n).ok(),
+            _ => None,
+        }
+        .ok_or_else(|| PyValueError::new_err(format!("{name} {self}: {rule}")))
+    }
+}
+
+/// The three integers of a triple argument (such as an offset), each in `range`,
+/// else the ValueError "`name` (x, y, z): `rule`".
+pub fn within3<T: TryFrom<i128>>(
+    v: &(Int, Int, Int),
+    name: &str,
+    range: RangeInclusive<i128>,
+    rule: &str,
+) -> PyResult<[T; 3]> {
+    let one = |i: &Int| {
+        i.within(name, range.clone(), rule).map_err(|_| {
+            PyValueError::new_err(format!("{name} ({}, {}, {}): {rule}", v.0, v.1, v.2))
+        })
+    };
+    Ok([one(&v.0)?, one(&v.1)?, one(&v.2)?])
 }

@@ -10,9 +10,10 @@ use tesseral::dynamic::DynamicOctree as Tree;
 use tesseral::io::FormatError;
 use tesseral::occupancy::{OccupancyMap, SensorModel};
 
+use crate::args::Int;
 use crate::arrays::{cells, points, to_array};
 use crate::errors::{borrow, borrow_mut};
-use crate::scans::{check_work, max_range, origin, DEFAULT_MAX_CELLS};
+use crate::scans::{check_work, max_cells, max_range, origin, DEFAULT_MAX_CELLS};
 
 /// An unbounded dynamic octree of voxels (i64 coordinates), with its count of
 /// exposed faces (the surface area) kept as voxels come and go.
@@ -131,11 +132,12 @@ impl DynamicOctree {
         origin: &Bound<'py, PyAny>,
         points: &Bound<'py, PyAny>,
         max_range: Option<f64>,
-        max_cells: u64,
+        max_cells: Int,
     ) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
         let (o, pts) = (self::origin(origin)?, self::points(points, "points")?);
         let max_range = self::max_range(max_range)?;
+        let max_cells = self::max_cells(&max_cells)?;
         // One scan in a fresh map at unit resolution: hit cells end with a positive
         // log-odds and crossed ones with a negative one.
         let mut map = OccupancyMap::new(1.0, SensorModel::octomap())

@@ -7,6 +7,7 @@ use pyo3::prelude::*;
 mod args;
 mod arrays;
 mod calc;
+mod dataset;
 mod dynamic;
 mod errors;
 mod motion;

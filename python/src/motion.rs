@@ -7,7 +7,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use tesseral::motion::{self, Placement, PlanOptions, Rotation};
 
+use crate::args::{within3, Int, I64, I64_RULE, ZERO3};
 use crate::errors;
+
+const I64_MAX: i128 = i64::MAX as i128;
 use crate::octree::Octree;
 
 fn rotation(text: &str) -> PyResult<Rotation> {
@@ -19,26 +22,32 @@ fn rotation(text: &str) -> PyResult<Rotation> {
 /// `turns`, such as "z90"), meets A: a dict with intersects, overlap_voxels and
 /// clearance (None when a solid is empty).
 #[pyfunction]
-#[pyo3(signature = (a, b, offset = (0, 0, 0), turns = ""))]
+#[pyo3(signature = (a, b, offset = ZERO3, turns = ""), text_signature = "(a, b, offset=(0, 0, 0), turns=\"\")")]
 pub fn collide<'py>(
     py: Python<'py>,
     a: &Octree,
     b: &Octree,
-    offset: (i64, i64, i64),
+    offset: (Int, Int, Int),
     turns: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let offset: [i64; 3] = within3(&offset, "offset", I64, I64_RULE)?;
     let framed = a
         .model
         .frame
         .offset_to(&b.model.frame)
         .map_err(errors::octree)?;
+    let mut moved = [0; 3];
+    for ((m, o), f) in moved.iter_mut().zip(offset).zip(framed) {
+        // Refused past int64, not wrapped round.
+        *m = o.checked_add(f).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "offset {offset:?}: with b's frame offset {framed:?} from a's it lies past int64"
+            ))
+        })?;
+    }
     let place = Placement {
         rotation: rotation(turns)?,
-        offset: [
-            offset.0 + framed[0],
-            offset.1 + framed[1],
-            offset.2 + framed[2],
-        ],
+        offset: moved,
     };
     let (ta, tb) = (&a.model.tree, &b.model.tree);
     let (hit, gap) = py.allow_threads(|| {
@@ -60,35 +69,33 @@ pub fn collide<'py>(
 /// A negative `margin`, or a planning region too large to search (past 2**21
 /// voxels a side), raises ValueError.
 #[pyfunction]
-#[pyo3(signature = (env, obj, start, goal, margin = 0, turns = "", rotations = false))]
+#[pyo3(signature = (env, obj, start, goal, margin = Int::Fits(0), turns = "", rotations = false),
+    text_signature = "(env, obj, start, goal, margin=0, turns=\"\", rotations=False)")]
 #[allow(clippy::too_many_arguments)]
 pub fn plan<'py>(
     py: Python<'py>,
     env: &Octree,
     obj: &Octree,
-    start: (i64, i64, i64),
-    goal: (i64, i64, i64),
-    margin: i64,
+    start: (Int, Int, Int),
+    goal: (Int, Int, Int),
+    margin: Int,
     turns: &str,
     rotations: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
+    let from: [i64; 3] = within3(&start, "start", I64, I64_RULE)?;
+    let to: [i64; 3] = within3(&goal, "goal", I64, I64_RULE)?;
+    let margin: i64 = margin.within("margin", 0..=I64_MAX, "expected 0 to 2**63 - 1 voxels")?;
     let placed = env
         .model
         .frame
         .offset_to(&obj.model.frame)
         .map_err(errors::octree)?;
     let obj_tree = obj.model.tree.translate(placed).map_err(errors::octree)?;
-    if margin < 0 {
-        return Err(PyValueError::new_err(format!(
-            "margin {margin}: expected 0 or more voxels"
-        )));
-    }
     let opts = PlanOptions {
         rotation: rotation(turns)?,
         margin,
         ..PlanOptions::default()
     };
-    let (from, to) = ([start.0, start.1, start.2], [goal.0, goal.1, goal.2]);
     let e = &env.model.tree;
     let d = PyDict::new(py);
     if rotations {

@@ -8,11 +8,12 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::occupancy::{CellState, OccupancyMap as Map, SensorModel};
 
+use crate::args::Int;
 use crate::arrays::{cells, check_cell, points};
 use crate::errors::{borrow, borrow_mut};
 use crate::octree::Octree;
 use crate::scans::DEFAULT_MAX_CELLS;
-use crate::scans::{at_scan, check_work, max_range, origin, scan_pair, stats_dict};
+use crate::scans::{at_scan, check_work, max_cells, max_range, origin, scan_pair, stats_dict};
 
 /// An unbounded occupancy map (unknown / free / occupied cells with log-odds), built
 /// from range scans with OctoMap's `insertPointCloud` semantics and sensor model.
@@ -71,11 +72,12 @@ impl OccupancyMap {
         origin: &Bound<'py, PyAny>,
         points: &Bound<'py, PyAny>,
         max_range: Option<f64>,
-        max_cells: u64,
+        max_cells: Int,
     ) -> PyResult<Bound<'py, PyDict>> {
         let py = slf.py();
         let (o, pts) = (self::origin(origin)?, self::points(points, "points")?);
         let max_range = self::max_range(max_range)?;
+        let max_cells = self::max_cells(&max_cells)?;
         let mut this = borrow_mut(slf, WHAT)?;
         check_work(&this.map, o, &pts, max_range, max_cells)?;
         let m = &mut this.map;
@@ -98,10 +100,11 @@ impl OccupancyMap {
         slf: &Bound<'py, Self>,
         scans: &Bound<'py, PyAny>,
         max_range: Option<f64>,
-        max_cells: u64,
+        max_cells: Int,
     ) -> PyResult<Vec<Bound<'py, PyDict>>> {
         let py = slf.py();
         let max_range = self::max_range(max_range)?;
+        let max_cells = self::max_cells(&max_cells)?;
         let items = scans.try_iter().map_err(|_| {
             pyo3::exceptions::PyTypeError::new_err(format!(
                 "scans: expected an iterable of (origin, points) pairs, got {}",

@@ -9,6 +9,7 @@ use pyo3::types::{PyBytes, PyDict};
 use tesseral::linear::{Axis, LinearOctree, SetOp};
 use tesseral::model::{Frame, Model};
 
+use crate::args::{int_within, within3, Int, I64, I64_RULE, ZERO3};
 use crate::arrays::{cells, check_cell, mask3, points, to_array};
 use crate::errors;
 
@@ -93,20 +94,31 @@ impl Octree {
     /// element [0, 0, 0] at voxel `origin`. Another dtype (integers too) is a
     /// TypeError, another number of dimensions a ValueError.
     #[staticmethod]
-    #[pyo3(signature = (mask, origin = (0, 0, 0)))]
+    #[pyo3(signature = (mask, origin = ZERO3), text_signature = "(mask, origin=(0, 0, 0))")]
     fn from_dense(
         py: Python<'_>,
         mask: &Bound<'_, PyAny>,
-        origin: (i64, i64, i64),
+        origin: (Int, Int, Int),
     ) -> PyResult<Octree> {
+        let o: [i64; 3] = within3(&origin, "origin", I64, I64_RULE)?;
         let mask = mask3(mask, "mask")?;
         let a = mask.as_array();
-        let o = [origin.0, origin.1, origin.2];
+        // A voxel past int64 (origin near its end) is refused, not wrapped round.
+        let at = |o: i64, i: usize| i64::try_from(i).ok().and_then(|i| o.checked_add(i));
         let v: Vec<[i64; 3]> = a
             .indexed_iter()
             .filter(|(_, &b)| b)
-            .map(|((x, y, z), _)| [o[0] + x as i64, o[1] + y as i64, o[2] + z as i64])
-            .collect();
+            .map(
+                |((x, y, z), _)| match (at(o[0], x), at(o[1], y), at(o[2], z)) {
+                    (Some(x), Some(y), Some(z)) => Ok([x, y, z]),
+                    _ => Err(PyValueError::new_err(format!(
+                        "origin ({}, {}, {}): the true element [{x}, {y}, {z}] lies past int64 \
+                     from it",
+                        o[0], o[1], o[2]
+                    ))),
+                },
+            )
+            .collect::<PyResult<_>>()?;
         let tree = py
             .allow_threads(|| LinearOctree::from_voxels_fitted(&v))
             .map_err(errors::octree)?;
@@ -122,7 +134,7 @@ impl Octree {
             return py
                 .allow_threads(|| tesseral::partition::read_dataset_model(&path))
                 .map(Octree::new)
-                .map_err(crate::partition::partition_error);
+                .map_err(crate::dataset::partition_error);
         }
         py.allow_threads(|| tesseral::io::read_model(&path))
             .map(Octree::new)
@@ -314,15 +326,23 @@ impl Octree {
     }
 
     /// Moved by a whole number of voxels (x, y, z); the frame is kept.
-    fn translate(&self, py: Python<'_>, v: (i64, i64, i64)) -> PyResult<Octree> {
+    fn translate(&self, py: Python<'_>, v: (Int, Int, Int)) -> PyResult<Octree> {
+        let v: [i64; 3] = within3(&v, "v", I64, I64_RULE)?;
         let m = &self.model;
-        py.allow_threads(|| m.translate([v.0, v.1, v.2]))
+        py.allow_threads(|| m.translate(v))
             .map(Octree::new)
             .map_err(errors::octree)
     }
 
-    /// Quarter turns about 'x', 'y' or 'z' within the space (as `tesseral rotate`).
-    fn rotate(&self, axis_name: &str, turns: i32) -> PyResult<Octree> {
+    /// Quarter turns about 'x', 'y' or 'z' within the space (as `tesseral rotate`):
+    /// any integer, taken modulo 4.
+    fn rotate(&self, axis_name: &str, turns: &Bound<'_, PyAny>) -> PyResult<Octree> {
+        // Modulo 4 here, as the library takes it, so that a count of any size is the
+        // rotation it names (was pyo3's OverflowError past i32).
+        let turns = match int_within(turns, "turns", i64::MIN..=i64::MAX)? {
+            Some(n) => n.rem_euclid(4),
+            None => turns.rem(4)?.extract::<i64>()?,
+        } as i32;
         self.model
             .rotate_in_space(axis(axis_name)?, turns)
             .map(Octree::new)
@@ -340,11 +360,14 @@ impl Octree {
     /// Scaled by an integer, or by one integer per axis (kx, ky, kz); a negative
     /// factor mirrors. Exact.
     fn scale(&self, py: Python<'_>, k: &Bound<'_, PyAny>) -> PyResult<Octree> {
-        let f: [i64; 3] = if let Ok(n) = k.extract::<i64>() {
-            [n; 3]
+        let f: [i64; 3] = if let Ok(n) = k.extract::<Int>() {
+            [n.within(
+                "k",
+                I64,
+                "the factor must lie in int64 (-2**63 to 2**63 - 1)",
+            )?; 3]
         } else {
-            let t: (i64, i64, i64) = k.extract()?;
-            [t.0, t.1, t.2]
+            within3(&k.extract()?, "k", I64, I64_RULE)?
         };
         let m = &self.model;
         py.allow_threads(|| m.scale_axes(f))

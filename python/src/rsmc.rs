@@ -9,7 +9,10 @@ use tesseral::dynamic::DynamicOctree;
 use tesseral::rsmc::{topology, Chain, Counters, DenseLattice, Lattice, Params, Sample};
 use tesseral::Voxel;
 
+use crate::args::{Int, U64};
 use crate::arrays::{cells, to_array};
+
+const U64_MAX: i128 = u64::MAX as i128;
 
 /// The most rows a trajectory may hold, so that `steps / sample_every` is a budget
 /// checked before the run.
@@ -54,24 +57,32 @@ fn run<L: Lattice>(
 /// `sample_every` steps and one at the start, plus `voxels` (the final N×3 solid),
 /// `faces` (its plaquette count), `counters` (a dict) and `seconds`.
 #[pyfunction]
-#[pyo3(signature = (steps = 100_000, beta = 0.0, mu = 0.0, max_area = None, seed = 1,
-    start = None, libes = false, sample_every = 1000, backend = "octree"))]
+#[pyo3(signature = (steps = Int::Fits(100_000), beta = 0.0, mu = 0.0, max_area = None,
+    seed = Int::Fits(1), start = None, libes = false, sample_every = Int::Fits(1000),
+    backend = "octree"),
+    text_signature = "(steps=100000, beta=0.0, mu=0.0, max_area=None, seed=1, start=None, \
+    libes=False, sample_every=1000, backend=\"octree\")")]
 #[allow(clippy::too_many_arguments)]
 pub fn rsmc<'py>(
     py: Python<'py>,
-    steps: u64,
+    steps: Int,
     beta: f64,
     mu: f64,
-    max_area: Option<u64>,
-    seed: u64,
+    max_area: Option<Int>,
+    seed: Int,
     start: Option<&Bound<'py, PyAny>>,
     libes: bool,
-    sample_every: u64,
+    sample_every: Int,
     backend: &str,
 ) -> PyResult<Bound<'py, PyDict>> {
-    if sample_every == 0 {
-        return Err(PyValueError::new_err("sample_every must be at least 1"));
-    }
+    // Checked here, not converted by pyo3, whose OverflowError names neither.
+    let steps: u64 = steps.within("steps", U64, "expected 0 to 2**64 - 1")?;
+    let seed: u64 = seed.within("seed", U64, "expected 0 to 2**64 - 1")?;
+    let sample_every: u64 =
+        sample_every.within("sample_every", 1..=U64_MAX, "expected 1 to 2**64 - 1")?;
+    let max_area: Option<u64> = max_area
+        .map(|m| m.within("max_area", U64, "expected None or 6 to 2**64 - 1 faces"))
+        .transpose()?;
     if steps / sample_every > MAX_ROWS {
         return Err(PyValueError::new_err(format!(
             "steps / sample_every gives more than {MAX_ROWS} rows; raise sample_every"

@@ -6,8 +6,10 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use tesseral::occupancy::{OccupancyMap as Map, ScanStats};
 
+use crate::args::{Int, U64};
+
 /// The default of `max_cells`: as the CLI's `--max-cells`.
-pub(crate) const DEFAULT_MAX_CELLS: u64 = 10_000_000_000;
+pub(crate) const DEFAULT_MAX_CELLS: Int = Int::Fits(10_000_000_000);
 
 /// `n` finite numbers from any sequence of them (a tuple, a list, an array), named
 /// `name` in errors: TypeError when it is not `n` numbers, ValueError when one is NaN
@@ -43,6 +45,12 @@ pub(crate) fn max_range(r: Option<f64>) -> PyResult<Option<f64>> {
         ))),
         _ => Ok(r),
     }
+}
+
+/// `max_cells` checked: 0 to 2**64 - 1 (ValueError naming it outside, however
+/// large, not pyo3's OverflowError).
+pub(crate) fn max_cells(m: &Int) -> PyResult<u64> {
+    m.within("max_cells", U64, "expected 0 to 2**64 - 1 cells")
 }
 
 /// Refuses a scan whose rays may cross more than `max_cells` cells, before any is

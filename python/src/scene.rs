@@ -10,7 +10,7 @@ use tesseral::csg::Scene as CsgScene;
 use tesseral::model::Model;
 use tesseral::render::{self as draw, Camera, Image, Projection, RenderOptions, View};
 
-use crate::args::{int_within, ints_within};
+use crate::args::{int_within, ints_within, Int};
 use crate::errors;
 use crate::occupancy::OccupancyMap;
 use crate::octree::Octree;
@@ -125,6 +125,14 @@ impl Scene {
         }
         Ok(s)
     }
+}
+
+/// A scene depth argument, 1 to 16 (ValueError naming `depth` outside, however
+/// far), or None for the scene's own.
+pub fn scene_depth(depth: Option<&Int>) -> PyResult<Option<u8>> {
+    depth
+        .map(|d| d.within("depth", 1..=16, "expected 1 to 16"))
+        .transpose()
 }
 
 /// The render options a Python call can give.

@@ -331,8 +331,8 @@ def build(scene: Union[Scene, str, "os.PathLike[str]"], depth: Union[int, None] 
     colours on the part's voxels (those the CLI's dataset parts hold)."""
     if not isinstance(scene, Scene):
         scene = Scene.read(os.fspath(scene))
-    if not isinstance(parts, int) or parts < 1:
-        raise ValueError(f"parts={parts!r}: expected a positive integer")
+    if not isinstance(parts, int) or not 1 <= parts < 2**64:
+        raise ValueError(f"parts={parts!r}: expected a positive integer (below 2**64)")
     ranges = _ext.partition_scene_ranges(scene, depth, parts)
     s = dask.delayed(scene)
     octrees = [dask.delayed(_build_part)(s, depth, lo, hi) for lo, hi in ranges]
@@ -402,6 +402,9 @@ def translate(parts: Parts, offset: Tuple[int, int, int], **compute_kwargs: Any)
     by = tuple(int(c) for c in offset)
     if len(by) != 3:
         raise ValueError(f"offset {offset!r}: expected three integers (x, y, z)")
+    if not all(-(2**63) <= c < 2**63 for c in by):
+        raise ValueError(f"offset {offset!r}: each of x, y, z must lie in int64 "
+                         "(-2**63 to 2**63 - 1)")
     kept = parts.persist(**compute_kwargs)
     k = len(kept)
     first = kept.octrees[0]
