@@ -124,6 +124,12 @@ fn flags_out_of_place_or_range_are_refused() {
         &[&turn[..], &["--roundtrip"]].concat(),
         "--roundtrip applies only with --degrees",
     );
+    for parts in ["0", "65537", "18446744073709551615"] {
+        refused(
+            &["build", "s.tss", "-o", "ds", "--parts", parts],
+            "from 1 to 65536",
+        );
+    }
     for depth in ["0", "17"] {
         refused(
             &["build", "s.tss", "-o", "b.tess", "--depth", depth],

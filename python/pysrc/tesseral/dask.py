@@ -331,8 +331,8 @@ def build(scene: Union[Scene, str, "os.PathLike[str]"], depth: Union[int, None] 
     colours on the part's voxels (those the CLI's dataset parts hold)."""
     if not isinstance(scene, Scene):
         scene = Scene.read(os.fspath(scene))
-    if not isinstance(parts, int) or not 1 <= parts < 2**64:
-        raise ValueError(f"parts={parts!r}: expected a positive integer (below 2**64)")
+    if not isinstance(parts, int) or not 1 <= parts <= 65536:
+        raise ValueError(f"parts={parts!r}: expected a number of parts from 1 to 65536")
     ranges = _ext.partition_scene_ranges(scene, depth, parts)
     s = dask.delayed(scene)
     octrees = [dask.delayed(_build_part)(s, depth, lo, hi) for lo, hi in ranges]

@@ -31,7 +31,7 @@ pub struct Args {
     /// Build into a partitioned dataset of K parts of about equal work: OUTPUT is a
     /// directory of `.tess` parts and a `manifest.json` (see docs/scale.md), each
     /// part streamed as with --stream.
-    #[arg(long, value_name = "K")]
+    #[arg(long, value_name = "K", value_parser = parse_parts)]
     parts: Option<usize>,
     /// Build at this depth (1 to 16) instead of the scene's: the same space, voxels
     /// 2^k times smaller or larger.
@@ -41,6 +41,19 @@ pub struct Args {
     limits: octree::OutArgs,
     #[command(flatten)]
     budget: Budget,
+}
+
+/// The most parts of a dataset (`--parts`): each is a file.
+pub const MAX_PARTS: usize = 1 << 16;
+
+/// Parses `--parts K`: 1 to [`MAX_PARTS`].
+pub fn parse_parts(s: &str) -> Result<usize, String> {
+    match s.trim().parse::<usize>() {
+        Ok(k) if (1..=MAX_PARTS).contains(&k) => Ok(k),
+        _ => Err(format!(
+            "`{s}`: give a number of parts from 1 to {MAX_PARTS}"
+        )),
+    }
 }
 
 pub fn run(args: Args) -> Result<()> {

@@ -59,7 +59,7 @@ pub struct Args {
     /// Write a partitioned dataset of K parts of about equal leaf counts: OUTPUT is
     /// a directory of `.tess` parts and a `manifest.json` (as `build --parts`). From
     /// a `.tess` file or a dataset it streams.
-    #[arg(long, value_name = "K", conflicts_with_all = ["smooth", "format"])]
+    #[arg(long, value_name = "K", value_parser = super::build::parse_parts, conflicts_with_all = ["smooth", "format"])]
     pub parts: Option<usize>,
     /// Print a summary as JSON.
     #[arg(long)]

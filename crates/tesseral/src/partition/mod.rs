@@ -114,11 +114,13 @@ fn check_tiling(depth: u8, parts: &[Partition]) -> Result<(), PartitionError> {
 #[must_use]
 pub fn balanced_ranges(depth: u8, k: usize, weights: &[Range<u64>]) -> Vec<Partition> {
     let end = 1u64 << (3 * u32::from(depth));
-    let k = k.max(1);
-    let mut cuts = vec![0u64];
     let n = weights.len();
+    // A cut falls at a weight's start: more parts than weights cannot be cut.
+    let k = k.clamp(1, n.max(1));
+    let mut cuts = vec![0u64];
     for j in 1..k {
-        let i = j * n / k;
+        // In 128 bits: j · n passes 2^64 for a few billion weights.
+        let i = (j as u128 * n as u128 / k as u128) as usize;
         if i == 0 || i >= n {
             continue;
         }

@@ -335,3 +335,21 @@ fn streamed_set_operations_keep_colours_as_in_memory() {
         }
     }
 }
+
+/// More parts asked than there are weights to cut at: as many ranges as can be
+/// cut, tiling the space, at once (a loop to `k` with `j · k` in 64 bits hung or
+/// wrapped for a `k` near 2^64).
+#[test]
+fn balanced_ranges_cap_the_parts_at_the_weights() {
+    let weights: Vec<std::ops::Range<u64>> = (0..10u64).map(|i| i * 100..i * 100 + 50).collect();
+    for k in [1, 3, 10, 11, 1 << 40, usize::MAX] {
+        let ranges = balanced_ranges(4, k, &weights);
+        assert!(ranges.len() <= k.min(10), "k {k}: {} ranges", ranges.len());
+        assert_eq!(ranges[0].lo, 0);
+        assert_eq!(ranges.last().unwrap().hi, 1 << 12);
+        assert!(ranges
+            .windows(2)
+            .all(|w| w[0].hi == w[1].lo && w[0].lo < w[0].hi));
+    }
+    assert_eq!(balanced_ranges(4, usize::MAX, &weights).len(), 10);
+}
