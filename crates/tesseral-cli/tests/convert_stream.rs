@@ -227,7 +227,7 @@ fn convert_parts_replaces_datasets_and_guards_inputs() {
     fails(
         d,
         &["convert", "a.tess", "-o", "z", "--parts", "0"],
-        "--parts 0",
+        "from 1 to 65536",
     );
     assert_eq!(
         names(d),

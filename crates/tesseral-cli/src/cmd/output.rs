@@ -260,8 +260,14 @@ pub fn check_size(output: &Path, estimate: u64, limit: u64) -> Result<()> {
         } else {
             ", or choose a more compact format such as .tess"
         };
+        // The exact count only where the rounded one hides it.
+        let exact = if estimate < 1024 {
+            String::new()
+        } else {
+            format!(" ({estimate} bytes)")
+        };
         bail!(
-            "{}: the output would be about {} ({estimate} bytes), more than the limit of {}; \
+            "{}: the output would be about {}{exact}, more than the limit of {}; \
              raise it with --max-output (e.g. --max-output {}){compact}",
             output.display(),
             human_bytes(estimate),
@@ -272,8 +278,12 @@ pub fn check_size(output: &Path, estimate: u64, limit: u64) -> Result<()> {
     Ok(())
 }
 
-/// A `--max-output` value just above `bytes`, in whole GiB or TiB.
+/// A `--max-output` value just above `bytes`, in whole MiB, GiB or TiB.
 fn suggest(bytes: u64) -> String {
+    let mib = bytes.div_ceil(1 << 20);
+    if mib < 1024 {
+        return format!("{mib}M");
+    }
     let gib = bytes.div_ceil(1 << 30);
     if gib < 1024 {
         format!("{gib}G")
@@ -370,11 +380,21 @@ mod tests {
     fn a_refused_size_suggests_tess_only_for_other_formats() {
         let err = |name: &str| check_size(Path::new(name), 10, 5).unwrap_err().to_string();
         assert!(err("big.xyz")
-            .contains("--max-output 1G), or choose a more compact format such as .tess"));
+            .contains("--max-output 1M), or choose a more compact format such as .tess"));
         assert!(
-            err("big.tess").ends_with("--max-output 1G)"),
+            err("big.tess").ends_with("--max-output 1M)"),
             "{}",
             err("big.tess")
+        );
+        // Small sizes once; large ones with the exact count; the suggestion in
+        // the unit that fits.
+        assert!(err("big.tess").contains("about 10 bytes, more"));
+        let big = check_size(Path::new("a.tess"), 3 << 30, 1 << 30)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            big.contains("about 3.0 GiB (3221225472 bytes)") && big.ends_with("--max-output 3G)"),
+            "{big}"
         );
         assert!(check_size(Path::new("big.tess"), 5, 5).is_ok());
     }

@@ -64,7 +64,7 @@ fn the_map_is_a_model_with_its_frame() {
     assert!(out
         .stdout
         .starts_with(&fs::read(d.join("map.tess")).unwrap()[..4]));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("wrote -"));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("wrote <stdout>"));
 }
 
 #[test]

@@ -333,7 +333,11 @@ fn run_holding(args: Args, budget: usize) -> Result<()> {
         };
         let line = format!(
             "wrote {}: {}, {}{skipped}, {} in {:.3} s ({:.3} M rays/s); {} occupied and {} free cells in {}, {} in memory",
-            args.output.display(),
+            if super::output::is_stdio(&args.output) {
+                "<stdout>".to_string()
+            } else {
+                args.output.display().to_string()
+            },
             plural(t.scans, "scan", "scans"),
             plural(t.points, "point", "points"),
             plural(t.rays, "ray", "rays"),
