@@ -128,6 +128,13 @@ fn completions_man_and_grouped_help() {
             script.contains("translate") && script.contains("max-output"),
             "{shell}"
         );
+        // Values from a fixed list complete as those values (render --view).
+        let listed = if shell == "fish" {
+            script.contains("iso\\t") && script.contains("side\\t")
+        } else {
+            script.contains("iso front top side")
+        };
+        assert!(listed, "{shell}: --view");
     }
     fails(d, &["completions", "cmd.exe"], "invalid value");
     let page = expect_success(&run(d, &["man"]));

@@ -29,7 +29,7 @@ pub struct Args {
     #[arg(long, default_value = "800x600", value_parser = output::parse_size)]
     size: Size,
     /// A named view: iso, front, top or side.
-    #[arg(long, default_value = "iso")]
+    #[arg(long, default_value = "iso", value_parser = ["iso", "front", "top", "side"])]
     view: String,
     /// Azimuth in degrees (from +x towards +y), overriding the view's.
     #[arg(long, allow_negative_numbers = true)]

@@ -14,6 +14,7 @@ pub use translate::{translate, TranslateArgs};
 
 /// Arguments of `tesseral rotate`.
 #[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("angle").required(true).args(["turns", "degrees"])))]
 pub struct RotateArgs {
     /// The input octree file.
     input: PathBuf,
@@ -22,12 +23,7 @@ pub struct RotateArgs {
     axis: [f64; 3],
     /// Quarter turns, right-handed (about z, +x goes to +y); negative allowed. Exact,
     /// within the space.
-    #[arg(
-        long,
-        allow_hyphen_values = true,
-        required_unless_present = "degrees",
-        conflicts_with = "degrees"
-    )]
+    #[arg(long, allow_hyphen_values = true)]
     turns: Option<i32>,
     /// Any angle in degrees, right-handed, by point sampling at voxel centres (see
     /// docs/octrees.md); reports the fragmentation (leaves before and after) on stderr.

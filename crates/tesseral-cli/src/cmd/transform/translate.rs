@@ -22,13 +22,13 @@ pub enum Method {
 
 /// Arguments of `tesseral translate`.
 #[derive(clap::Args)]
+#[command(group(clap::ArgGroup::new("displacement").required(true).args(["by", "by_world"])))]
 pub struct TranslateArgs {
     /// The input octree file.
     input: PathBuf,
     /// The displacement `DX,DY,DZ` in voxels (negative allowed: `--by=-4,-50,0` or
     /// `--by -4,-50,0`). The frame is kept, so the world moves by DX·voxel size.
-    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true,
-          required_unless_present = "by_world", conflicts_with = "by_world")]
+    #[arg(long, value_parser = octree::parse_vector, allow_hyphen_values = true)]
     by: Option<[i64; 3]>,
     /// The displacement `X,Y,Z` in world units (metres for an OctoMap map); it must be
     /// a whole number of voxels.
