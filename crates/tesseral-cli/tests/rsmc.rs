@@ -59,6 +59,7 @@ fn json_summary_and_output_files() {
     }
     assert_eq!(v["steps"], 20000);
     assert_eq!(v["euler"], 2);
+    assert_eq!(v["output"], v["out"]);
     let o = dir.path().join("o");
     let rows = csv_rows(&o.join("series.csv"));
     assert_eq!(rows.len(), 21, "a row at 0 and every 1000 steps");

@@ -42,6 +42,7 @@ fn a_scene_makes_a_page_with_its_voxels_and_colours() {
     let size = std::fs::metadata(&page).unwrap().len();
     assert_eq!(out["page_bytes"].as_u64(), Some(size));
     assert_eq!(out["shown_depth"], out["depth"]);
+    assert_eq!(out["colors"], out["colours"]);
     let render = json(
         d,
         &["render", tank, "-o", "t.png", "--size", "32x32", "--json"],

@@ -476,6 +476,8 @@ fn simulate<L: Lattice>(args: Args) -> Result<()> {
             "seed": chain.seed(),
             "backend": args.backend,
             "out": args.out.display().to_string(),
+            // The key every other command uses for its output; `out` kept.
+            "output": args.out.display().to_string(),
         });
         crate::outln!("{summary}")?;
     } else {

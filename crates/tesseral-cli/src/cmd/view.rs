@@ -101,6 +101,8 @@ pub fn run(args: Args) -> Result<()> {
             "voxels": frame.voxels,
             "entries": page.entries().len(),
             "colours": page.palette().colours().len(),
+            // The spelling of every other command's key; `colours` kept.
+            "colors": page.palette().colours().len(),
             "load_ms": load_ms,
             "pack_ms": pack_ms,
         });
