@@ -169,12 +169,15 @@ impl super::Scene {
     /// `2^(self.depth - depth)` times the size.
     ///
     /// # Errors
-    /// [`super::SceneError::Build`] for a depth above the scene limit.
+    /// [`super::SceneError::Build`] for a depth outside 1 to the scene limit (16).
     pub fn with_depth(mut self, depth: u8) -> Result<Self, super::SceneError> {
-        if depth > super::scene::MAX_SCENE_DEPTH {
+        let max = super::scene::MAX_SCENE_DEPTH;
+        if depth == 0 || depth > max {
             return Err(super::SceneError::Build {
                 path: self.path.clone(),
-                source: CsgError::Octree(crate::linear::OctreeError::DepthTooLarge(depth)),
+                source: CsgError::Octree(crate::linear::OctreeError::InvalidArgument(format!(
+                    "depth {depth}: a scene's depth is 1 to {max}"
+                ))),
             });
         }
         self.voxel *= 2f64.powi(i32::from(self.depth) - i32::from(depth));

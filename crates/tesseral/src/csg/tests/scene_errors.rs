@@ -429,3 +429,23 @@ fn caret_sits_under_the_fault() {
     assert_eq!(lines[3], "  |                        ^^^^^");
     assert_eq!(lines[4], "  = hint: did you mean \"red\"?");
 }
+
+/// `Scene::with_depth` takes the scene grammar's depths, 1 to 16, and names the
+/// range when refused (it said "exceeds the maximum of 21" for 17 and took 0).
+#[test]
+fn with_depth_names_the_scene_range() {
+    let scene = Scene::parse(
+        "depth 4\nbox(size = [4, 4, 4])\n",
+        std::path::Path::new("s.tss"),
+    )
+    .unwrap();
+    for bad in [0, 17, 30] {
+        let err = scene.clone().with_depth(bad).unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("depth {bad}: a scene's depth is 1 to 16")),
+            "{err}"
+        );
+    }
+    let deeper = scene.with_depth(16).unwrap();
+    assert_eq!(deeper.depth, 16);
+}
