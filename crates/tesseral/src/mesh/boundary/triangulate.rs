@@ -25,31 +25,37 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
         ids: FxHashMap::default(),
         keys: Vec::new(),
     };
-    // Corners first: they are the vertices every side must include.
+    // Corners first: they are the vertices every side must include. Each
+    // rectangle's four corner ids are kept for its polygon below.
     let mut corners: FxHashSet<Voxel> = FxHashSet::default();
+    let mut corner_ids: Vec<[u32; 4]> = Vec::with_capacity(rects.len());
     for r in &rects {
-        for (pu, pv) in [(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)] {
+        let mut ids = [0u32; 4];
+        for (k, (pu, pv)) in [(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)]
+            .into_iter()
+            .enumerate()
+        {
             let p = point(r, pu, pv);
             let g = verts.group(r, p);
-            verts.id((p, g));
+            ids[k] = verts.id((p, g));
             corners.insert(p);
         }
+        corner_ids.push(ids);
     }
     let mut triangles = Vec::with_capacity(2 * rects.len());
     let mut centres: Vec<[f64; 3]> = Vec::new();
     let mut poly: Vec<u32> = Vec::new();
-    for r in &rects {
+    for (r, ids) in rects.iter().zip(&corner_ids) {
         poly.clear();
-        // Counter-clockwise seen from +a: along v0, up u1, back along v1, down u0.
+        // Counter-clockwise seen from +a: along v0, up u1, back along v1, down u0;
+        // each side its first corner, then the points inside it that are vertices
+        // (pinch points, and other rectangles' corners of the same group).
         let mut side =
-            |pts: &mut dyn Iterator<Item = (i64, i64)>, verts: &mut Vertices, first: bool| {
-                for (i, (pu, pv)) in pts.enumerate() {
+            |corner: u32, inside: &mut dyn Iterator<Item = (i64, i64)>, verts: &mut Vertices| {
+                poly.push(corner);
+                for (pu, pv) in inside {
                     let p = point(r, pu, pv);
-                    if i == 0 && !first {
-                        continue;
-                    }
-                    let is_corner = (pu == r.u0 || pu == r.u1) && (pv == r.v0 || pv == r.v1);
-                    if is_corner || verts.is_pinch_point(p) {
+                    if verts.is_pinch_point(p) {
                         let g = verts.group(r, p);
                         poly.push(verts.id((p, g)));
                     } else if corners.contains(&p) {
@@ -60,17 +66,17 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
                     }
                 }
             };
-        side(&mut (r.u0..r.u1).map(|u| (u, r.v0)), &mut verts, true);
-        side(&mut (r.v0..r.v1).map(|v| (r.u1, v)), &mut verts, true);
+        side(ids[0], &mut (r.u0 + 1..r.u1).map(|u| (u, r.v0)), &mut verts);
+        side(ids[1], &mut (r.v0 + 1..r.v1).map(|v| (r.u1, v)), &mut verts);
         side(
-            &mut ((r.u0 + 1)..=r.u1).rev().map(|u| (u, r.v1)),
+            ids[2],
+            &mut (r.u0 + 1..r.u1).rev().map(|u| (u, r.v1)),
             &mut verts,
-            true,
         );
         side(
-            &mut ((r.v0 + 1)..=r.v1).rev().map(|v| (r.u0, v)),
+            ids[3],
+            &mut (r.v0 + 1..r.v1).rev().map(|v| (r.u0, v)),
             &mut verts,
-            true,
         );
         if !r.pos {
             poly.reverse();
@@ -93,7 +99,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     }
     // Only the keys and groups are given back: the rest goes before the positions
     // are made.
-    drop(corners);
+    drop((corners, corner_ids));
     let Vertices { keys, groups, .. } = verts;
     let shared = keys.len() as u32;
     let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
