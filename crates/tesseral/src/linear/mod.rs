@@ -21,6 +21,7 @@ mod leaf;
 mod mapped;
 mod merge;
 mod node_list;
+mod octet;
 mod ops;
 mod resample;
 pub(crate) mod sort;

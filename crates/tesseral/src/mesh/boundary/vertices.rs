@@ -19,20 +19,11 @@ pub(super) struct Vertices<'t> {
 impl Vertices<'_> {
     fn config(&mut self, p: Voxel) -> u8 {
         let tree = self.tree;
-        *self.config.entry(p).or_insert_with(|| {
-            let mut c = 0u8;
-            for o in 0..8 {
-                let v = [
-                    p[0] - 1 + (o & 1),
-                    p[1] - 1 + ((o >> 1) & 1),
-                    p[2] - 1 + ((o >> 2) & 1),
-                ];
-                if tree.contains(v) {
-                    c |= 1 << o;
-                }
-            }
-            c
-        })
+        // Bit o: voxel p − 1 + (o & 1, o >> 1 & 1, o >> 2 & 1) is black.
+        *self
+            .config
+            .entry(p)
+            .or_insert_with(|| tree.octet(p.map(|c| c - 1)))
     }
 
     /// The vertex groups of the 12 faces at `p`. An edge with four boundary faces

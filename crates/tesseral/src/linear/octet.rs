@@ -1,0 +1,101 @@
+//! Eight neighbouring voxels at once: the 2 × 2 × 2 box at a lattice point, as the
+//! boundary mesher asks of every vertex (`mesh::boundary`). One binary search, then
+//! a galloping search forward from the last leaf for each further code in order:
+//! the eight codes are mostly near each other in tesseral order, so the leaves they
+//! land in are mostly the same or next to each other.
+
+use super::LinearOctree;
+use crate::Voxel;
+
+impl LinearOctree {
+    /// Which voxels of the box `lo ..= lo + 1` are black: bit `o` for voxel
+    /// `lo + (o & 1, o >> 1 & 1, o >> 2 & 1)` (voxels outside the space are white),
+    /// as eight calls of [`contains`](Self::contains) would say.
+    ///
+    /// # Runtime
+    /// O(log n) for the first voxel, O(log d) for each further one, d the leaves
+    /// between it and the one before.
+    ///
+    /// ```
+    /// use tesseral::linear::LinearOctree;
+    /// let t = LinearOctree::from_voxels(2, [0, 0, 0], [[1, 1, 1], [2, 1, 1]]).unwrap();
+    /// assert_eq!(t.octet([1, 1, 1]), 0b11);
+    /// assert_eq!(t.octet([0, 0, 0]), 0b1000_0000);
+    /// ```
+    #[must_use]
+    pub fn octet(&self, lo: Voxel) -> u8 {
+        let mut codes = [(u64::MAX, 0u8); 8];
+        let mut n = 0;
+        for o in 0..8u8 {
+            let v = [0, 1, 2].map(|a| lo[a].wrapping_add(i64::from(o >> a & 1)));
+            // `lo + 1` past i64 wraps below the space: outside, white.
+            if (0..3).all(|a| v[a] >= lo[a]) {
+                if let Some(c) = self.code_of(v) {
+                    codes[n] = (c, o);
+                    n += 1;
+                }
+            }
+        }
+        let codes = &mut codes[..n];
+        codes.sort_unstable();
+        let leaves = self.leaves();
+        let mut bits = 0u8;
+        // Every leaf before `from` starts at or below the last code looked up.
+        let mut from = 0;
+        for &(c, o) in codes.iter() {
+            // The first leaf after `from` that starts above `c`, galloping.
+            let mut step = 1;
+            let mut below = from;
+            while below + step < leaves.len() && leaves[below + step].code() <= c {
+                below += step;
+                step *= 2;
+            }
+            let end = (below + step).min(leaves.len());
+            let i = below + leaves[below..end].partition_point(|l| l.code() <= c);
+            if i > 0 && leaves[i - 1].contains_code(c) {
+                bits |= 1 << o;
+            }
+            from = i.saturating_sub(1);
+        }
+        bits
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{Rng, SeedableRng};
+
+    use super::*;
+
+    /// Against eight calls of `contains`, on seeded random trees and boxes that
+    /// reach past the space on every side.
+    #[test]
+    fn octet_agrees_with_contains() {
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(0x0c7e);
+        for round in 0..200 {
+            let depth = rng.random_range(0..=5u8);
+            let side = 1i64 << depth;
+            let origin = [0, 1, 2].map(|_| rng.random_range(-8..8i64));
+            let n = rng.random_range(0..=(side * side * side) as usize);
+            let voxels: Vec<Voxel> = (0..n)
+                .map(|_| [0, 1, 2].map(|a| origin[a] + rng.random_range(0..side)))
+                .collect();
+            let t = LinearOctree::from_voxels(depth, origin, voxels).unwrap();
+            t.assert_valid();
+            for _ in 0..50 {
+                let lo = [0, 1, 2].map(|a| origin[a] + rng.random_range(-2..=side));
+                let mut want = 0u8;
+                for o in 0..8u8 {
+                    let v = [0, 1, 2].map(|a| lo[a] + i64::from(o >> a & 1));
+                    if t.contains(v) {
+                        want |= 1 << o;
+                    }
+                }
+                assert_eq!(t.octet(lo), want, "round {round}, lo {lo:?}");
+            }
+        }
+        // At the top of i64: the box's far voxels wrap, and are white.
+        let t = LinearOctree::from_voxels(0, [i64::MAX; 3], [[i64::MAX; 3]]).unwrap();
+        assert_eq!(t.octet([i64::MAX; 3]), 1);
+    }
+}
