@@ -4,7 +4,7 @@
 //! the eight codes are mostly near each other in tesseral order, so the leaves they
 //! land in are mostly the same or next to each other.
 
-use super::LinearOctree;
+use super::{Leaf, LinearOctree};
 use crate::Voxel;
 
 impl LinearOctree {
@@ -40,24 +40,47 @@ impl LinearOctree {
         codes.sort_unstable();
         let leaves = self.leaves();
         let mut bits = 0u8;
-        // Every leaf before `from` starts at or below the last code looked up.
-        let mut from = 0;
+        // The leaf that held (or preceded) the last code looked up.
+        let mut near = 0;
         for &(c, o) in codes.iter() {
-            // The first leaf after `from` that starts above `c`, galloping.
-            let mut step = 1;
-            let mut below = from;
-            while below + step < leaves.len() && leaves[below + step].code() <= c {
-                below += step;
-                step *= 2;
-            }
-            let end = (below + step).min(leaves.len());
-            let i = below + leaves[below..end].partition_point(|l| l.code() <= c);
+            let i = first_above(leaves, c, near);
             if i > 0 && leaves[i - 1].contains_code(c) {
                 bits |= 1 << o;
             }
-            from = i.saturating_sub(1);
+            near = i.saturating_sub(1);
         }
         bits
+    }
+}
+
+/// The first of `leaves` (sorted by code) whose code is above `c`, as
+/// `partition_point` gives it, found by galloping from index `near` (either way):
+/// O(log d) for d leaves between `near` and the answer.
+pub(crate) fn first_above(leaves: &[Leaf], c: u64, near: usize) -> usize {
+    let n = leaves.len();
+    if n == 0 {
+        return 0;
+    }
+    let near = near.min(n - 1);
+    let mut step = 1;
+    if leaves[near].code() <= c {
+        // leaves[lo] ≤ c: widen until a leaf above c, or the end.
+        let mut lo = near;
+        while lo + step < n && leaves[lo + step].code() <= c {
+            lo += step;
+            step *= 2;
+        }
+        let hi = (lo + step).min(n);
+        lo + 1 + leaves[lo + 1..hi].partition_point(|l| l.code() <= c)
+    } else {
+        // leaves[hi] > c: widen down until a leaf at or below c, or the start.
+        let mut hi = near;
+        while hi >= step && leaves[hi - step].code() > c {
+            hi -= step;
+            step *= 2;
+        }
+        let lo = hi.saturating_sub(step);
+        lo + leaves[lo..hi].partition_point(|l| l.code() <= c)
     }
 }
 
@@ -92,6 +115,23 @@ mod tests {
                     }
                 }
                 assert_eq!(t.octet(lo), want, "round {round}, lo {lo:?}");
+            }
+        }
+        // first_above from every start, against partition_point.
+        for _ in 0..200 {
+            let depth = rng.random_range(0..=4u8);
+            let side = 1i64 << depth;
+            let voxels: Vec<Voxel> = (0..rng.random_range(0..40))
+                .map(|_| [0, 1, 2].map(|_| rng.random_range(0..side)))
+                .collect();
+            let t = LinearOctree::from_voxels(depth, [0, 0, 0], voxels).unwrap();
+            let leaves = t.leaves();
+            let end = 1u64 << (3 * u32::from(depth));
+            for c in (0..end).step_by(rng.random_range(1..4)) {
+                let want = leaves.partition_point(|l| l.code() <= c);
+                for near in 0..=leaves.len() + 1 {
+                    assert_eq!(first_above(leaves, c, near), want, "c {c} near {near}");
+                }
             }
         }
         // At the top of i64: the box's far voxels wrap, and are white.

@@ -1,7 +1,7 @@
 //! Step 1: the boundary squares, found top-down against the tree.
 
 use crate::code;
-use crate::linear::LinearOctree;
+use crate::linear::{first_above, LinearOctree};
 use crate::Voxel;
 
 #[derive(Clone, Copy)]
@@ -22,8 +22,9 @@ enum Region {
 }
 
 /// Classifies the cube of side `2^k` at `min` (aligned in the tree's space, or wholly
-/// outside it) against the tree.
-fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8) -> Region {
+/// outside it) against the tree, searching from leaf `near` (the block whose face
+/// it is across: its neighbours are mostly near it in code order).
+fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8, near: usize) -> Region {
     let side = tree.side() as i64;
     let o = tree.origin();
     let mut rel = [0u32; 3];
@@ -37,7 +38,7 @@ fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8) -> Region {
     let c = code::encode(rel[0], rel[1], rel[2]);
     let len = 1u64 << (3 * u32::from(k));
     let leaves = tree.leaves();
-    let i = leaves.partition_point(|l| l.code() <= c);
+    let i = first_above(leaves, c, near);
     if i > 0 && leaves[i - 1].end() > c {
         return if leaves[i - 1].size_log2() >= k {
             Region::Full
@@ -54,31 +55,31 @@ fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8) -> Region {
 
 pub(super) fn boundary_squares(tree: &LinearOctree) -> Vec<Square> {
     let mut out = Vec::new();
-    for b in tree.blocks() {
+    for (near, b) in tree.blocks().enumerate() {
         let s = b.size();
         for a in 0..3 {
             for pos in [false, true] {
                 let mut n = b.min;
                 n[a] += if pos { s } else { -s };
                 let plane = if pos { b.min[a] + s } else { b.min[a] };
-                descend(tree, n, b.size_log2, a, pos, plane, &mut out);
+                descend(tree, (n, b.size_log2), near, (a, pos, plane), &mut out);
             }
         }
     }
     out
 }
 
+/// The boundary squares of the face (axis `a`, side `pos`, at `plane`) across which
+/// lies `cube` (its lowest voxel, its side's log2), searched from leaf `near`.
 fn descend(
     tree: &LinearOctree,
-    cube: Voxel,
-    k: u8,
-    a: usize,
-    pos: bool,
-    plane: i64,
+    (cube, k): (Voxel, u8),
+    near: usize,
+    (a, pos, plane): (usize, bool, i64),
     out: &mut Vec<Square>,
 ) {
     let (u, v) = ((a + 1) % 3, (a + 2) % 3);
-    match classify_cube(tree, cube, k) {
+    match classify_cube(tree, cube, k, near) {
         Region::Full => {}
         Region::Empty => out.push(Square {
             a,
@@ -98,7 +99,7 @@ fn descend(
                     if !pos {
                         m[a] += h;
                     }
-                    descend(tree, m, k - 1, a, pos, plane, out);
+                    descend(tree, (m, k - 1), near, (a, pos, plane), out);
                 }
             }
         }
