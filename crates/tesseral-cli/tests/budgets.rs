@@ -334,3 +334,24 @@ fn an_in_memory_output_counts_its_writing() {
         }
     }
 }
+
+/// An in-memory `op` counts its two operands together (and the result), from
+/// the files' headers before either is read: the depth-9 spheroid twice fits
+/// `--memory 32M` one at a time but not together.
+#[test]
+fn an_in_memory_op_counts_both_operands() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let spheroid = fs::read_to_string(scenes().join("fig4c-spheroid.tss")).unwrap();
+    fs::write(d.join("s9.tss"), spheroid.replace("depth 6", "depth 9")).unwrap();
+    common::ok(d, &["build", "s9.tss", "-o", "a.tess"]);
+    fs::copy(d.join("a.tess"), d.join("b.tess")).unwrap();
+    let op = ["op", "union", "a.tess", "b.tess", "-o", "u.xyz", "--memory"];
+    refused(
+        d,
+        &[&op[..], &["32M"]].concat(),
+        &["a.tess and b.tess together"],
+    );
+    assert!(!d.join("u.xyz").exists());
+    common::ok(d, &[&op[..], &["64M"]].concat());
+}

@@ -58,8 +58,9 @@ pub fn run(args: Args) -> Result<()> {
     if let Some(done) = streamed(&args, op)? {
         return done;
     }
-    // Each operand, with the result and the writing of the output beside it (each
-    // checked alone against --memory: the two together can take up to twice).
+    // The operands' leaves, each with its share of the result (at most their sum)
+    // and of the writing of the output: both files' headers before either is read,
+    // each file as it is read, then the two read.
     let ext = args.limits.format_of(&args.output);
     let budget = super::budget::Budget {
         max_leaves: None,
@@ -70,8 +71,23 @@ pub fn run(args: Args) -> Result<()> {
     for input in [&args.a, &args.b] {
         super::streamed::check_version_1_in_memory(input, &budget)?;
     }
+    let together = format!(
+        "{} and {} together (read whole)",
+        args.a.display(),
+        args.b.display()
+    );
+    let on_disk =
+        |p: &std::path::Path| super::streamed::leaves_on_disk(p).map(Option::unwrap_or_default);
+    budget.check_leaves(
+        &together,
+        on_disk(&args.a)?.saturating_add(on_disk(&args.b)?),
+    )?;
     let a = octree::read_model(&args.a, &budget, &Default::default())?;
     let b = octree::read_model(&args.b, &budget, &Default::default())?;
+    budget.check_leaves(
+        &together,
+        (a.tree.leaf_count() + b.tree.leaf_count()) as u64,
+    )?;
     let r = a.set_op(&b, op).with_context(|| {
         format!(
             "combining {} ({}) and {} ({})",
