@@ -14,9 +14,10 @@ pub fn int_within(
     name: &str,
     range: RangeInclusive<i64>,
 ) -> PyResult<Option<i64>> {
-    match obj.extract::<i64>() {
-        Ok(n) => Ok(range.contains(&n).then_some(n)),
-        Err(e) if e.is_instance_of::<PyOverflowError>(obj.py()) => Ok(None),
+    // Told apart from an integer too large by `Int`'s extraction.
+    match obj.extract::<Int>() {
+        Ok(Int::Fits(n)) => Ok(i64::try_from(n).ok().filter(|n| range.contains(n))),
+        Ok(Int::Huge(_)) => Ok(None),
         Err(_) => Err(PyTypeError::new_err(format!(
             "{name}: expected an integer, got {}",
             obj.repr()

@@ -114,6 +114,17 @@ impl Budget {
         usize::try_from(self.memory / self.bytes_per_leaf()).unwrap_or(usize::MAX)
     }
 
+    /// Whether `--memory` binds the leaf cap `cap` (it allows no more), rather
+    /// than `--max-leaves`.
+    fn memory_binds_at(&self, cap: usize) -> bool {
+        cap >= self.memory_leaf_cap()
+    }
+
+    /// Whether `--memory`, not `--max-leaves`, binds this budget's leaf cap.
+    pub fn memory_binds(&self) -> bool {
+        self.memory_binds_at(self.leaf_cap())
+    }
+
     /// Refuses a model of `leaves` leaves (`what`: the input) over the leaf cap:
     /// a file to be read whole, from its header, or one just read, before the work.
     ///
@@ -129,7 +140,7 @@ impl Budget {
     /// As [`Budget::refuse`], for the cap `cap`: `--memory` binds when it allows no
     /// more than `cap`, else `--max-leaves` (given, or its default).
     pub fn refuse_at(&self, what: &str, leaves: u64, cap: usize) -> anyhow::Error {
-        let (flag, limit) = if cap >= self.memory_leaf_cap() {
+        let (flag, limit) = if self.memory_binds_at(cap) {
             ("--memory", human_bytes(self.memory))
         } else {
             ("--max-leaves", cap.to_string())

@@ -86,7 +86,7 @@ pub fn run(args: Args) -> Result<()> {
     ));
     let tree = budget.build_scene(&args.scene, &scene).map_err(|e| {
         // A .tess build streams within --memory; --max-leaves binds it too.
-        if e.to_string().contains("--memory") {
+        if budget.memory_binds() {
             anyhow::anyhow!("{e}; or build to a .tess file, which streams")
         } else {
             e

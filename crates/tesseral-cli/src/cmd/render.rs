@@ -250,19 +250,10 @@ pub fn run(args: Args) -> Result<()> {
             let mode = if let Some((axis, _, c)) = slice {
                 let side = 1usize << tree.depth();
                 let scale = slice_scale(&args, side)?;
+                let at = to_voxel(axis, c).floor() as i64;
                 let spec = args.slice.as_deref().unwrap_or_default();
-                note_slice(
-                    spec,
-                    to_voxel(axis, c).floor() as i64,
-                    side as u64,
-                    lo[axis],
-                    unit,
-                );
-                streamed::Mode::Slice {
-                    axis,
-                    at: to_voxel(axis, c).floor() as i64,
-                    scale,
-                }
+                note_slice(spec, at, side as u64, lo[axis], unit);
+                streamed::Mode::Slice { axis, at, scale }
             } else if args.sheet {
                 streamed::Mode::Sheet
             } else {

@@ -123,6 +123,7 @@ pub fn build_streamed(
     };
     let bar = progress_bar(plan.cell_count(), estimate);
     let mut summary = tesseral::partition::StreamSummary::default();
+    let mut over = None;
     let written = tesseral::io::write_atomic(out, |w| {
         summary = tesseral::partition::write_plan_tess_coloured(
             &plan,
@@ -141,7 +142,8 @@ pub fn build_streamed(
         )?;
         // The estimate can be low: the leaves counted are checked before the
         // file is committed (an error here leaves no file).
-        if check_max_leaves(budget, &what, summary.leaves, true).is_err() {
+        if let Err(e) = check_max_leaves(budget, &what, summary.leaves, true) {
+            over = Some(e);
             return Err(std::io::Error::other("over --max-leaves"));
         }
         Ok(())
@@ -149,7 +151,9 @@ pub fn build_streamed(
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    check_max_leaves(budget, &what, summary.leaves, true)?;
+    if let Some(e) = over {
+        return Err(e);
+    }
     written.with_context(|| format!("writing {}", out.display()))?;
     Ok(Streamed {
         leaves: summary.leaves,
