@@ -42,6 +42,7 @@ int main(int argc, char** argv) {
     for (auto& c : cells) n += acc.value(c) != nullptr;
     return n;
   };
+  lookup_gate();
   auto t1 = std::chrono::steady_clock::now();
   double c1 = cpu_seconds();
   size_t known = count_known();

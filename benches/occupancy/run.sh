@@ -17,6 +17,11 @@
 # time (each tool gets the same loops; none is warmed more than another).
 # One core: `taskset -c 0` and RAYON_NUM_THREADS=1; two cores: RAYON_NUM_THREADS=2 on
 # cores 0,1 (only tesseral is parallel).
+# The lookups are paired (PAIRED=1, the default): every one-core tool builds its map
+# in turn while the others wait, and then their lookups run one right after another
+# (see `paired` below), so that a ratio of lookup times compares loops timed seconds
+# apart, not minutes (on a shared host the same binary's lookups vary by a factor of
+# two between minutes). PAIRED=0 runs each tool start to end in turn, as before.
 #
 # Usage: benches/occupancy/run.sh [BONXAI_DIR]
 #   BONXAI_DIR: a checkout of github.com/facontidavide/Bonxai (header-only; its
@@ -75,6 +80,52 @@ timed() {
   echo "$out" | awk '/^RESULT/ { r = $0 } /^peak_rss_kb/ { p = $0 } END { print r, p }'
 }
 
+# The one-core run of a tool on the workload $w (its scans in $dir, max range $range).
+one_core() {
+  case $1 in
+    tesseral) RAYON_NUM_THREADS=1 timed taskset -c 0 "$peer" run "$dir/$w.scans" "$range" ;;
+    bonxai) timed taskset -c 0 "$build/bonxai_driver" "$dir/$w.scans" "$range" ;;
+    octomap) timed taskset -c 0 "$build/octomap_driver" "$dir/$w.scans" "$range" "${OCTOMAP_SCANS:-1000000}" ;;
+    *) echo "unknown tool $1 (TOOLS: tesseral bonxai octomap)" >&2; return 1 ;;
+  esac
+}
+
+# One repeat (number $1) of the one-core runs with their lookups paired: each tool
+# builds its map alone on core 0 while those started before it wait, idle, polling
+# a file every 10 ms (LOOKUP_GATE); then their lookups are let go one at a time, the
+# first tool rotating with the repeat. So the tools' lookups are timed seconds apart,
+# under the same load from the rest of the machine, instead of minutes apart (an
+# OctoMap insertion takes minutes), and the last tool to build is not always the one
+# that looks up first. The maps are held at once: the memory of all three together.
+paired() {
+  local rep=$1 gates tool k n
+  local -a tools order
+  local -A pids
+  read -r -a tools <<<"${TOOLS:-tesseral bonxai octomap}"
+  gates=$(mktemp -d)
+  for tool in "${tools[@]}"; do
+    LOOKUP_GATE="$gates/$tool" one_core "$tool" >"$gates/$tool.out" &
+    pids[$tool]=$!
+    until [ -e "$gates/$tool.ready" ]; do
+      if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
+        wait "${pids[$tool]}" || true
+        echo "$w: $tool ended before its lookups" >&2
+        return 1
+      fi
+      sleep 0.05
+    done
+  done
+  n=${#tools[@]}
+  for k in $(seq 0 $((n - 1))); do order+=("${tools[$(((k + rep - 1) % n))]}"); done
+  echo "   lookups in the order ${order[*]}" >&2
+  for tool in "${order[@]}"; do
+    touch "$gates/$tool.go"
+    wait "${pids[$tool]}" || { echo "$w: $tool failed" >&2; return 1; }
+  done
+  for tool in "${tools[@]}"; do echo "$w $tool-1core $(cat "$gates/$tool.out")"; done
+  rm -rf "$gates"
+}
+
 workloads=${WORKLOADS:-indoor outdoor}
 [ -n "${REAL_SCAN:-}" ] && [[ " $workloads " != *" real "* ]] && workloads="$workloads real"
 for w in $workloads; do
@@ -105,19 +156,15 @@ for w in $workloads; do
   fi
   for rep in $(seq "${REPEATS:-1}"); do
     [ "${REPEATS:-1}" -gt 1 ] && echo "-- $w: run $rep of $REPEATS" >&2
-    for tool in ${TOOLS:-tesseral bonxai octomap}; do
-      case $tool in
-        tesseral)
-          echo "$w tesseral-1core $(RAYON_NUM_THREADS=1 timed taskset -c 0 "$peer" run "$dir/$w.scans" "$range")"
-          echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
-          ;;
-        bonxai)
-          echo "$w bonxai-1core $(timed taskset -c 0 "$build/bonxai_driver" "$dir/$w.scans" "$range")"
-          ;;
-        octomap)
-          echo "$w octomap-1core $(timed taskset -c 0 "$build/octomap_driver" "$dir/$w.scans" "$range" "${OCTOMAP_SCANS:-1000000}")"
-          ;;
-      esac
-    done
+    if [ "${PAIRED:-1}" = 1 ]; then
+      paired "$rep"
+    else
+      for tool in ${TOOLS:-tesseral bonxai octomap}; do
+        echo "$w $tool-1core $(one_core "$tool")"
+      done
+    fi
+    if [[ " ${TOOLS:-tesseral} " == *" tesseral "* ]]; then
+      echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
+    fi
   done
 done

@@ -8,6 +8,8 @@
 #include <cstdio>
 #include <cstdlib>
 #include <ctime>
+#include <string>
+#include <unistd.h>
 #include <vector>
 
 struct ScanFile {
@@ -76,4 +78,17 @@ inline void print_loops(std::vector<double> ns, double first_ns) {
   std::sort(ns.begin(), ns.end());
   std::printf(" lookup_loops %zu lookup_min_cpu_ns %.1f lookup_median_cpu_ns %.1f", ns.size(), ns.front(),
               ns[ns.size() / 2]);
+}
+
+// With LOOKUP_GATE=PATH (run.sh's paired runs): creates PATH.ready once the map is
+// built and the cells drawn, then waits, idle, until PATH.go exists, so that the
+// tools' lookups can be timed one right after another rather than minutes apart.
+inline void lookup_gate() {
+  const char* g = std::getenv("LOOKUP_GATE");
+  if (!g || !*g) return;
+  std::string base(g);
+  FILE* f = std::fopen((base + ".ready").c_str(), "w");
+  if (!f) { std::perror((base + ".ready").c_str()); std::exit(1); }
+  std::fclose(f);
+  while (access((base + ".go").c_str(), F_OK) != 0) usleep(10000);
 }

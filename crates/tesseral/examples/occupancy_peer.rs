@@ -18,7 +18,8 @@
 //!   known, and `lookup_many_ns`, `lookup_many_cpu_ns`: the same cells through the
 //!   batched `log_odds_many`, per cell; then `lookup_loops`, `lookup_min_cpu_ns` and
 //!   `lookup_median_cpu_ns` over the first loop and `LOOKUP_LOOPS − 1` more (5 in all
-//!   by default), as the C++ drivers report them.
+//!   by default), as the C++ drivers report them. With `LOOKUP_GATE` it waits before
+//!   the lookups (see `lookup_gate`).
 //!
 //! The rayon pool size is `RAYON_NUM_THREADS` (one core: `RAYON_NUM_THREADS=1`).
 
@@ -144,6 +145,7 @@ fn main() -> std::io::Result<()> {
             // such barrier, and it cost our loop a store and a reload per cell, 12 %
             // of a lookup on the real scan.)
             let count_known = || cells.iter().filter(|&&c| map.log_odds(c).is_some()).count();
+            lookup_gate()?;
             let (t, c) = (Instant::now(), process_cpu());
             let known = count_known();
             let (lookup, lookup_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
@@ -175,6 +177,27 @@ fn main() -> std::io::Result<()> {
             );
         }
         other => panic!("unknown command {other}: gen, xyz or run"),
+    }
+    Ok(())
+}
+
+/// With `LOOKUP_GATE=PATH` (`run.sh`'s paired runs): creates `PATH.ready` once the
+/// map is built and the cells drawn, then waits, idle, until `PATH.go` exists, as
+/// `scans.hpp`'s `lookup_gate` does for the C++ peers, so that the tools' lookups
+/// are timed one right after another rather than minutes apart.
+fn lookup_gate() -> std::io::Result<()> {
+    let Some(base) = std::env::var_os("LOOKUP_GATE").filter(|g| !g.is_empty()) else {
+        return Ok(());
+    };
+    let with = |ext: &str| {
+        let mut p = base.clone();
+        p.push(ext);
+        std::path::PathBuf::from(p)
+    };
+    std::fs::File::create(with(".ready"))?;
+    let go = with(".go");
+    while !go.exists() {
+        std::thread::sleep(std::time::Duration::from_millis(10));
     }
     Ok(())
 }
