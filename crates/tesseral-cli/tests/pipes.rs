@@ -20,11 +20,7 @@ fn quiet_on_broken_pipe(dir: &Path, args: &[&str]) {
     drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{args:?}: stderr {err}"
-    );
+    assert_eq!(out.status.code(), Some(0), "{args:?}: stderr {err}");
     assert_eq!(err, "", "{args:?}");
 }
 
