@@ -79,9 +79,10 @@ fn face_colors(
     mesh: &crate::mesh::TriMesh,
     colors: &crate::model::Layer<crate::model::Rgba>,
 ) -> Vec<[u8; 3]> {
+    use rayon::prelude::*;
     let default = super::vox::DEFAULT_COLOR;
     mesh.triangles
-        .iter()
+        .par_iter()
         .map(|t| {
             let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
             let u = [0, 1, 2].map(|k| b[k] - a[k]);

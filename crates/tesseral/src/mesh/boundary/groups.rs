@@ -124,3 +124,12 @@ pub(super) fn is_pinch_edge(config: usize, e: usize, s: usize) -> bool {
     let g = &group_table()[config][0];
     edge_faces(e, s).iter().all(|&f| g[f] >= 0)
 }
+
+/// Whether an edge at a point of colouring `config` has four boundary faces (a
+/// table of the 256 colourings).
+pub(super) fn is_pinch_point(config: u8) -> bool {
+    static TABLE: OnceLock<[bool; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|c| (0..3).any(|e| (0..2).any(|s| is_pinch_edge(c, e, s))))
+    })[usize::from(config)]
+}

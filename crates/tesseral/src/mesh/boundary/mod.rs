@@ -22,6 +22,7 @@
 //! step 3) and `vertices.rs` (its use), `triangulate.rs` (4); `tests.rs`.
 
 mod groups;
+mod lattice;
 mod rects;
 mod squares;
 mod triangulate;
@@ -72,9 +73,8 @@ pub fn boundary_mesh(tree: &LinearOctree) -> TriMesh {
 /// ```
 #[must_use]
 pub fn smooth_mesh(tree: &LinearOctree) -> TriMesh {
-    let (mut mesh, keys, groups) = build(tree, false);
-    for (i, (p, g)) in keys.iter().enumerate() {
-        let row = groups[p];
+    let (mut mesh, keys, rows) = build(tree, false);
+    for (i, ((p, g), row)) in keys.iter().zip(&rows).enumerate() {
         let mut sum = [0.0f64; 3];
         let mut n = 0.0;
         for (f, _) in row.iter().enumerate().filter(|e| e.1 == g) {
@@ -95,4 +95,8 @@ pub fn smooth_mesh(tree: &LinearOctree) -> TriMesh {
 }
 
 #[cfg(test)]
+mod reference;
+#[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_lattice;

@@ -1,5 +1,6 @@
 //! Step 2: boundary squares merged greedily into rectangles.
 
+use rayon::prelude::*;
 use rustc_hash::FxHashMap;
 
 use super::squares::Square;
@@ -17,10 +18,14 @@ pub(super) struct Rect {
     pub(super) v1: i64,
 }
 
-pub(super) fn rectangles(squares: &[Square], merge: bool) -> Vec<Rect> {
+/// The rectangles of the boundary squares (in runs, as [`super::squares`] gives
+/// them): each square cut into unit squares, or with `merge` the squares merged
+/// greedily into rows and rows stacked.
+pub(super) fn rectangles(squares: &[Vec<Square>], merge: bool) -> Vec<Rect> {
+    let squares = || squares.iter().flatten();
     if !merge {
         let mut out = Vec::new();
-        for q in squares {
+        for q in squares() {
             for du in 0..q.s {
                 for dv in 0..q.s {
                     out.push(Rect {
@@ -39,12 +44,13 @@ pub(super) fn rectangles(squares: &[Square], merge: bool) -> Vec<Rect> {
     }
     // Rows: (axis, orientation, plane, v, u0, u1).
     let mut rows: Vec<(usize, bool, i64, i64, i64, i64)> = Vec::new();
-    for q in squares {
+    for q in squares() {
         for v in q.v..q.v + q.s {
             rows.push((q.a, q.pos, q.c, v, q.u, q.u + q.s));
         }
     }
-    rows.sort_unstable();
+    // Equal rows are the same value: the order is the same as a stable sort's.
+    rows.par_sort_unstable();
     // Join touching runs in each row.
     let mut runs: Vec<(usize, bool, i64, i64, i64, i64)> = Vec::with_capacity(rows.len());
     for r in rows {

@@ -1,5 +1,7 @@
 //! Step 1: the boundary squares, found top-down against the tree.
 
+use rayon::prelude::*;
+
 use crate::code;
 use crate::linear::{first_above, LinearOctree};
 use crate::Voxel;
@@ -53,20 +55,35 @@ fn classify_cube(tree: &LinearOctree, min: Voxel, k: u8, near: usize) -> Region 
     }
 }
 
-pub(super) fn boundary_squares(tree: &LinearOctree) -> Vec<Square> {
-    let mut out = Vec::new();
-    for (near, b) in tree.blocks().enumerate() {
-        let s = b.size();
-        for a in 0..3 {
-            for pos in [false, true] {
-                let mut n = b.min;
-                n[a] += if pos { s } else { -s };
-                let plane = if pos { b.min[a] + s } else { b.min[a] };
-                descend(tree, (n, b.size_log2), near, (a, pos, plane), &mut out);
+/// Leaves per parallel task of [`boundary_squares`].
+const LEAVES_PER_TASK: usize = 1 << 12;
+
+/// The boundary squares of every black block's six faces, block by block in
+/// tesseral order, in runs of [`LEAVES_PER_TASK`] blocks searched in parallel (not
+/// joined: a copy of them all would double their memory).
+pub(super) fn boundary_squares(tree: &LinearOctree) -> Vec<Vec<Square>> {
+    let leaves = tree.leaves();
+    (0..leaves.len().div_ceil(LEAVES_PER_TASK))
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Vec::new();
+            let from = k * LEAVES_PER_TASK;
+            let to = leaves.len().min(from + LEAVES_PER_TASK);
+            for (near, leaf) in leaves[from..to].iter().enumerate() {
+                let (near, min, k) = (from + near, tree.voxel_of(leaf.code()), leaf.size_log2());
+                let s = 1i64 << k;
+                for a in 0..3 {
+                    for pos in [false, true] {
+                        let mut n = min;
+                        n[a] += if pos { s } else { -s };
+                        let plane = if pos { min[a] + s } else { min[a] };
+                        descend(tree, (n, k), near, (a, pos, plane), &mut out);
+                    }
+                }
             }
-        }
-    }
-    out
+            out
+        })
+        .collect()
 }
 
 /// The boundary squares of the face (axis `a`, side `pos`, at `plane`) across which

@@ -1,7 +1,6 @@
 //! Step 4: each rectangle, with every vertex on its sides, fanned into triangles.
 
-use rustc_hash::{FxHashMap, FxHashSet};
-
+use super::lattice::{corners, perimeter, Lattice};
 use super::rects::rectangles;
 use super::squares::boundary_squares;
 use super::vertices::{point, Vertices};
@@ -9,75 +8,61 @@ use crate::linear::LinearOctree;
 use crate::mesh::TriMesh;
 use crate::Voxel;
 
-/// A mesh with, per vertex, its lattice point and group, and the groups per point.
-pub(super) type Built = (TriMesh, Vec<(Voxel, i8)>, FxHashMap<Voxel, [i8; 12]>);
+/// A mesh with, per vertex, its lattice point and group, and the groups of the 12
+/// faces at its point.
+pub(super) type Built = (TriMesh, Vec<(Voxel, i8)>, Vec<[i8; 12]>);
 
 pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     let squares = boundary_squares(tree);
     let rects = rectangles(&squares, merge);
     // The squares are larger than the rectangles they became: freed before the
-    // vertices' maps grow.
+    // lattice is made.
     drop(squares);
-    let mut verts = Vertices {
-        tree,
-        config: FxHashMap::default(),
-        groups: FxHashMap::default(),
-        ids: FxHashMap::default(),
-        keys: Vec::new(),
-    };
+    let lattice = Lattice::new(tree, &rects);
+    let mut verts = Vertices::new(&lattice);
     // Corners first: they are the vertices every side must include. Each
     // rectangle's four corner ids are kept for its polygon below.
-    let mut corners: FxHashSet<Voxel> = FxHashSet::default();
     let mut corner_ids: Vec<[u32; 4]> = Vec::with_capacity(rects.len());
-    for r in &rects {
+    for (r, &start) in rects.iter().zip(&lattice.starts) {
         let mut ids = [0u32; 4];
-        for (k, (pu, pv)) in [(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)]
+        for (k, (at, (pu, pv))) in corners(r)
             .into_iter()
+            .zip([(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)])
             .enumerate()
         {
             let p = point(r, pu, pv);
-            let g = verts.group(r, p);
-            ids[k] = verts.id((p, g));
-            corners.insert(p);
+            let at = lattice.point[start + at];
+            ids[k] = verts.id(at, p, verts.group(r, p, at));
+            verts.mark_corner(at);
         }
         corner_ids.push(ids);
     }
     let mut triangles = Vec::with_capacity(2 * rects.len());
     let mut centres: Vec<[f64; 3]> = Vec::new();
     let mut poly: Vec<u32> = Vec::new();
-    for (r, ids) in rects.iter().zip(&corner_ids) {
+    for ((r, ids), &start) in rects.iter().zip(&corner_ids).zip(&lattice.starts) {
         poly.clear();
-        // Counter-clockwise seen from +a: along v0, up u1, back along v1, down u0;
-        // each side its first corner, then the points inside it that are vertices
-        // (pinch points, and other rectangles' corners of the same group).
-        let mut side =
-            |corner: u32, inside: &mut dyn Iterator<Item = (i64, i64)>, verts: &mut Vertices| {
-                poly.push(corner);
-                for (pu, pv) in inside {
-                    let p = point(r, pu, pv);
-                    if verts.is_pinch_point(p) {
-                        let g = verts.group(r, p);
-                        poly.push(verts.id((p, g)));
-                    } else if corners.contains(&p) {
-                        let g = verts.group(r, p);
-                        if let Some(&id) = verts.ids.get(&(p, g)) {
-                            poly.push(id);
-                        }
-                    }
+        // Counter-clockwise seen from +a: each side its first corner, then the
+        // points inside it that are vertices (pinch points, and other rectangles'
+        // corners of the same group).
+        let at_corner = corners(r);
+        let mut next = 0;
+        for (j, p) in perimeter(r).enumerate() {
+            if next < 4 && j == at_corner[next] {
+                poly.push(ids[next]);
+                next += 1;
+                continue;
+            }
+            let at = lattice.point[start + j];
+            if verts.is_pinch_point(at) {
+                let g = verts.group(r, p, at);
+                poly.push(verts.id(at, p, g));
+            } else if verts.is_corner(at) {
+                if let Some(id) = verts.existing(at, verts.group(r, p, at)) {
+                    poly.push(id);
                 }
-            };
-        side(ids[0], &mut (r.u0 + 1..r.u1).map(|u| (u, r.v0)), &mut verts);
-        side(ids[1], &mut (r.v0 + 1..r.v1).map(|v| (r.u1, v)), &mut verts);
-        side(
-            ids[2],
-            &mut (r.u0 + 1..r.u1).rev().map(|u| (u, r.v1)),
-            &mut verts,
-        );
-        side(
-            ids[3],
-            &mut (r.v0 + 1..r.v1).rev().map(|v| (r.u0, v)),
-            &mut verts,
-        );
+            }
+        }
         if !r.pos {
             poly.reverse();
         }
@@ -99,8 +84,9 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     }
     // Only the keys and groups are given back: the rest goes before the positions
     // are made.
-    drop((corners, corner_ids));
-    let Vertices { keys, groups, .. } = verts;
+    drop(corner_ids);
+    let Vertices { keys, rows, .. } = verts;
+    drop(lattice);
     let shared = keys.len() as u32;
     let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
     positions.extend_from_slice(&centres);
@@ -118,6 +104,6 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
             colors: Vec::new(),
         },
         keys,
-        groups,
+        rows,
     )
 }

@@ -1,81 +1,90 @@
 //! Step 3 applied: the vertices of the mesh, one per lattice point and group,
-//! numbered as they are first met.
+//! numbered as they are first met (corners first, rectangle by rectangle, then the
+//! pinch points in the polygons' order), in arrays indexed by the lattice's
+//! distinct points.
 
-use rustc_hash::FxHashMap;
-
-use super::groups::{group_table, is_pinch_edge, joined_by_black};
+use super::groups::is_pinch_point;
+use super::lattice::Lattice;
 use super::rects::Rect;
-use crate::linear::LinearOctree;
 use crate::Voxel;
 
-pub(super) struct Vertices<'t> {
-    pub(super) tree: &'t LinearOctree,
-    pub(super) config: FxHashMap<Voxel, u8>,
-    pub(super) groups: FxHashMap<Voxel, [i8; 12]>,
-    pub(super) ids: FxHashMap<(Voxel, i8), u32>,
+/// No id yet.
+const NONE: u32 = u32::MAX;
+
+pub(super) struct Vertices<'l> {
+    lattice: &'l Lattice,
+    /// Per distinct point, where its groups' ids start in `ids`.
+    slot: Vec<usize>,
+    /// Per group of each distinct point, its vertex id, or [`NONE`].
+    ids: Vec<u32>,
+    /// Per distinct point, whether it is a corner of some rectangle.
+    corner: Vec<bool>,
+    /// Per vertex id: its lattice point and group.
     pub(super) keys: Vec<(Voxel, i8)>,
+    /// Per vertex id: the groups of the 12 faces at its point.
+    pub(super) rows: Vec<[i8; 12]>,
 }
 
-impl Vertices<'_> {
-    fn config(&mut self, p: Voxel) -> u8 {
-        let tree = self.tree;
-        // Bit o: voxel p − 1 + (o & 1, o >> 1 & 1, o >> 2 & 1) is black.
-        *self
-            .config
-            .entry(p)
-            .or_insert_with(|| tree.octet(p.map(|c| c - 1)))
-    }
-
-    /// The vertex groups of the 12 faces at `p`. An edge with four boundary faces
-    /// pairs them by black voxel, unless that pinches the edge at both of its ends,
-    /// in which case it pairs them by white voxel (which then cannot pinch at either
-    /// end), so that no two triangles' edges share both vertices twice.
-    fn groups(&mut self, p: Voxel) -> [i8; 12] {
-        if let Some(g) = self.groups.get(&p) {
-            return *g;
+impl<'l> Vertices<'l> {
+    pub(super) fn new(lattice: &'l Lattice) -> Self {
+        let mut slot = Vec::with_capacity(lattice.groups.len());
+        let mut n = 0usize;
+        for row in &lattice.groups {
+            slot.push(n);
+            n += row.iter().map(|&g| g + 1).max().unwrap_or(0) as usize;
         }
-        let cfg = usize::from(self.config(p));
-        let mut mask = 0usize;
-        for e in 0..3 {
-            for s in 0..2 {
-                if is_pinch_edge(cfg, e, s) && joined_by_black(cfg, e, s) {
-                    let mut q = p;
-                    q[e] += if s == 1 { 1 } else { -1 };
-                    let qcfg = usize::from(self.config(q));
-                    if joined_by_black(qcfg, e, 1 - s) {
-                        mask |= 1 << (2 * e + s);
-                    }
-                }
-            }
+        Self {
+            lattice,
+            slot,
+            ids: vec![NONE; n],
+            corner: vec![false; lattice.groups.len()],
+            keys: Vec::new(),
+            rows: Vec::new(),
         }
-        let g = group_table()[cfg][mask];
-        self.groups.insert(p, g);
-        g
     }
 
-    /// Whether an edge at `p` has four boundary faces: such points must be vertices
-    /// of every rectangle whose side passes through them.
-    pub(super) fn is_pinch_point(&mut self, p: Voxel) -> bool {
-        let cfg = usize::from(self.config(p));
-        (0..3).any(|e| (0..2).any(|s| is_pinch_edge(cfg, e, s)))
-    }
-
-    /// The vertex group at `p` of the face of `r` that touches `p`.
-    pub(super) fn group(&mut self, r: &Rect, p: Voxel) -> i8 {
+    /// The vertex group at `p` (distinct point `at`) of the face of `r` that
+    /// touches `p`.
+    pub(super) fn group(&self, r: &Rect, p: Voxel, at: u32) -> i8 {
         let (u, v) = ((r.a + 1) % 3, (r.a + 2) % 3);
         let du = usize::from(p[u] < r.u1);
         let dv = usize::from(p[v] < r.v1);
-        let g = self.groups(p)[4 * r.a + du + 2 * dv];
+        let g = self.lattice.groups[at as usize][4 * r.a + du + 2 * dv];
         debug_assert!(g >= 0, "rectangle face at {p:?} is not boundary");
         g
     }
 
-    pub(super) fn id(&mut self, key: (Voxel, i8)) -> u32 {
-        let next = self.keys.len() as u32;
-        *self.ids.entry(key).or_insert_with(|| {
-            self.keys.push(key);
-            next
-        })
+    /// The id of group `g` at `p` (distinct point `at`), given now if it has none.
+    pub(super) fn id(&mut self, at: u32, p: Voxel, g: i8) -> u32 {
+        let s = self.slot[at as usize] + g as usize;
+        if self.ids[s] == NONE {
+            self.ids[s] = self.keys.len() as u32;
+            self.keys.push((p, g));
+            self.rows.push(self.lattice.groups[at as usize]);
+        }
+        self.ids[s]
+    }
+
+    /// The id of group `g` at distinct point `at`, if it has one.
+    pub(super) fn existing(&self, at: u32, g: i8) -> Option<u32> {
+        let id = self.ids[self.slot[at as usize] + g as usize];
+        (id != NONE).then_some(id)
+    }
+
+    /// Records that distinct point `at` is a rectangle's corner.
+    pub(super) fn mark_corner(&mut self, at: u32) {
+        self.corner[at as usize] = true;
+    }
+
+    /// Whether distinct point `at` is a rectangle's corner.
+    pub(super) fn is_corner(&self, at: u32) -> bool {
+        self.corner[at as usize]
+    }
+
+    /// Whether an edge at distinct point `at` has four boundary faces: such points
+    /// must be vertices of every rectangle whose side passes through them.
+    pub(super) fn is_pinch_point(&self, at: u32) -> bool {
+        is_pinch_point(self.lattice.config[at as usize])
     }
 }
 
