@@ -8,10 +8,9 @@ use rustc_hash::{FxHashMap, FxHashSet};
 use super::groups::{group_table, is_pinch_edge, joined_by_black};
 use super::rects::{rectangles, Rect};
 use super::squares::boundary_squares;
-use super::triangulate::Built;
+use super::triangulate::{Built, Fans};
 use super::vertices::point;
 use crate::linear::LinearOctree;
-use crate::mesh::TriMesh;
 use crate::Voxel;
 
 struct Vertices<'t> {
@@ -117,8 +116,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
         }
         corner_ids.push(ids);
     }
-    let mut triangles = Vec::with_capacity(2 * rects.len());
-    let mut centres: Vec<[f64; 3]> = Vec::new();
+    let mut fans = Fans::with_capacity(rects.len());
     let mut poly: Vec<u32> = Vec::new();
     for (r, ids) in rects.iter().zip(&corner_ids) {
         poly.clear();
@@ -153,47 +151,12 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
             &mut (r.v0 + 1..r.v1).rev().map(|v| (r.u0, v)),
             &mut verts,
         );
-        if !r.pos {
-            poly.reverse();
-        }
-        if poly.len() == 4 {
-            triangles.push([poly[0], poly[1], poly[2]]);
-            triangles.push([poly[0], poly[2], poly[3]]);
-        } else {
-            let mut c = [0.0; 3];
-            c[r.a] = r.c as f64;
-            c[(r.a + 1) % 3] = (r.u0 + r.u1) as f64 / 2.0;
-            c[(r.a + 2) % 3] = (r.v0 + r.v1) as f64 / 2.0;
-            // Centre ids are placed after the shared vertices; fixed up below.
-            let cid = u32::MAX - centres.len() as u32;
-            centres.push(c);
-            for i in 0..poly.len() {
-                triangles.push([cid, poly[i], poly[(i + 1) % poly.len()]]);
-            }
-        }
+        fans.add(r, &mut poly);
     }
     // Only the keys and groups are given back: the rest goes before the positions
     // are made.
     drop((corners, corner_ids));
     let Vertices { keys, groups, .. } = verts;
     let rows = keys.iter().map(|(p, _)| groups[p]).collect();
-    let shared = keys.len() as u32;
-    let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
-    positions.extend_from_slice(&centres);
-    for t in &mut triangles {
-        for i in t.iter_mut() {
-            if *i > u32::MAX - centres.len() as u32 {
-                *i = shared + (u32::MAX - *i);
-            }
-        }
-    }
-    (
-        TriMesh {
-            positions,
-            triangles,
-            colors: Vec::new(),
-        },
-        keys,
-        rows,
-    )
+    (fans.into_mesh(&keys), keys, rows)
 }

@@ -1,7 +1,7 @@
 //! Step 4: each rectangle, with every vertex on its sides, fanned into triangles.
 
 use super::lattice::{corners, perimeter, Lattice};
-use super::rects::rectangles;
+use super::rects::{rectangles, Rect};
 use super::squares::boundary_squares;
 use super::vertices::{point, Vertices};
 use crate::linear::LinearOctree;
@@ -37,8 +37,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
         }
         corner_ids.push(ids);
     }
-    let mut triangles = Vec::with_capacity(2 * rects.len());
-    let mut centres: Vec<[f64; 3]> = Vec::new();
+    let mut fans = Fans::with_capacity(rects.len());
     let mut poly: Vec<u32> = Vec::new();
     for ((r, ids), &start) in rects.iter().zip(&corner_ids).zip(&lattice.starts) {
         poly.clear();
@@ -63,47 +62,75 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
                 }
             }
         }
-        if !r.pos {
-            poly.reverse();
-        }
-        if poly.len() == 4 {
-            triangles.push([poly[0], poly[1], poly[2]]);
-            triangles.push([poly[0], poly[2], poly[3]]);
-        } else {
-            let mut c = [0.0; 3];
-            c[r.a] = r.c as f64;
-            c[(r.a + 1) % 3] = (r.u0 + r.u1) as f64 / 2.0;
-            c[(r.a + 2) % 3] = (r.v0 + r.v1) as f64 / 2.0;
-            // Centre ids are placed after the shared vertices; fixed up below.
-            let cid = u32::MAX - centres.len() as u32;
-            centres.push(c);
-            for i in 0..poly.len() {
-                triangles.push([cid, poly[i], poly[(i + 1) % poly.len()]]);
-            }
-        }
+        fans.add(r, &mut poly);
     }
     // Only the keys and groups are given back: the rest goes before the positions
     // are made.
     drop(corner_ids);
     let Vertices { keys, rows, .. } = verts;
     drop(lattice);
-    let shared = keys.len() as u32;
-    let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
-    positions.extend_from_slice(&centres);
-    for t in &mut triangles {
-        for i in t.iter_mut() {
-            if *i > u32::MAX - centres.len() as u32 {
-                *i = shared + (u32::MAX - *i);
+    (fans.into_mesh(&keys), keys, rows)
+}
+
+/// The triangles of the rectangles' polygons, and the centres of those fanned.
+pub(super) struct Fans {
+    triangles: Vec<[u32; 3]>,
+    centres: Vec<[f64; 3]>,
+}
+
+impl Fans {
+    pub(super) fn with_capacity(rects: usize) -> Self {
+        Self {
+            triangles: Vec::with_capacity(2 * rects),
+            centres: Vec::new(),
+        }
+    }
+
+    /// The triangles of `r`'s polygon `poly` (its vertex ids counter-clockwise seen
+    /// from +a; reversed here when `r` faces −a): two for a plain rectangle, else a
+    /// fan from its centre.
+    pub(super) fn add(&mut self, r: &Rect, poly: &mut [u32]) {
+        if !r.pos {
+            poly.reverse();
+        }
+        if poly.len() == 4 {
+            self.triangles.push([poly[0], poly[1], poly[2]]);
+            self.triangles.push([poly[0], poly[2], poly[3]]);
+        } else {
+            let mut c = [0.0; 3];
+            c[r.a] = r.c as f64;
+            c[(r.a + 1) % 3] = (r.u0 + r.u1) as f64 / 2.0;
+            c[(r.a + 2) % 3] = (r.v0 + r.v1) as f64 / 2.0;
+            // Centre ids are placed after the shared vertices; fixed up below.
+            let cid = u32::MAX - self.centres.len() as u32;
+            self.centres.push(c);
+            for i in 0..poly.len() {
+                self.triangles
+                    .push([cid, poly[i], poly[(i + 1) % poly.len()]]);
             }
         }
     }
-    (
+
+    /// The mesh: the vertices `keys` (their lattice points), then the centres.
+    pub(super) fn into_mesh(self, keys: &[(Voxel, i8)]) -> TriMesh {
+        let Self {
+            mut triangles,
+            centres,
+        } = self;
+        let shared = keys.len() as u32;
+        let mut positions: Vec<[f64; 3]> = keys.iter().map(|(p, _)| p.map(|x| x as f64)).collect();
+        positions.extend_from_slice(&centres);
+        for t in &mut triangles {
+            for i in t.iter_mut() {
+                if *i > u32::MAX - centres.len() as u32 {
+                    *i = shared + (u32::MAX - *i);
+                }
+            }
+        }
         TriMesh {
             positions,
             triangles,
             colors: Vec::new(),
-        },
-        keys,
-        rows,
-    )
+        }
+    }
 }
