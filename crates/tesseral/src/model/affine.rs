@@ -6,6 +6,12 @@ use super::{Model, ModelError};
 use crate::linear::{affine_space, scale_space, LinearOctree};
 use crate::Voxel;
 
+/// The identity matrix.
+const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// Whole voxel offsets below this (2^62) are moved as translations.
+const WHOLE_LIMIT: f64 = 4_611_686_018_427_387_904.0;
+
 impl Model {
     /// The box of voxels holding every part: the solid and the known-free space
     /// (colours and log-odds lie within them).
@@ -48,7 +54,9 @@ impl Model {
     /// The model under the world map `x ↦ m·x + offset` (world units), by point
     /// sampling on its own lattice: the frame is kept, and output voxel `w` is black
     /// when the preimage of its centre lies in a black voxel. Rotations by any angle
-    /// are `m` = a rotation matrix (see [`crate::linear::rotation_matrix`]).
+    /// are `m` = a rotation matrix (see [`crate::linear::rotation_matrix`]). The
+    /// identity moving by whole voxels is [`Model::translate`] (the same voxels, the
+    /// space kept rather than widened).
     ///
     /// # Errors
     /// As [`LinearOctree::affine`].
@@ -58,6 +66,12 @@ impl Model {
         let t: [f64; 3] = std::array::from_fn(|i| {
             ((0..3).map(|j| m[i][j] * tr[j]).sum::<f64>() + offset[i] - tr[i]) / h
         });
+        // The identity moving by whole voxels is a translation: sampling gives the
+        // same voxels, in a space a voxel wider on every side (often a level
+        // deeper) than the translation keeps.
+        if m == IDENTITY && t.iter().all(|c| c.fract() == 0.0 && c.abs() < WHOLE_LIMIT) {
+            return self.translate(t.map(|c| c as i64));
+        }
         let Some(bbox) = self.known_bbox() else {
             return Ok(self.clone());
         };

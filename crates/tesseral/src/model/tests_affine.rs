@@ -88,3 +88,39 @@ fn values_follow_their_voxels_under_any_rotation() {
         }
     }
 }
+
+/// The identity matrix with a whole-voxel offset is a translation: the voxels the
+/// point sampling gives, in the space the translation keeps (the sampling took a
+/// wider one), and with no offset the model itself.
+#[test]
+fn the_identity_moves_as_a_translation() {
+    let id = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for seed in 0..100 {
+        let mut rng = Pcg64Mcg::seed_from_u64(seed);
+        let (h, t) = random_frame(&mut rng);
+        let m = random_model(&mut rng, h, t);
+        let by: [i64; 3] = [0; 3].map(|_| rng.random_range(-5..5));
+        let r = m.affine_world(id, by.map(|c| c as f64 * h)).unwrap();
+        let hk = key([h, 0.0, 0.0])[0];
+        let expect = moved(&world(&m), |c| vec![[0, 1, 2].map(|a| c[a] + by[a] * hk)]);
+        check(&r, &expect, "identity moving by whole voxels", seed);
+        let sampled = m.tree.affine(id, by.map(|c| c as f64)).unwrap();
+        let sorted = |t: &crate::linear::LinearOctree| {
+            let mut v: Vec<_> = t.voxels().collect();
+            v.sort_unstable();
+            v
+        };
+        assert_eq!(
+            sorted(&r.tree),
+            sorted(&sampled),
+            "seed {seed}: the voxels of the sampling"
+        );
+        let same = m.affine_world(id, [0.0; 3]).unwrap();
+        assert_eq!(
+            (same.tree.depth(), same.tree.origin()),
+            (m.tree.depth(), m.tree.origin()),
+            "seed {seed}: the space"
+        );
+        assert!(same.tree.voxels().eq(m.tree.voxels()), "seed {seed}");
+    }
+}
