@@ -101,15 +101,24 @@ paired() {
   local rep=$1 gates tool k n
   local -a tools order
   local -A pids
-  read -r -a tools <<<"${TOOLS:-tesseral bonxai octomap}"
+  read -r -a tools <<<"$tool_list"
   gates=$(mktemp -d)
+  # On a failure, the drivers still waiting at their gates are let go and waited
+  # for (killing the shell around one would leave the driver itself waiting).
+  give_up() {
+    echo "$w: $1" >&2
+    local t
+    for t in "${tools[@]}"; do touch "$gates/$t.go"; done
+    for t in "${!pids[@]}"; do wait "${pids[$t]}" 2>/dev/null || true; done
+    rm -rf "$gates"
+  }
   for tool in "${tools[@]}"; do
     LOOKUP_GATE="$gates/$tool" one_core "$tool" >"$gates/$tool.out" &
     pids[$tool]=$!
     until [ -e "$gates/$tool.ready" ]; do
       if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
         wait "${pids[$tool]}" || true
-        echo "$w: $tool ended before its lookups" >&2
+        give_up "$tool ended before its lookups"
         return 1
       fi
       sleep 0.05
@@ -120,12 +129,13 @@ paired() {
   echo "   lookups in the order ${order[*]}" >&2
   for tool in "${order[@]}"; do
     touch "$gates/$tool.go"
-    wait "${pids[$tool]}" || { echo "$w: $tool failed" >&2; return 1; }
+    wait "${pids[$tool]}" || { give_up "$tool failed"; return 1; }
   done
   for tool in "${tools[@]}"; do echo "$w $tool-1core $(cat "$gates/$tool.out")"; done
   rm -rf "$gates"
 }
 
+tool_list=${TOOLS:-tesseral bonxai octomap}
 workloads=${WORKLOADS:-indoor outdoor}
 [ -n "${REAL_SCAN:-}" ] && [[ " $workloads " != *" real "* ]] && workloads="$workloads real"
 for w in $workloads; do
@@ -159,11 +169,11 @@ for w in $workloads; do
     if [ "${PAIRED:-1}" = 1 ]; then
       paired "$rep"
     else
-      for tool in ${TOOLS:-tesseral bonxai octomap}; do
+      for tool in $tool_list; do
         echo "$w $tool-1core $(one_core "$tool")"
       done
     fi
-    if [[ " ${TOOLS:-tesseral} " == *" tesseral "* ]]; then
+    if [[ " $tool_list " == *" tesseral "* ]]; then
       echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
     fi
   done

@@ -342,9 +342,7 @@ fn an_in_memory_output_counts_its_writing() {
 fn an_in_memory_op_counts_both_operands() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    let spheroid = fs::read_to_string(scenes().join("fig4c-spheroid.tss")).unwrap();
-    fs::write(d.join("s9.tss"), spheroid.replace("depth 6", "depth 9")).unwrap();
-    common::ok(d, &["build", "s9.tss", "-o", "a.tess"]);
+    common::build_scene(d, "fig4c-spheroid.tss", "a.tess", 9);
     fs::copy(d.join("a.tess"), d.join("b.tess")).unwrap();
     let op = ["op", "union", "a.tess", "b.tess", "-o", "u.xyz", "--memory"];
     refused(

@@ -297,6 +297,19 @@ pub fn scale_space(bbox: (Voxel, Voxel), k: [i64; 3]) -> Result<(u8, Voxel), Oct
     space_for(lo, hi)
 }
 
+/// The lattice coordinates an affine map's image may reach (2^62 either way).
+const AFFINE_LIMIT: f64 = 4_611_686_018_427_387_904.0;
+
+/// The whole-voxel move `t` when the lattice map `q = m·p + t` is one: `m` the
+/// identity and `t` whole (and within reach). Point sampling under such a map gives
+/// the voxels of the translation by `t`.
+#[must_use]
+pub fn whole_translation(m: [[f64; 3]; 3], t: [f64; 3]) -> Option<Voxel> {
+    let identity = (0..3).all(|i| (0..3).all(|j| m[i][j] == f64::from(u8::from(i == j))));
+    (identity && t.iter().all(|c| c.fract() == 0.0 && c.abs() < AFFINE_LIMIT))
+        .then(|| t.map(|c| c as i64))
+}
+
 /// The smallest space holding the image of the voxel box `bbox` (inclusive) under
 /// the affine map `q = m·p + t`, with a voxel of margin.
 ///
@@ -323,8 +336,7 @@ pub fn affine_space(
             hi[i] = hi[i].max(q);
         }
     }
-    let limit = 2f64.powi(62);
-    if !(0..3).all(|a| lo[a].abs() < limit && hi[a].abs() < limit) {
+    if !(0..3).all(|a| lo[a].abs() < AFFINE_LIMIT && hi[a].abs() < AFFINE_LIMIT) {
         return Err(OctreeError::Overflow);
     }
     space_for(

@@ -29,7 +29,7 @@ mod transform;
 
 pub use crate::code::Axis;
 pub(crate) use affine::sin_cos_degrees;
-pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space};
+pub use affine::{affine_space, invert_matrix, rotation_matrix, scale_space, whole_translation};
 pub use box_state::BoxState;
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};

@@ -3,14 +3,8 @@
 //! the same point sampling, so values still follow their voxels.
 
 use super::{Model, ModelError};
-use crate::linear::{affine_space, scale_space, LinearOctree};
+use crate::linear::{affine_space, scale_space, whole_translation, LinearOctree};
 use crate::Voxel;
-
-/// The identity matrix.
-const IDENTITY: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-
-/// Whole voxel offsets below this (2^62) are moved as translations.
-const WHOLE_LIMIT: f64 = 4_611_686_018_427_387_904.0;
 
 impl Model {
     /// The box of voxels holding every part: the solid and the known-free space
@@ -69,8 +63,8 @@ impl Model {
         // The identity moving by whole voxels is a translation: sampling gives the
         // same voxels, in a space a voxel wider on every side (often a level
         // deeper) than the translation keeps.
-        if m == IDENTITY && t.iter().all(|c| c.fract() == 0.0 && c.abs() < WHOLE_LIMIT) {
-            return self.translate(t.map(|c| c as i64));
+        if let Some(by) = whole_translation(m, t) {
+            return self.translate(by);
         }
         let Some(bbox) = self.known_bbox() else {
             return Ok(self.clone());

@@ -55,10 +55,15 @@ pub(super) fn perimeter(r: &Rect) -> impl Iterator<Item = Voxel> + '_ {
         .map(move |(u, v)| point(r, u, v))
 }
 
-/// Where the four corners of `r` come in its [`perimeter`].
-pub(super) fn corners(r: &Rect) -> [usize; 4] {
+/// The four corners of `r` in [`perimeter`] order, each with where it comes there.
+pub(super) fn corners(r: &Rect) -> [(usize, Voxel); 4] {
     let (w, h) = ((r.u1 - r.u0) as usize, (r.v1 - r.v0) as usize);
-    [0, w, w + h, 2 * w + h]
+    [
+        (0, point(r, r.u0, r.v0)),
+        (w, point(r, r.u1, r.v0)),
+        (w + h, point(r, r.u1, r.v1)),
+        (2 * w + h, point(r, r.u0, r.v1)),
+    ]
 }
 
 /// The rectangles' points, numbered by distinct point, and what is known of each.

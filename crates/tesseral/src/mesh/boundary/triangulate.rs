@@ -3,7 +3,7 @@
 use super::lattice::{corners, perimeter, Lattice};
 use super::rects::{rectangles, Rect};
 use super::squares::boundary_squares;
-use super::vertices::{point, Vertices};
+use super::vertices::Vertices;
 use crate::linear::LinearOctree;
 use crate::mesh::TriMesh;
 use crate::Voxel;
@@ -25,12 +25,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
     let mut corner_ids: Vec<[u32; 4]> = Vec::with_capacity(rects.len());
     for (r, &start) in rects.iter().zip(&lattice.starts) {
         let mut ids = [0u32; 4];
-        for (k, (at, (pu, pv))) in corners(r)
-            .into_iter()
-            .zip([(r.u0, r.v0), (r.u1, r.v0), (r.u1, r.v1), (r.u0, r.v1)])
-            .enumerate()
-        {
-            let p = point(r, pu, pv);
+        for (k, (at, p)) in corners(r).into_iter().enumerate() {
             let at = lattice.point[start + at];
             ids[k] = verts.id(at, p, verts.group(r, p, at));
             verts.mark_corner(at);
@@ -44,7 +39,7 @@ pub(super) fn build(tree: &LinearOctree, merge: bool) -> Built {
         // Counter-clockwise seen from +a: each side its first corner, then the
         // points inside it that are vertices (pinch points, and other rectangles'
         // corners of the same group).
-        let at_corner = corners(r);
+        let at_corner = corners(r).map(|(at, _)| at);
         let mut next = 0;
         for (j, p) in perimeter(r).enumerate() {
             if next < 4 && j == at_corner[next] {
