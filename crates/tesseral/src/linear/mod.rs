@@ -34,7 +34,7 @@ pub use box_state::BoxState;
 pub use build::{CellClass, Classifier};
 pub use leaf::{Block, Leaf};
 pub use node_list::{Node, NodeColour};
-pub(crate) use octet::first_above;
+pub(crate) use octet::{first_above, gallop};
 pub use ops::SetOp;
 pub use transform::rotation_labels;
 

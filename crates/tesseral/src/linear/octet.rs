@@ -24,6 +24,17 @@ impl LinearOctree {
     /// ```
     #[must_use]
     pub fn octet(&self, lo: Voxel) -> u8 {
+        self.octet_near(lo, &mut 0)
+    }
+
+    /// [`octet`](Self::octet), its search started from leaf `near` (a leaf found
+    /// for a box nearby, as the mesher's points come sorted), and `near` left at
+    /// the leaf of this box's first voxel in tesseral order, for the next box.
+    ///
+    /// # Runtime
+    /// O(log d) for the first voxel, d the leaves between it and `near`; as
+    /// [`octet`](Self::octet) for the others.
+    pub(crate) fn octet_near(&self, lo: Voxel, near: &mut usize) -> u8 {
         let mut codes = [(u64::MAX, 0u8); 8];
         let mut n = 0;
         for o in 0..8u8 {
@@ -41,13 +52,16 @@ impl LinearOctree {
         let leaves = self.leaves();
         let mut bits = 0u8;
         // The leaf that held (or preceded) the last code looked up.
-        let mut near = 0;
-        for &(c, o) in codes.iter() {
-            let i = first_above(leaves, c, near);
+        let mut at = *near;
+        for (k, &(c, o)) in codes.iter().enumerate() {
+            let i = first_above(leaves, c, at);
             if i > 0 && leaves[i - 1].contains_code(c) {
                 bits |= 1 << o;
             }
-            near = i.saturating_sub(1);
+            at = i.saturating_sub(1);
+            if k == 0 {
+                *near = at;
+            }
         }
         bits
     }
@@ -57,31 +71,51 @@ impl LinearOctree {
 /// `partition_point` gives it, found by galloping from index `near` (either way):
 /// O(log d) for d leaves between `near` and the answer.
 pub(crate) fn first_above(leaves: &[Leaf], c: u64, near: usize) -> usize {
-    let n = leaves.len();
+    gallop(leaves.len(), near, |i| leaves[i].code() <= c)
+}
+
+/// The first index of `0..n` where `at_or_below` turns false (it must be true, then
+/// false, along the indices), as `partition_point` would find it, galloping from
+/// index `near` either way: O(log d) calls for d indices between `near` and the
+/// answer.
+pub(crate) fn gallop(n: usize, near: usize, at_or_below: impl Fn(usize) -> bool) -> usize {
     if n == 0 {
         return 0;
     }
     let near = near.min(n - 1);
     let mut step = 1;
-    if leaves[near].code() <= c {
-        // leaves[lo] ≤ c: widen until a leaf above c, or the end.
+    if at_or_below(near) {
+        // `lo` is at or below: widen until an index above, or the end.
         let mut lo = near;
-        while lo + step < n && leaves[lo + step].code() <= c {
+        while lo + step < n && at_or_below(lo + step) {
             lo += step;
             step *= 2;
         }
         let hi = (lo + step).min(n);
-        lo + 1 + leaves[lo + 1..hi].partition_point(|l| l.code() <= c)
+        partition(lo + 1, hi, &at_or_below)
     } else {
-        // leaves[hi] > c: widen down until a leaf at or below c, or the start.
+        // `hi` is above: widen down until an index at or below, or the start.
         let mut hi = near;
-        while hi >= step && leaves[hi - step].code() > c {
+        while hi >= step && !at_or_below(hi - step) {
             hi -= step;
             step *= 2;
         }
-        let lo = hi.saturating_sub(step);
-        lo + leaves[lo..hi].partition_point(|l| l.code() <= c)
+        partition(hi.saturating_sub(step), hi, &at_or_below)
     }
+}
+
+/// The first index of `lo..hi` where `at_or_below` turns false (`hi` when none
+/// does), by bisection.
+fn partition(mut lo: usize, mut hi: usize, at_or_below: &impl Fn(usize) -> bool) -> usize {
+    while lo < hi {
+        let mid = lo + (hi - lo) / 2;
+        if at_or_below(mid) {
+            lo = mid + 1;
+        } else {
+            hi = mid;
+        }
+    }
+    lo
 }
 
 #[cfg(test)]
@@ -115,6 +149,12 @@ mod tests {
                     }
                 }
                 assert_eq!(t.octet(lo), want, "round {round}, lo {lo:?}");
+                let mut near = rng.random_range(0..=t.leaves().len() + 1);
+                assert_eq!(
+                    t.octet_near(lo, &mut near),
+                    want,
+                    "round {round}, lo {lo:?}"
+                );
             }
         }
         // first_above from every start, against partition_point.

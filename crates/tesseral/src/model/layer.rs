@@ -3,7 +3,7 @@
 use std::collections::HashMap;
 use std::sync::OnceLock;
 
-use crate::linear::{Leaf, LinearOctree, OctreeError};
+use crate::linear::{gallop, Leaf, LinearOctree, OctreeError};
 use crate::Voxel;
 
 /// A value a [`Layer`] can hold: copied, and grouped into regions by a key (so
@@ -280,10 +280,24 @@ impl<T: LayerValue> Layer<T> {
     /// first call.
     #[must_use]
     pub fn get(&self, v: Voxel) -> Option<T> {
+        self.get_near(v, &mut 0)
+    }
+
+    /// [`get`](Self::get), its search started from index entry `near` (one found
+    /// for a voxel nearby, as when the voxels come in order) and `near` left at the
+    /// entry found, for the next voxel.
+    ///
+    /// # Runtime
+    /// O(log d) for d index entries between `near` and the voxel's, after the
+    /// index is built.
+    pub(crate) fn get_near(&self, v: Voxel, near: &mut usize) -> Option<T> {
         let probe = LinearOctree::empty(self.depth, self.origin).ok()?;
         let c = probe.code_of(v)?;
         let idx = self.index();
-        let i = idx.partition_point(|&(p, _)| Leaf::from_packed(p).code() <= c);
+        let i = gallop(idx.len(), *near, |k| {
+            Leaf::from_packed(idx[k].0).code() <= c
+        });
+        *near = i.saturating_sub(1);
         if i == 0 {
             return None;
         }

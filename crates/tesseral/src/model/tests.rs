@@ -322,6 +322,16 @@ fn layers_with_many_distinct_values_stay_exact() {
         assert_eq!(layer.get(*v), Some(*c));
     }
     assert_eq!(layer.voxel_count(), last.len() as u64);
+    // From any hint, near or far, and for voxels with no value (some outside the
+    // space), get_near answers as the map does, in order and out of it.
+    let mut near = 0;
+    for round in 0..20_000 {
+        let v: Voxel = std::array::from_fn(|_| rng.random_range(-2..66));
+        if round % 3 == 0 {
+            near = rng.random_range(0..30_000);
+        }
+        assert_eq!(layer.get_near(v, &mut near), last.get(&v).copied(), "{v:?}");
+    }
 }
 
 #[test]

@@ -81,24 +81,31 @@ fn face_colors(
 ) -> Vec<[u8; 3]> {
     use rayon::prelude::*;
     let default = super::vox::DEFAULT_COLOR;
+    // A triangle's neighbours in the list are mostly its neighbours on the surface:
+    // each run of them starts its search where the last one's ended.
     mesh.triangles
         .par_iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
-            let u = [0, 1, 2].map(|k| b[k] - a[k]);
-            let v = [0, 1, 2].map(|k| c[k] - a[k]);
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
-                .sqrt()
-                .max(f64::MIN_POSITIVE);
-            // Triangles wind counter-clockwise seen from outside: n points out.
-            let p = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0 - 0.5 * n[k] / len);
-            let col = colors.get(p.map(|x| x.floor() as i64)).unwrap_or(default);
-            [col[0], col[1], col[2]]
-        })
+        .map_init(
+            || 0usize,
+            |near, t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                let u = [0, 1, 2].map(|k| b[k] - a[k]);
+                let v = [0, 1, 2].map(|k| c[k] - a[k]);
+                let n = [
+                    u[1] * v[2] - u[2] * v[1],
+                    u[2] * v[0] - u[0] * v[2],
+                    u[0] * v[1] - u[1] * v[0],
+                ];
+                let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2])
+                    .sqrt()
+                    .max(f64::MIN_POSITIVE);
+                // Triangles wind counter-clockwise seen from outside: n points out.
+                let p = [0, 1, 2].map(|k| (a[k] + b[k] + c[k]) / 3.0 - 0.5 * n[k] / len);
+                let col = colors
+                    .get_near(p.map(|x| x.floor() as i64), near)
+                    .unwrap_or(default);
+                [col[0], col[1], col[2]]
+            },
+        )
         .collect()
 }

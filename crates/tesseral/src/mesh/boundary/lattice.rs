@@ -122,14 +122,19 @@ impl Lattice {
             point[at] = (keys.len() - 1) as u32;
         }
         drop(tagged);
+        // Each run of points starts its searches where the last point's ended:
+        // sorted, the points follow one another, and so do their leaves.
         let (config, groups) = keys
             .par_iter()
-            .map(|k| {
-                let rel = k.unpack(bits);
-                let p = [0, 1, 2].map(|a| o[a] + rel[a] as i64);
-                let config = tree.octet(p.map(|c| c - 1));
-                (config, groups_at(tree, p, config))
-            })
+            .map_init(
+                || 0usize,
+                |near, k| {
+                    let rel = k.unpack(bits);
+                    let p = [0, 1, 2].map(|a| o[a] + rel[a] as i64);
+                    let config = tree.octet_near(p.map(|c| c - 1), near);
+                    (config, groups_at(tree, p, config, *near))
+                },
+            )
             .unzip();
         Self {
             point,
@@ -145,7 +150,8 @@ impl Lattice {
 /// edge at both of its ends, in which case it pairs them by white voxel (which then
 /// cannot pinch at either end), so that no two triangles' edges share both
 /// vertices twice.
-fn groups_at(tree: &LinearOctree, p: Voxel, config: u8) -> [i8; 12] {
+/// `near`: a leaf near `p`'s, where the searches start.
+fn groups_at(tree: &LinearOctree, p: Voxel, config: u8, mut near: usize) -> [i8; 12] {
     let cfg = usize::from(config);
     let mut mask = 0usize;
     for e in 0..3 {
@@ -153,7 +159,7 @@ fn groups_at(tree: &LinearOctree, p: Voxel, config: u8) -> [i8; 12] {
             if is_pinch_edge(cfg, e, s) && joined_by_black(cfg, e, s) {
                 let mut q = p;
                 q[e] += if s == 1 { 1 } else { -1 };
-                let qcfg = usize::from(tree.octet(q.map(|c| c - 1)));
+                let qcfg = usize::from(tree.octet_near(q.map(|c| c - 1), &mut near));
                 if joined_by_black(qcfg, e, 1 - s) {
                     mask |= 1 << (2 * e + s);
                 }
