@@ -40,9 +40,7 @@ pub fn parse_voxel(s: &str) -> Result<Voxel, String> {
     }
     let mut v = [0i64; 3];
     for (c, p) in v.iter_mut().zip(&parts) {
-        *c = p
-            .parse()
-            .map_err(|_| format!("{p:?} in {s:?} is not an integer"))?;
+        *c = super::octree::parse_int(p).map_err(|e| format!("{e} (in {s:?})"))?;
     }
     Ok(v)
 }

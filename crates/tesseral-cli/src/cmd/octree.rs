@@ -235,11 +235,22 @@ pub fn parse_vector(text: &str) -> Result<[i64; 3], String> {
     }
     let mut v = [0i64; 3];
     for (a, p) in parts.iter().enumerate() {
-        v[a] = p
-            .parse()
-            .map_err(|_| format!("`{p}` is not an integer (in `{text}`)"))?;
+        v[a] = parse_int(p).map_err(|e| format!("{e} (in `{text}`)"))?;
     }
     Ok(v)
+}
+
+/// Parses one 64-bit integer of a list given on the command line; the error says
+/// whether `p` is no integer at all or one past the 64-bit range.
+pub fn parse_int(p: &str) -> Result<i64, String> {
+    use std::num::IntErrorKind::{NegOverflow, PosOverflow};
+    p.parse()
+        .map_err(|e: std::num::ParseIntError| match e.kind() {
+            PosOverflow | NegOverflow => {
+                format!("`{p}` is past the 64-bit range (-2^63 to 2^63 - 1)")
+            }
+            _ => format!("`{p}` is not an integer"),
+        })
 }
 
 /// An axis on the command line.
@@ -299,6 +310,32 @@ mod tests {
         assert_eq!(
             wrote_line(at, 8, 2, 4, [0; 3], &Frame::new(0.05, [1.0, 0.0, 0.0])),
             "wrote a.tess: 8 voxels, 2 leaves, depth 4, origin (0, 0, 0), voxel size 0.05 at (1, 0, 0)"
+        );
+    }
+
+    #[test]
+    fn an_integer_past_64_bits_is_named_as_such() {
+        assert_eq!(
+            parse_vector("-3, 0,9223372036854775807"),
+            Ok([-3, 0, i64::MAX])
+        );
+        assert_eq!(parse_int("-9223372036854775808"), Ok(i64::MIN));
+        for big in [
+            "9223372036854775808",
+            "-9223372036854775809",
+            "99999999999999999999",
+        ] {
+            let e = parse_int(big).unwrap_err();
+            assert!(e.contains("past the 64-bit range"), "{e}");
+        }
+        for bad in ["1.5", "x", "", "1e3"] {
+            let e = parse_int(bad).unwrap_err();
+            assert!(e.ends_with("is not an integer"), "{e}");
+        }
+        let e = parse_vector("1,99999999999999999999,0").unwrap_err();
+        assert!(
+            e.contains("past the 64-bit range") && e.contains("(in `1,9999"),
+            "{e}"
         );
     }
 }

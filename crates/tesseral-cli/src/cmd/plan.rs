@@ -75,11 +75,7 @@ fn parse_view(s: &str) -> Result<View, String> {
 fn parse_region(s: &str) -> Result<Aabb, String> {
     let v: Vec<i64> = s
         .split(',')
-        .map(|p| {
-            p.trim()
-                .parse::<i64>()
-                .map_err(|_| format!("{p:?} in {s:?} is not an integer"))
-        })
+        .map(|p| super::octree::parse_int(p.trim()).map_err(|e| format!("{e} (in {s:?})")))
         .collect::<Result<_, _>>()?;
     if v.len() != 6 {
         return Err(format!(

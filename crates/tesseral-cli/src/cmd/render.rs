@@ -38,13 +38,13 @@ pub struct Args {
     #[arg(long, allow_negative_numbers = true)]
     elevation: Option<f64>,
     /// Magnification; 1 frames the whole solid.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, allow_negative_numbers = true)]
     zoom: f64,
     /// Perspective projection instead of orthographic.
     #[arg(long)]
     perspective: bool,
     /// Vertical field of view of the perspective camera, degrees (with --perspective).
-    #[arg(long, requires = "perspective")]
+    #[arg(long, requires = "perspective", allow_negative_numbers = true)]
     fov: Option<f64>,
     /// Draw the outlines of the octree blocks (the decomposition).
     #[arg(long)]
