@@ -177,7 +177,10 @@ fn bad_arguments_and_files_fail_cleanly() {
     r(&["--zoom", "0"], "--zoom");
     r(&["--zoom", "-1"], "--zoom -1: must be a positive number");
     r(&["--fov", "200", "--perspective"], "--fov");
-    r(&["--fov", "-5", "--perspective"], "--fov -5: must lie between");
+    r(
+        &["--fov", "-5", "--perspective"],
+        "--fov -5: must lie between",
+    );
     r(&["--ao", "1000"], "--ao");
     r(&["--cut", "w<3"], "--cut");
     r(&["--cut", "z=3"], "--cut");
