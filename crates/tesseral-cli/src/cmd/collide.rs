@@ -40,7 +40,7 @@ pub fn parse_voxel(s: &str) -> Result<Voxel, String> {
     }
     let mut v = [0i64; 3];
     for (c, p) in v.iter_mut().zip(&parts) {
-        *c = super::octree::parse_int(p).map_err(|e| format!("{e} (in {s:?})"))?;
+        *c = super::octree::parse_int(p).map_err(|e| format!("{e} (in `{s}`)"))?;
     }
     Ok(v)
 }

@@ -75,7 +75,7 @@ fn parse_view(s: &str) -> Result<View, String> {
 fn parse_region(s: &str) -> Result<Aabb, String> {
     let v: Vec<i64> = s
         .split(',')
-        .map(|p| super::octree::parse_int(p.trim()).map_err(|e| format!("{e} (in {s:?})")))
+        .map(|p| super::octree::parse_int(p.trim()).map_err(|e| format!("{e} (in `{s}`)")))
         .collect::<Result<_, _>>()?;
     if v.len() != 6 {
         return Err(format!(
