@@ -305,7 +305,7 @@ const AFFINE_LIMIT: f64 = 4_611_686_018_427_387_904.0;
 /// the voxels of the translation by `t`.
 #[must_use]
 pub fn whole_translation(m: [[f64; 3]; 3], t: [f64; 3]) -> Option<Voxel> {
-    let identity = (0..3).all(|i| (0..3).all(|j| m[i][j] == f64::from(u8::from(i == j))));
+    let identity = (0..3).all(|i| (0..3).all(|j| m[i][j] == if i == j { 1.0 } else { 0.0 }));
     (identity && t.iter().all(|c| c.fract() == 0.0 && c.abs() < AFFINE_LIMIT))
         .then(|| t.map(|c| c as i64))
 }

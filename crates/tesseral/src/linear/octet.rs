@@ -71,51 +71,39 @@ impl LinearOctree {
 /// `partition_point` gives it, found by galloping from index `near` (either way):
 /// O(log d) for d leaves between `near` and the answer.
 pub(crate) fn first_above(leaves: &[Leaf], c: u64, near: usize) -> usize {
-    gallop(leaves.len(), near, |i| leaves[i].code() <= c)
+    gallop(leaves, near, |l| l.code() <= c)
 }
 
-/// The first index of `0..n` where `at_or_below` turns false (it must be true, then
-/// false, along the indices), as `partition_point` would find it, galloping from
-/// index `near` either way: O(log d) calls for d indices between `near` and the
+/// The first index of `items` where `at_or_below` turns false (it must be true,
+/// then false, along the items), as `partition_point` gives it, galloping from
+/// index `near` either way: O(log d) calls for d items between `near` and the
 /// answer.
-pub(crate) fn gallop(n: usize, near: usize, at_or_below: impl Fn(usize) -> bool) -> usize {
+pub(crate) fn gallop<T>(items: &[T], near: usize, at_or_below: impl Fn(&T) -> bool) -> usize {
+    let n = items.len();
     if n == 0 {
         return 0;
     }
     let near = near.min(n - 1);
     let mut step = 1;
-    if at_or_below(near) {
-        // `lo` is at or below: widen until an index above, or the end.
+    if at_or_below(&items[near]) {
+        // `lo` is at or below: widen until an item above, or the end.
         let mut lo = near;
-        while lo + step < n && at_or_below(lo + step) {
+        while lo + step < n && at_or_below(&items[lo + step]) {
             lo += step;
             step *= 2;
         }
         let hi = (lo + step).min(n);
-        partition(lo + 1, hi, &at_or_below)
+        lo + 1 + items[lo + 1..hi].partition_point(at_or_below)
     } else {
-        // `hi` is above: widen down until an index at or below, or the start.
+        // `hi` is above: widen down until an item at or below, or the start.
         let mut hi = near;
-        while hi >= step && !at_or_below(hi - step) {
+        while hi >= step && !at_or_below(&items[hi - step]) {
             hi -= step;
             step *= 2;
         }
-        partition(hi.saturating_sub(step), hi, &at_or_below)
+        let lo = hi.saturating_sub(step);
+        lo + items[lo..hi].partition_point(at_or_below)
     }
-}
-
-/// The first index of `lo..hi` where `at_or_below` turns false (`hi` when none
-/// does), by bisection.
-fn partition(mut lo: usize, mut hi: usize, at_or_below: &impl Fn(usize) -> bool) -> usize {
-    while lo < hi {
-        let mid = lo + (hi - lo) / 2;
-        if at_or_below(mid) {
-            lo = mid + 1;
-        } else {
-            hi = mid;
-        }
-    }
-    lo
 }
 
 #[cfg(test)]

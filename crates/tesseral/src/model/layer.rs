@@ -294,9 +294,7 @@ impl<T: LayerValue> Layer<T> {
         let probe = LinearOctree::empty(self.depth, self.origin).ok()?;
         let c = probe.code_of(v)?;
         let idx = self.index();
-        let i = gallop(idx.len(), *near, |k| {
-            Leaf::from_packed(idx[k].0).code() <= c
-        });
+        let i = gallop(idx, *near, |&(p, _)| Leaf::from_packed(p).code() <= c);
         *near = i.saturating_sub(1);
         if i == 0 {
             return None;
