@@ -34,15 +34,7 @@ pub struct Args {
 
 /// Parses `X,Y,Z` integers.
 pub fn parse_voxel(s: &str) -> Result<Voxel, String> {
-    let parts: Vec<&str> = s.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!("expected X,Y,Z (three integers), got {s:?}"));
-    }
-    let mut v = [0i64; 3];
-    for (c, p) in v.iter_mut().zip(&parts) {
-        *c = super::octree::parse_int(p).map_err(|e| format!("{e} (in `{s}`)"))?;
-    }
-    Ok(v)
+    super::octree::parse_triple(s, "X,Y,Z")
 }
 
 #[derive(Serialize)]

@@ -229,9 +229,15 @@ pub fn fmt_voxel(v: [i64; 3]) -> String {
 
 /// Parses `DX,DY,DZ` (integers, negative allowed).
 pub fn parse_vector(text: &str) -> Result<[i64; 3], String> {
+    parse_triple(text, "DX,DY,DZ")
+}
+
+/// Parses three comma-separated integers (negative allowed); `form` names them in
+/// the error (`X,Y,Z`, `DX,DY,DZ`).
+pub fn parse_triple(text: &str, form: &str) -> Result<[i64; 3], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     if parts.len() != 3 {
-        return Err(format!("expected three integers `DX,DY,DZ`, got `{text}`"));
+        return Err(format!("expected three integers `{form}`, got `{text}`"));
     }
     let mut v = [0i64; 3];
     for (a, p) in parts.iter().enumerate() {
