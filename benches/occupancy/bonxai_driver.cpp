@@ -43,6 +43,7 @@ int main(int argc, char** argv) {
     return n;
   };
   lookup_gate();
+  read_keys(cells);
   auto t1 = std::chrono::steady_clock::now();
   double c1 = cpu_seconds();
   size_t known = count_known();

@@ -22,6 +22,10 @@
 # (see `paired` below), so that a ratio of lookup times compares loops timed seconds
 # apart, not minutes (on a shared host the same binary's lookups vary by a factor of
 # two between minutes). PAIRED=0 runs each tool start to end in turn, as before.
+# Every tool reads its keys once (not its map) just before its first timed loop, so
+# that no loop streams its keys from memory after the other tools' work evicted them
+# (tesseral's keys are 24 bytes, OctoMap's 6, Bonxai's 12; streamed cold, tesseral's
+# room loop took 8.7-12.8 ns a lookup against 7.4 with them read).
 #
 # Usage: benches/occupancy/run.sh [BONXAI_DIR]
 #   BONXAI_DIR: a checkout of github.com/facontidavide/Bonxai (header-only; its
