@@ -77,6 +77,14 @@ g++ -O3 -DNDEBUG -std=c++17 -I"$here" "$here/octomap_driver.cpp" -o "$build/octo
 peer="$root/target/release/examples/occupancy_peer"
 echo "OctoMap $(dpkg-query -W -f='${Version}' liboctomap-dev), Bonxai $(git -C "$bonxai" rev-parse --short HEAD 2>/dev/null || echo '(no git)')" >&2
 
+# Waits SETTLE seconds (default 1) before a timed run, so that the kernel's work after
+# the last runs' exits (freeing their maps: `perf sched` showed rcu_preempt busy on
+# core 1 for 16 ms right after the paired runs, with both of a two-core run's
+# workers left sharing core 0) is not done inside the next run.
+settle() {
+  sleep "${SETTLE:-1}"
+}
+
 # Runs a command, appending its peak RSS (KB) to its RESULT line.
 timed() {
   local out
@@ -117,6 +125,7 @@ paired() {
     rm -rf "$gates"
   }
   for tool in "${tools[@]}"; do
+    settle
     LOOKUP_GATE="$gates/$tool" one_core "$tool" >"$gates/$tool.out" &
     pids[$tool]=$!
     until [ -e "$gates/$tool.ready" ]; do
@@ -178,6 +187,7 @@ for w in $workloads; do
       done
     fi
     if [[ " $tool_list " == *" tesseral "* ]]; then
+      settle
       echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
     fi
   done
