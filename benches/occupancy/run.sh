@@ -77,17 +77,14 @@ g++ -O3 -DNDEBUG -std=c++17 -I"$here" "$here/octomap_driver.cpp" -o "$build/octo
 peer="$root/target/release/examples/occupancy_peer"
 echo "OctoMap $(dpkg-query -W -f='${Version}' liboctomap-dev), Bonxai $(git -C "$bonxai" rev-parse --short HEAD 2>/dev/null || echo '(no git)')" >&2
 
-# Waits SETTLE seconds (default 1) before a timed run, so that the kernel's work after
-# the last runs' exits (freeing their maps: `perf sched` showed rcu_preempt busy on
-# core 1 for 16 ms right after the paired runs, with both of a two-core run's
-# workers left sharing core 0) is not done inside the next run.
-settle() {
-  sleep "${SETTLE:-1}"
-}
-
-# Runs a command, appending its peak RSS (KB) to its RESULT line.
+# Runs a command, appending its peak RSS (KB) to its RESULT line. It first waits
+# SETTLE seconds (default 1), so that the kernel's work after the last runs' exits
+# (freeing their maps: `perf sched` showed rcu_preempt busy on core 1 for 16 ms right
+# after the paired runs, with both of a two-core run's workers left sharing core 0)
+# is not done inside this one; every timed run, paired or not, waits the same.
 timed() {
   local out
+  sleep "${SETTLE:-1}"
   out=$( { /usr/bin/time -f "peak_rss_kb %M" "$@" 2>&1 1>&3 3>&-; } 3>&1 ) || { echo "$out" >&2; return 1; }
   echo "$out" | awk '/^RESULT/ { r = $0 } /^peak_rss_kb/ { p = $0 } END { print r, p }'
 }
@@ -125,7 +122,6 @@ paired() {
     rm -rf "$gates"
   }
   for tool in "${tools[@]}"; do
-    settle
     LOOKUP_GATE="$gates/$tool" one_core "$tool" >"$gates/$tool.out" &
     pids[$tool]=$!
     until [ -e "$gates/$tool.ready" ]; do
@@ -187,7 +183,6 @@ for w in $workloads; do
       done
     fi
     if [[ " $tool_list " == *" tesseral "* ]]; then
-      settle
       echo "$w tesseral-2cores $(RAYON_NUM_THREADS=2 timed taskset -c 0,1 "$peer" run "$dir/$w.scans" "$range")"
     fi
   done
