@@ -235,11 +235,17 @@ pub fn parse_vector(text: &str) -> Result<[i64; 3], String> {
 /// Parses three comma-separated integers (negative allowed); `form` names them in
 /// the error (`X,Y,Z`, `DX,DY,DZ`).
 pub fn parse_triple(text: &str, form: &str) -> Result<[i64; 3], String> {
+    parse_ints(text, form)
+}
+
+/// Parses `N` comma-separated integers (negative allowed); `form` names them in the
+/// error.
+pub fn parse_ints<const N: usize>(text: &str, form: &str) -> Result<[i64; N], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
-    if parts.len() != 3 {
-        return Err(format!("expected three integers `{form}`, got `{text}`"));
+    if parts.len() != N {
+        return Err(format!("expected {N} integers `{form}`, got `{text}`"));
     }
-    let mut v = [0i64; 3];
+    let mut v = [0i64; N];
     for (a, p) in parts.iter().enumerate() {
         v[a] = parse_int(p).map_err(|e| format!("{e} (in `{text}`)"))?;
     }

@@ -73,15 +73,7 @@ fn parse_view(s: &str) -> Result<View, String> {
 }
 
 fn parse_region(s: &str) -> Result<Aabb, String> {
-    let v: Vec<i64> = s
-        .split(',')
-        .map(|p| super::octree::parse_int(p.trim()).map_err(|e| format!("{e} (in `{s}`)")))
-        .collect::<Result<_, _>>()?;
-    if v.len() != 6 {
-        return Err(format!(
-            "expected X0,Y0,Z0,X1,Y1,Z1 (six integers), got {s:?}"
-        ));
-    }
+    let v: [i64; 6] = super::octree::parse_ints(s, "X0,Y0,Z0,X1,Y1,Z1")?;
     let (min, max) = ([v[0], v[1], v[2]], [v[3], v[4], v[5]]);
     if (0..3).any(|a| max[a] < min[a]) {
         return Err(format!(
