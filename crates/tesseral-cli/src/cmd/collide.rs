@@ -34,7 +34,7 @@ pub struct Args {
 
 /// Parses `X,Y,Z` integers.
 pub fn parse_voxel(s: &str) -> Result<Voxel, String> {
-    super::octree::parse_triple(s, "X,Y,Z")
+    super::octree::parse_ints(s, "X,Y,Z")
 }
 
 #[derive(Serialize)]

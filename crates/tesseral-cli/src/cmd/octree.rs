@@ -229,17 +229,11 @@ pub fn fmt_voxel(v: [i64; 3]) -> String {
 
 /// Parses `DX,DY,DZ` (integers, negative allowed).
 pub fn parse_vector(text: &str) -> Result<[i64; 3], String> {
-    parse_triple(text, "DX,DY,DZ")
-}
-
-/// Parses three comma-separated integers (negative allowed); `form` names them in
-/// the error (`X,Y,Z`, `DX,DY,DZ`).
-pub fn parse_triple(text: &str, form: &str) -> Result<[i64; 3], String> {
-    parse_ints(text, form)
+    parse_ints(text, "DX,DY,DZ")
 }
 
 /// Parses `N` comma-separated integers (negative allowed); `form` names them in the
-/// error.
+/// error (`X,Y,Z`, `DX,DY,DZ`, `X0,Y0,Z0,X1,Y1,Z1`).
 pub fn parse_ints<const N: usize>(text: &str, form: &str) -> Result<[i64; N], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
     if parts.len() != N {
