@@ -187,13 +187,14 @@ fn blocks_take_the_smallest_form() {
     }
     store.put(b, &cells, fixed);
     assert_eq!(kind(&store), Some(Kind::Sparse));
-    // The same cells occupied: a surface, whose values fit two bits, takes a palette
-    // though the sparse form is smaller (5 units against 3, within the slack).
+    // The same cells occupied: a surface, whose palette is never narrower than two
+    // bits, takes one though the sparse form is smaller (9 units against 3, just
+    // within the slack).
     for c in cells.iter_mut().step_by(50) {
         *c = fixed.max;
     }
     store.put(b, &cells, fixed);
-    assert_eq!(kind(&store), Some(Kind::Palette(1)));
+    assert_eq!(kind(&store), Some(Kind::Palette(2)));
     // A surface of two cells, one free and one occupied, with unknown: a 2-bit
     // palette would take 9 units against the sparse form's 2, past the slack.
     let mut two = [UNKNOWN; 512];
@@ -220,12 +221,17 @@ fn blocks_take_the_smallest_form() {
     }
     store.put(b, &cells, fixed);
     assert_eq!(kind(&store), Some(Kind::Palette(2)));
-    // All known, two values: 1 bit.
+    // All known, two values: 1 bit; a surface (one value occupied): 2 bits.
+    for (i, c) in cells.iter_mut().enumerate() {
+        *c = [fixed.min, fixed.miss][i % 2];
+    }
+    store.put(b, &cells, fixed);
+    assert_eq!(kind(&store), Some(Kind::Palette(1)));
     for (i, c) in cells.iter_mut().enumerate() {
         *c = [fixed.min, fixed.max][i % 2];
     }
     store.put(b, &cells, fixed);
-    assert_eq!(kind(&store), Some(Kind::Palette(1)));
+    assert_eq!(kind(&store), Some(Kind::Palette(2)));
     // Sixteen values: 4 bits; 256: 8 bits; 512: dense.
     for (i, c) in cells.iter_mut().enumerate() {
         *c = (i % 16) as i16;
@@ -313,8 +319,9 @@ fn blocks_that_list_an_occupied_value_move_to_their_own_arena() {
     store.update(c, &none, &one, fixed);
     store.update(d, &one, &none, fixed);
     store.assert_valid(fixed);
-    // One occupied cell and unknown: a surface, so a 1-bit palette, not sparse.
-    assert_eq!(store.entry(c).map(|e| e.kind()), Some(Kind::Palette(1)));
+    // One occupied cell and unknown: a surface, whose palette would take two bits
+    // (9 units against 2, past the slack): sparse.
+    assert_eq!(store.entry(c).map(|e| e.kind()), Some(Kind::Sparse));
     assert_eq!(store.in_occupied_arena(c), Some(true));
     assert_eq!(store.in_occupied_arena(d), Some(false));
     // Random updates: `assert_valid` checks every block's arena after each.

@@ -212,17 +212,21 @@ pub(crate) fn decode(tag: u32, words: &[u16], out: &mut [i16; BLOCK_CELLS]) {
     }
 }
 
-/// Units a surface's palette of width 1 or 2 may take beyond the sparse form's and
+/// Units a surface's palette (of width 2) may take beyond the sparse form's and
 /// still be chosen (see [`choose`]).
 pub(crate) const SURFACE_SLACK: usize = 6;
 
 /// The form a block takes: its tag and its units (0 for none and uniform). The
 /// smallest (a palette over a patched palette on a tie: its lookups read one
 /// word less), except that a *surface* (a block that lists an occupied value) whose
-/// values fit a palette of width 1 or 2 takes that palette unless the sparse form
+/// values fit a palette of width 2 (never 1) takes that palette unless the sparse form
 /// is more than [`SURFACE_SLACK`] units (96 bytes) smaller. Lookups land mostly on
 /// surfaces, and a palette is read without the sparse form's compares and without
-/// a mispredicted branch between the two forms; the slack keeps the few-cell
+/// a mispredicted branch between the two forms. A surface's palette has width 2 at
+/// least: lookups read cells of two bits (width-2 and patched palettes) with
+/// constant shifts, and a surface of width 1 would send 5 % of the real scan's
+/// lookups down the general path, a branch mispredicted after the entry's miss.
+/// The slack keeps the few-cell
 /// surfaces of a thinly seen map sparse, so that the surfaces' arena still fits
 /// the caches (ARCHITECTURE.md, "Surfaces in palettes").
 pub(crate) fn choose(
@@ -239,7 +243,9 @@ pub(crate) fn choose(
         }
     }
     let mut slack = 0;
-    if let Some(w) = width_for(values) {
+    // A surface never takes width 1: its lookups read two-bit cells on a path of
+    // their own (`Store::value`), without a branch between widths.
+    if let Some(w) = width_for(values).map(|w| if surface { w.max(2) } else { w }) {
         let u = palette_units(w, values);
         if u <= best.1 {
             best = (PALETTE + w.trailing_zeros(), u);

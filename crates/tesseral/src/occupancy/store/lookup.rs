@@ -55,6 +55,14 @@ const PALETTES: [u64; 5] = {
     p
 };
 
+/// A patched palette's escaped cell `i`, out of line so that the common path
+/// falls through.
+#[cold]
+#[inline(never)]
+fn escaped(words: &[u16], at: usize, i: usize) -> i16 {
+    patched::escaped_value(|k| words_at(words, k), at, i)
+}
+
 /// Cells looked up together by [`Store::get_many`].
 pub(crate) const BATCH: usize = 32;
 
@@ -162,9 +170,25 @@ impl Store {
     fn value(&self, e: Entry, i: usize) -> i16 {
         let tag = e.tag();
         let (words, at) = self.block_at(e);
-        // Palettes of width w = 1, 2, 4 or 8 and patched palettes (tags 2 to 6)
-        // first: most lookups land on surfaces, stored as those. No branch on the
-        // width.
+        // Cells of two bits first, width-2 and patched palettes: most lookups land
+        // on surfaces, and a surface's palette is never narrower (`forms::choose`).
+        // Constant shifts, no table; the escape (a patched palette's number 3) out
+        // of line. On an AMD EPYC (Zen 4) VM, against the general palette path
+        // below for every width: the real scan's random lookups 6.1-6.2 ns against
+        // 6.3-6.4, the §8 room's 9.0-9.1 against 9.6, the street's the same.
+        if (1u32 << (PALETTE + 1) | 1 << PATCHED) >> tag & 1 != 0 {
+            let patched = usize::from(tag == PATCHED);
+            let list = at + list_at(2);
+            let bit = i << 1;
+            let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
+            let j = usize::from(x) & 3;
+            if (j << 1 | patched) == 7 {
+                return escaped(words, at, i);
+            }
+            return words_at(words, list + j) as i16;
+        }
+        // Palettes of width 1, 4 and 8 (and, unreached, 2 and patched): no branch
+        // on the width.
         if tag.wrapping_sub(PALETTE) < 5 {
             let p = PALETTES[tag as usize - PALETTE as usize];
             let list = at + (p >> 16 & 0xFFFF) as usize;
@@ -177,7 +201,7 @@ impl Store {
             // A patched palette's escaped cell: known from its number, before the
             // list is read.
             if j == (p >> 32) as usize {
-                return patched::escaped_value(|k| words_at(words, k), at, i);
+                return escaped(words, at, i);
             }
             return words_at(words, list + j) as i16;
         }
