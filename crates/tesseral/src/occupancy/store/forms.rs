@@ -243,8 +243,6 @@ pub(crate) fn choose(
         }
     }
     let mut slack = 0;
-    // A surface never takes width 1: its lookups read two-bit cells on a path of
-    // their own (`Store::value`), without a branch between widths.
     if let Some(w) = width_for(values).map(|w| if surface { w.max(2) } else { w }) {
         let u = palette_units(w, values);
         if u <= best.1 {

@@ -33,26 +33,25 @@ fn prefetch_word(words: &[u16], k: usize) {
     prefetch(unsafe { words.get_unchecked(k) });
 }
 
-/// Palettes of width 1, 2, 4 and 8, then the patched palette (by `tag −
-/// PALETTE`), from the high bits down: the number that escapes to the patch (3 for
-/// the patched palette, none for a palette), where the value list starts (after
-/// the cells and the count), the log2 of a cell's bits, their mask. A patched
-/// palette's cells are read as a palette of width 2's.
-const PALETTES: [u64; 5] = {
-    let mut p = [0; 5];
+/// Palettes of width 1, 2, 4 and 8 (by `tag − PALETTE`), from the high bits down:
+/// where the value list starts (after the cells and the count), the log2 of a
+/// cell's bits, their mask.
+const PALETTES: [u64; 4] = {
+    let mut p = [0; 4];
     let mut k = 0;
-    while k < 5 {
-        let (log2, escape) = if k < 4 {
-            (k, 0xFFFF)
-        } else {
-            (1, patched::ESCAPE as u64)
-        };
-        let w = 1 << log2;
-        p[k] = escape << 32 | (list_at(w) as u64) << 16 | (log2 as u64) << 8 | ((1 << w) - 1);
+    while k < 4 {
+        let w = 1 << k;
+        p[k] = (list_at(w) as u64) << 16 | (k as u64) << 8 | ((1 << w) - 1);
         k += 1;
     }
-    assert!(PATCHED == PALETTE + 4 && (p[4] >> 16 & 0xFFFF) as usize == patched::COMMON);
     p
+};
+
+/// The tags read as cells of two bits: width-2 palettes and patched palettes,
+/// whose cells and value list lie where a width-2 palette's do.
+const TWO_BIT: u32 = {
+    assert!(list_at(2) == patched::COMMON);
+    1 << (PALETTE + 1) | 1 << PATCHED
 };
 
 /// A patched palette's escaped cell `i`, out of line so that the common path
@@ -176,20 +175,20 @@ impl Store {
         // of line. On an AMD EPYC (Zen 4) VM, against the general palette path
         // below for every width: the real scan's random lookups 6.1-6.2 ns against
         // 6.3-6.4, the §8 room's 9.0-9.1 against 9.6, the street's the same.
-        if (1u32 << (PALETTE + 1) | 1 << PATCHED) >> tag & 1 != 0 {
+        if TWO_BIT >> tag & 1 != 0 {
             let patched = usize::from(tag == PATCHED);
-            let list = at + list_at(2);
             let bit = i << 1;
             let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
             let j = usize::from(x) & 3;
-            if (j << 1 | patched) == 7 {
+            // Escaped: number `ESCAPE` in a patched palette (one compare, no branch
+            // on the tag).
+            if (j << 1 | patched) == patched::ESCAPE << 1 | 1 {
                 return escaped(words, at, i);
             }
-            return words_at(words, list + j) as i16;
+            return words_at(words, at + list_at(2) + j) as i16;
         }
-        // Palettes of width 1, 4 and 8 (and, unreached, 2 and patched): no branch
-        // on the width.
-        if tag.wrapping_sub(PALETTE) < 5 {
+        // Palettes of width 1, 4 and 8 (and, unreached, 2): no branch on the width.
+        if tag.wrapping_sub(PALETTE) < 4 {
             let p = PALETTES[tag as usize - PALETTE as usize];
             let list = at + (p >> 16 & 0xFFFF) as usize;
             // The list lies a line or more past the cell's word: fetch both at once
@@ -198,11 +197,6 @@ impl Store {
             let bit = i << (p >> 8 & 0xff);
             let x = words_at(words, at + (bit >> 4)) >> (bit & 15);
             let j = usize::from(x) & (p as usize & 0xff);
-            // A patched palette's escaped cell: known from its number, before the
-            // list is read.
-            if j == (p >> 32) as usize {
-                return escaped(words, at, i);
-            }
             return words_at(words, list + j) as i16;
         }
         self.value_other(e, i)
