@@ -14,14 +14,19 @@
 # the same cells LOOKUP_LOOPS - 1 more times (default 5 loops in all) and adds
 # lookup_min_cpu_ns and lookup_median_cpu_ns: the fastest and the median loop, so that
 # a loop slowed by another process on the machine can be told from the tool's own
-# time (each tool gets the same loops; none is warmed more than another).
+# time (each tool gets the same loops; none is warmed more than another), and
+# lookup_turns_cpu_ns, every loop's time in order.
 # One core: `taskset -c 0` and RAYON_NUM_THREADS=1; two cores: RAYON_NUM_THREADS=2 on
 # cores 0,1 (only tesseral is parallel).
 # The lookups are paired (PAIRED=1, the default): every one-core tool builds its map
-# in turn while the others wait, and then their lookups run one right after another
-# (see `paired` below), so that a ratio of lookup times compares loops timed seconds
-# apart, not minutes (on a shared host the same binary's lookups vary by a factor of
-# two between minutes). PAIRED=0 runs each tool start to end in turn, as before.
+# in turn while the others wait, and then their lookup loops take turns (see `paired`
+# below): every tool's first loop, one after another, then every tool's second, and
+# so on, so that a ratio of lookup times compares loops timed a second or less apart,
+# not minutes (on a shared host the same binary's lookups vary by a factor of two
+# between minutes, and by 1.5 between loops of one process seconds apart). Each
+# tool then adds lookup_turns_cpu_ns, its loops' times in order: the ratio of turn
+# t is one tool's loop t against another's. PAIRED=0 runs each tool start to end in
+# turn, as before.
 # Every tool reads its keys once (not its map) just before its first timed loop, so
 # that no loop streams its keys from memory after the other tools' work evicted them
 # (tesseral's keys are 24 bytes, OctoMap's 6, Bonxai's 12; streamed cold, tesseral's
@@ -117,12 +122,15 @@ paired() {
   give_up() {
     echo "$w: $1" >&2
     local t
-    for t in "${tools[@]}"; do touch "$gates/$t.go"; done
+    for t in "${tools[@]}"; do
+      touch "$gates/$t.go"
+      for k in $(seq 1 "$loops"); do touch "$gates/$t.go$k"; done
+    done
     for t in "${!pids[@]}"; do wait "${pids[$t]}" 2>/dev/null || true; done
     rm -rf "$gates"
   }
   for tool in "${tools[@]}"; do
-    LOOKUP_GATE="$gates/$tool" one_core "$tool" >"$gates/$tool.out" &
+    LOOKUP_GATE="$gates/$tool" LOOKUP_TURNS=1 one_core "$tool" >"$gates/$tool.out" &
     pids[$tool]=$!
     until [ -e "$gates/$tool.ready" ]; do
       if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
@@ -135,15 +143,35 @@ paired() {
   done
   n=${#tools[@]}
   for k in $(seq 0 $((n - 1))); do order+=("${tools[$(((k + rep - 1) % n))]}"); done
-  echo "   lookups in the order ${order[*]}" >&2
+  echo "   lookups in turns of $loops loops, the first in the order ${order[*]}" >&2
+  # Turn t lets each tool's loop t go in turn, the order rotated by one a turn; a
+  # tool's loop is done when its PATH.done<t> appears.
+  for t in $(seq 0 $((loops - 1))); do
+    for k in $(seq 0 $((n - 1))); do
+      tool=${order[$(((k + t) % n))]}
+      if [ "$t" = 0 ]; then touch "$gates/$tool.go"; else touch "$gates/$tool.go$t"; fi
+      until [ -e "$gates/$tool.done$t" ]; do
+        if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
+          wait "${pids[$tool]}" || true
+          give_up "$tool ended before its loop $t"
+          return 1
+        fi
+        sleep 0.002
+      done
+    done
+  done
+  # Then each tool's rest (its census, tesseral's batched lookups, its exit) alone.
   for tool in "${order[@]}"; do
-    touch "$gates/$tool.go"
+    touch "$gates/$tool.go$loops"
     wait "${pids[$tool]}" || { give_up "$tool failed"; return 1; }
   done
   for tool in "${tools[@]}"; do echo "$w $tool-1core $(cat "$gates/$tool.out")"; done
   rm -rf "$gates"
 }
 
+# Every tool times its lookups in LOOKUP_LOOPS loops (the drivers' default, 5).
+export LOOKUP_LOOPS=${LOOKUP_LOOPS:-5}
+loops=$LOOKUP_LOOPS
 tool_list=${TOOLS:-tesseral bonxai octomap}
 workloads=${WORKLOADS:-indoor outdoor}
 [ -n "${REAL_SCAN:-}" ] && [[ " $workloads " != *" real "* ]] && workloads="$workloads real"

@@ -53,31 +53,76 @@ inline double cpu_seconds() {
   return ts.tv_sec + ts.tv_nsec * 1e-9;
 }
 
-// Loops over the lookups after the first timed one (LOOKUP_LOOPS, default 5, in all):
-// the fastest and the median loop's process CPU ns per lookup, so that a loop slowed
-// by another process on the machine can be told from the tool's own time. `loop`
-// runs the lookups once and returns the cells known.
-template <class F>
-std::vector<double> repeat_lookups(F loop, size_t cells) {
+// With LOOKUP_GATE=PATH and LOOKUP_TURNS=1 (run.sh's paired runs), the tools' loops
+// take turns: loop k (from 0, the first timed one) waits for PATH.go (k = 0, see
+// `lookup_gate`) or PATH.go<k>, and creates PATH.done<k> once timed, so that run.sh
+// lets each tool's loop k run right after the others' loop k. Without, no waits.
+inline const char* turn_gate() {
+  const char* t = std::getenv("LOOKUP_TURNS");
+  const char* g = std::getenv("LOOKUP_GATE");
+  return t && std::string(t) == "1" && g && *g ? g : nullptr;
+}
+
+inline void touch(const std::string& path) {
+  FILE* f = std::fopen(path.c_str(), "w");
+  if (!f) { std::perror(path.c_str()); std::exit(1); }
+  std::fclose(f);
+}
+
+// Waits for loop k's turn (k >= 1: loop 0 waits in `lookup_gate`).
+inline void turn_wait(int k) {
+  const char* g = turn_gate();
+  if (!g) return;
+  std::string go = std::string(g) + ".go" + std::to_string(k);
+  while (access(go.c_str(), F_OK) != 0) usleep(1000);
+}
+
+// Ends loop k's turn.
+inline void turn_done(int k) {
+  if (const char* g = turn_gate()) touch(std::string(g) + ".done" + std::to_string(k));
+}
+
+// Loops over the lookups after the first timed one (LOOKUP_LOOPS, default 5, in all),
+// each in its turn (`turn_wait`; then the turn numbered LOOKUP_LOOPS for the rest of
+// the run) after `before` (the keys read again, as before the
+// first): each loop's process CPU ns per lookup, in order, so that a loop slowed by
+// another process on the machine can be told from the tool's own time. `loop` runs
+// the lookups once and returns the cells known.
+template <class F, class G>
+std::vector<double> repeat_lookups(F loop, size_t cells, G before) {
   const char* env = std::getenv("LOOKUP_LOOPS");
   int loops = env ? std::max(1, std::atoi(env)) : 5;
   std::vector<double> ns;
   for (int i = 1; i < loops; i++) {
+    turn_wait(i);
+    before();
     double c = cpu_seconds();
     volatile size_t known = loop();
     (void)known;
     ns.push_back((cpu_seconds() - c) * 1e9 / double(cells));
+    turn_done(i);
   }
+  // The rest of the run (counting cells, exiting) in a turn of its own, after every
+  // tool's loops, so that no tool's exit shares the core with another's work.
+  turn_wait(loops);
   return ns;
 }
 
 // Appends `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y` (the first loop,
-// `first_ns`, counted in) to a RESULT line.
-inline void print_loops(std::vector<double> ns, double first_ns) {
-  ns.push_back(first_ns);
+// `first_ns`, counted in) and `lookup_turns_cpu_ns A,B,...` (every loop in order, the
+// first first) to a RESULT line.
+inline void print_loops(const std::vector<double>& later, double first_ns) {
+  std::vector<double> ns{first_ns};
+  ns.insert(ns.end(), later.begin(), later.end());
+  std::string turns;
+  char one[32];
+  for (double x : ns) {
+    std::snprintf(one, sizeof one, "%s%.1f", turns.empty() ? "" : ",", x);
+    turns += one;
+  }
   std::sort(ns.begin(), ns.end());
-  std::printf(" lookup_loops %zu lookup_min_cpu_ns %.1f lookup_median_cpu_ns %.1f", ns.size(), ns.front(),
-              ns[ns.size() / 2]);
+  std::printf(" lookup_loops %zu lookup_min_cpu_ns %.1f lookup_median_cpu_ns %.1f lookup_turns_cpu_ns %s", ns.size(),
+              ns.front(), ns[ns.size() / 2], turns.c_str());
 }
 
 // With LOOKUP_GATE=PATH (run.sh's paired runs): creates PATH.ready once the map is
@@ -87,9 +132,7 @@ inline void lookup_gate() {
   const char* g = std::getenv("LOOKUP_GATE");
   if (!g || !*g) return;
   std::string base(g);
-  FILE* f = std::fopen((base + ".ready").c_str(), "w");
-  if (!f) { std::perror((base + ".ready").c_str()); std::exit(1); }
-  std::fclose(f);
+  touch(base + ".ready");
   while (access((base + ".go").c_str(), F_OK) != 0) usleep(10000);
 }
 

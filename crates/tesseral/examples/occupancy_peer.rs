@@ -18,8 +18,9 @@
 //!   known, and `lookup_many_ns`, `lookup_many_cpu_ns`: the same cells through the
 //!   batched `log_odds_many`, per cell; then `lookup_loops`, `lookup_min_cpu_ns` and
 //!   `lookup_median_cpu_ns` over the first loop and `LOOKUP_LOOPS − 1` more (5 in all
-//!   by default), as the C++ drivers report them. With `LOOKUP_GATE` it waits before
-//!   the lookups (see `lookup_gate`).
+//!   by default), and `lookup_turns_cpu_ns`, every loop's in order, as the C++ drivers
+//!   report them. With `LOOKUP_GATE` it waits before the lookups (see `lookup_gate`),
+//!   and with `LOOKUP_TURNS=1` too before each later loop (see `turn_gate`).
 //!
 //! The rayon pool size is `RAYON_NUM_THREADS` (one core: `RAYON_NUM_THREADS=1`).
 
@@ -151,11 +152,13 @@ fn main() -> std::io::Result<()> {
             let known = count_known();
             let (lookup, lookup_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
             // More loops over the same cells, as the C++ drivers do (`repeat_lookups`).
+            turn_done(0)?;
             let loops = lookup_loops(
                 lookup_cpu * 1e9 / cells.len() as f64,
                 cells.len(),
+                || read_keys(&cells),
                 count_known,
-            );
+            )?;
             // The same cells through the batched lookup (prefetching in passes).
             let mut out = vec![None; cells.len()];
             let (t, c) = (Instant::now(), process_cpu());
@@ -212,29 +215,75 @@ fn read_keys(cells: &[[i64; 3]]) {
     std::hint::black_box(cells.iter().fold(0, |a, c| a ^ c[0]));
 }
 
-/// `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y` over the first loop
-/// (`first_ns`, process CPU ns per lookup) and `LOOKUP_LOOPS − 1` more runs of `run`,
-/// which looks up `cells` cells (`LOOKUP_LOOPS` defaults to 5): the fastest and the
-/// median loop, as `scans.hpp`'s `repeat_lookups` and `print_loops` give them for
-/// the C++ peers, so that a loop slowed by another process can be told from the
-/// tool's own time.
-fn lookup_loops(first_ns: f64, cells: usize, run: impl Fn() -> usize) -> String {
+/// With `LOOKUP_GATE=PATH` and `LOOKUP_TURNS=1` (`run.sh`'s paired runs): the gate
+/// files of lookup loop `k` (from 0, the first timed one), which waits for
+/// `PATH.go` (k = 0, in [`lookup_gate`]) or `PATH.go<k>` and creates `PATH.done<k>`
+/// once timed, as `scans.hpp`'s `turn_wait` and `turn_done`: the tools' loops take
+/// turns, each tool's loop k right after the others' loop k.
+fn turn_gate(k: usize, what: &str) -> Option<std::path::PathBuf> {
+    let base = std::env::var_os("LOOKUP_GATE").filter(|g| !g.is_empty())?;
+    (std::env::var_os("LOOKUP_TURNS")? == "1").then(|| {
+        let mut p = base;
+        p.push(format!(".{what}{k}"));
+        std::path::PathBuf::from(p)
+    })
+}
+
+/// Waits for lookup loop `k`'s turn (k ≥ 1: loop 0 waits in [`lookup_gate`]).
+fn turn_wait(k: usize) {
+    if let Some(go) = turn_gate(k, "go") {
+        while !go.exists() {
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+    }
+}
+
+/// Ends lookup loop `k`'s turn.
+fn turn_done(k: usize) -> std::io::Result<()> {
+    match turn_gate(k, "done") {
+        Some(done) => std::fs::File::create(done).map(drop),
+        None => Ok(()),
+    }
+}
+
+/// `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y lookup_turns_cpu_ns
+/// A,B,...` over the first loop (`first_ns`, process CPU ns per lookup) and
+/// `LOOKUP_LOOPS − 1` more runs of `run`, each in its turn ([`turn_wait`]; then the
+/// turn numbered `LOOKUP_LOOPS` for the rest of the run) after `before` (the keys read
+/// again), which looks up `cells` cells (`LOOKUP_LOOPS`
+/// defaults to 5): the fastest and the median loop, and every loop in order, as
+/// `scans.hpp`'s `repeat_lookups` and `print_loops` give them for the C++ peers, so
+/// that a loop slowed by another process can be told from the tool's own time.
+fn lookup_loops(
+    first_ns: f64,
+    cells: usize,
+    before: impl Fn(),
+    run: impl Fn() -> usize,
+) -> std::io::Result<String> {
     let loops = std::env::var("LOOKUP_LOOPS")
         .ok()
         .and_then(|v| v.parse::<usize>().ok())
         .unwrap_or(5)
         .max(1);
     let mut ns = vec![first_ns];
-    for _ in 1..loops {
+    for k in 1..loops {
+        turn_wait(k);
+        before();
         let c = process_cpu();
         std::hint::black_box(run());
         ns.push((process_cpu() - c) * 1e9 / cells as f64);
+        turn_done(k)?;
     }
+    // The rest of the run (the batched lookups, exiting) in a turn of its own, after
+    // every tool's loops, so that no other tool's exit shares the core with it.
+    turn_wait(loops);
+    let turns: Vec<String> = ns.iter().map(|x| format!("{x:.1}")).collect();
     ns.sort_by(f64::total_cmp);
-    format!(
-        "lookup_loops {} lookup_min_cpu_ns {:.1} lookup_median_cpu_ns {:.1}",
+    Ok(format!(
+        "lookup_loops {} lookup_min_cpu_ns {:.1} lookup_median_cpu_ns {:.1} lookup_turns_cpu_ns {}",
         ns.len(),
         ns[0],
-        ns[ns.len() / 2]
-    )
+        ns[ns.len() / 2],
+        turns.join(",")
+    ))
 }
