@@ -129,17 +129,22 @@ paired() {
     for t in "${!pids[@]}"; do wait "${pids[$t]}" 2>/dev/null || true; done
     rm -rf "$gates"
   }
+  # Waits for file $2 while tool $1 runs, polling every $4 seconds; gives up (naming
+  # $3) when the tool ends first.
+  await() {
+    until [ -e "$2" ]; do
+      if ! kill -0 "${pids[$1]}" 2>/dev/null; then
+        wait "${pids[$1]}" || true
+        give_up "$1 ended before $3"
+        return 1
+      fi
+      sleep "$4"
+    done
+  }
   for tool in "${tools[@]}"; do
     LOOKUP_GATE="$gates/$tool" LOOKUP_TURNS=1 one_core "$tool" >"$gates/$tool.out" &
     pids[$tool]=$!
-    until [ -e "$gates/$tool.ready" ]; do
-      if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
-        wait "${pids[$tool]}" || true
-        give_up "$tool ended before its lookups"
-        return 1
-      fi
-      sleep 0.05
-    done
+    await "$tool" "$gates/$tool.ready" "its lookups" 0.05 || return 1
   done
   n=${#tools[@]}
   for k in $(seq 0 $((n - 1))); do order+=("${tools[$(((k + rep - 1) % n))]}"); done
@@ -150,14 +155,7 @@ paired() {
     for k in $(seq 0 $((n - 1))); do
       tool=${order[$(((k + t) % n))]}
       if [ "$t" = 0 ]; then touch "$gates/$tool.go"; else touch "$gates/$tool.go$t"; fi
-      until [ -e "$gates/$tool.done$t" ]; do
-        if ! kill -0 "${pids[$tool]}" 2>/dev/null; then
-          wait "${pids[$tool]}" || true
-          give_up "$tool ended before its loop $t"
-          return 1
-        fi
-        sleep 0.002
-      done
+      await "$tool" "$gates/$tool.done$t" "its loop $t" 0.002 || return 1
     done
   done
   # Then each tool's rest (its census, tesseral's batched lookups, its exit) alone.
