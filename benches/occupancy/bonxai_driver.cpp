@@ -49,7 +49,6 @@ int main(int argc, char** argv) {
   size_t known = count_known();
   double lookup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   double lookup_cpu = cpu_seconds() - c1;
-  turn_done(0);
   auto loops = repeat_lookups(count_known, cells.size(), [&] { read_keys(cells); });
   std::printf("RESULT bonxai scans %zu rays %zu insert_s %.3f cpu_s %.3f rays_per_s %.4e bytes %zu occupied %zu free %zu lookup_ns %.1f known %zu lookup_cpu_ns %.1f",
               raw.size(), rays, wall, cpu, rays / wall, map.grid().memUsage(), occ.size(), fr.size(),

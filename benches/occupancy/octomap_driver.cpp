@@ -47,7 +47,6 @@ int main(int argc, char** argv) {
   size_t known = count_known();
   double lookup = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
   double lookup_cpu = cpu_seconds() - c1;
-  turn_done(0);
   auto loops = repeat_lookups(count_known, keys.size(), [&] { read_keys(keys); });
   size_t occ = 0, fr = 0;
   for (auto it = tree.begin_leafs(); it != tree.end_leafs(); ++it) {

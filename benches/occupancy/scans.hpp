@@ -82,17 +82,18 @@ inline void turn_done(int k) {
   if (const char* g = turn_gate()) touch(std::string(g) + ".done" + std::to_string(k));
 }
 
-// Loops over the lookups after the first timed one (LOOKUP_LOOPS, default 5, in all),
-// each in its turn (`turn_wait`; then the turn numbered LOOKUP_LOOPS for the rest of
-// the run) after `before` (the keys read again, as before the
-// first): each loop's process CPU ns per lookup, in order, so that a loop slowed by
-// another process on the machine can be told from the tool's own time. `loop` runs
-// the lookups once and returns the cells known.
+// Ends the first timed loop's turn, then loops over the lookups LOOKUP_LOOPS - 1 more
+// times (default 5 loops in all), each in its turn (`turn_wait`; then the turn
+// numbered LOOKUP_LOOPS for the rest of the run) after `before` (the keys read again,
+// as before the first): each loop's process CPU ns per lookup, in order, so that a
+// loop slowed by another process on the machine can be told from the tool's own
+// time. `loop` runs the lookups once and returns the cells known.
 template <class F, class G>
 std::vector<double> repeat_lookups(F loop, size_t cells, G before) {
   const char* env = std::getenv("LOOKUP_LOOPS");
   int loops = env ? std::max(1, std::atoi(env)) : 5;
   std::vector<double> ns;
+  turn_done(0);
   for (int i = 1; i < loops; i++) {
     turn_wait(i);
     before();

@@ -152,7 +152,6 @@ fn main() -> std::io::Result<()> {
             let known = count_known();
             let (lookup, lookup_cpu) = (t.elapsed().as_secs_f64(), process_cpu() - c);
             // More loops over the same cells, as the C++ drivers do (`repeat_lookups`).
-            turn_done(0)?;
             let loops = lookup_loops(
                 lookup_cpu * 1e9 / cells.len() as f64,
                 cells.len(),
@@ -246,14 +245,15 @@ fn turn_done(k: usize) -> std::io::Result<()> {
     }
 }
 
-/// `lookup_loops N lookup_min_cpu_ns X lookup_median_cpu_ns Y lookup_turns_cpu_ns
-/// A,B,...` over the first loop (`first_ns`, process CPU ns per lookup) and
-/// `LOOKUP_LOOPS − 1` more runs of `run`, each in its turn ([`turn_wait`]; then the
-/// turn numbered `LOOKUP_LOOPS` for the rest of the run) after `before` (the keys read
-/// again), which looks up `cells` cells (`LOOKUP_LOOPS`
-/// defaults to 5): the fastest and the median loop, and every loop in order, as
-/// `scans.hpp`'s `repeat_lookups` and `print_loops` give them for the C++ peers, so
-/// that a loop slowed by another process can be told from the tool's own time.
+/// Ends the first timed loop's turn, then gives `lookup_loops N lookup_min_cpu_ns X
+/// lookup_median_cpu_ns Y lookup_turns_cpu_ns A,B,...` over the first loop
+/// (`first_ns`, process CPU ns per lookup) and `LOOKUP_LOOPS − 1` more runs of `run`
+/// (`LOOKUP_LOOPS` defaults to 5), which looks up `cells` cells, each run in its turn
+/// ([`turn_wait`]; then the turn numbered `LOOKUP_LOOPS` for the rest of the run)
+/// after `before` (the keys read again): the fastest and the median loop, and every
+/// loop in order, as `scans.hpp`'s `repeat_lookups` and `print_loops` give them for
+/// the C++ peers, so that a loop slowed by another process can be told from the
+/// tool's own time.
 fn lookup_loops(
     first_ns: f64,
     cells: usize,
@@ -266,6 +266,7 @@ fn lookup_loops(
         .unwrap_or(5)
         .max(1);
     let mut ns = vec![first_ns];
+    turn_done(0)?;
     for k in 1..loops {
         turn_wait(k);
         before();

@@ -111,13 +111,20 @@ pub(crate) fn sparse_get(words: &[u16], i: usize) -> i16 {
     }
 }
 
+/// Four consecutive words as one `u64`, the first in the low bits (one 8-byte load on a
+/// little-endian machine).
+#[inline(always)]
+pub(crate) fn join4(q: [u16; 4]) -> u64 {
+    u64::from(q[0]) | u64::from(q[1]) << 16 | u64::from(q[2]) << 32 | u64::from(q[3]) << 48
+}
+
 /// The cells of a palette block of width `w` per number, into `n[..1 << w]`
 /// (widths 1 and 2 by popcounts of the bit planes, 64 cells at a time).
 pub(crate) fn palette_numbers(words: &[u16], w: u32, n: &mut [u64; 256]) {
     let u64s = || {
-        words[..bits_words(w)].chunks_exact(4).map(|q| {
-            u64::from(q[0]) | u64::from(q[1]) << 16 | u64::from(q[2]) << 32 | u64::from(q[3]) << 48
-        })
+        words[..bits_words(w)]
+            .chunks_exact(4)
+            .map(|q| join4([q[0], q[1], q[2], q[3]]))
     };
     let all = BLOCK_CELLS as u64;
     match w {

@@ -3,7 +3,7 @@
 //! index ([`super::flat`]) while it is live, else the directory and the tables.
 
 use super::arena::UNIT;
-use super::forms::{list_at, DENSE, INLINE, PALETTE, PATCHED, SPARSE};
+use super::forms::{join4, list_at, DENSE, INLINE, PALETTE, PATCHED, SPARSE};
 use super::patched;
 use super::probe::{sparse_value, LANES};
 use super::{cube_index, join, local, split, BlockKey, Entry, Store, BLOCK_LOG2, TABLE};
@@ -38,10 +38,8 @@ fn words4_at(words: &[u16], k: usize) -> u64 {
     );
     // SAFETY: as in `words_at`: a width-2 palette's list is four words (its
     // `list_words`), and a patched palette's three common values are followed by
-    // its ranks, all inside the block's units.
-    let w = unsafe { words.as_ptr().add(k).cast::<[u16; 4]>().read_unaligned() };
-    // One 8-byte load on a little-endian machine.
-    u64::from(w[0]) | u64::from(w[1]) << 16 | u64::from(w[2]) << 32 | u64::from(w[3]) << 48
+    // its patch's width, all inside the block's units.
+    join4(unsafe { words.as_ptr().add(k).cast::<[u16; 4]>().read_unaligned() })
 }
 
 /// Prefetches word `k` of an arena's words, as [`words_at`] would read it.
