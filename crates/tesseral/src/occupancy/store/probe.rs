@@ -5,9 +5,10 @@
 //! lookups of a map whose sparse blocks vary in length, and each misprediction
 //! holds up the lookups after it until the block's words have come from memory.
 //! [`sparse_value`] instead compares the cell with the first [`LANES`] listed cells
-//! at once (eight SSE2 compares whose loads overlap) and picks the match with bit
-//! arithmetic. Longer lists, blocks fewer than `UNIT + LANES` words (the compares'
-//! reach) from the arena's end, and CPUs other than x86_64 use the binary search
+//! at once (eight SSE2 compares whose loads overlap; one for a list of up to eight
+//! cells) and picks the match with bit arithmetic. Longer lists, blocks of more
+//! than eight cells fewer than `UNIT + LANES` words (the compares' reach) from the
+//! arena's end, and CPUs other than x86_64 use the binary search
 //! ([`sparse_get`]), which gives the same answers (tested against each other and
 //! against a model of cells).
 
@@ -27,29 +28,50 @@ pub(crate) fn sparse_value(words: &[u16], at: usize, i: usize) -> i16 {
 }
 
 /// [`sparse_value`] by compares alone: `None` when the list is longer than
-/// [`LANES`], when fewer than `UNIT + LANES` words are left from `at`, or off
-/// x86_64. The words past a short list (another block's, or free) are read and
-/// their lanes masked off.
+/// [`LANES`], when a list longer than [`UNIT`] has fewer than `UNIT + LANES` words
+/// left from `at`, or off x86_64.
+///
+/// A list of up to [`UNIT`] cells (most sparse surfaces outdoors: 94 % of the
+/// street's sparse lookups) is compared in one load of its own unit of cells.
+/// Longer lists read the words past their end (another block's, or free) and mask
+/// their lanes off; for a short list those were one or two more cache lines that
+/// the lookup waited for (the street's random lookups 3-5 % faster without them).
 #[inline(always)]
 fn sparse_value_short(words: &[u16], at: usize, i: usize) -> Option<i16> {
     #[cfg(target_arch = "x86_64")]
     {
-        let w = words.get(at..at + UNIT + LANES)?;
-        let len = usize::from(w[0]);
+        let head = words.get(at..at + 2 * UNIT)?;
+        let len = usize::from(head[0]);
+        if len <= UNIT {
+            let cells = head[UNIT..].try_into().expect("UNIT words");
+            return Some(pick(head, matches::<UNIT>(cells, i) & below(len), UNIT));
+        }
         if len > LANES {
             return None;
         }
+        let w = words.get(at..at + UNIT + LANES)?;
         let cells = w[UNIT..].try_into().expect("LANES words");
-        let hits = matches(cells, i) & below(len);
-        // With no hit, the first cell is read and its value dropped.
-        let c = w[UNIT + (hits.trailing_zeros() as usize & (LANES - 1))];
-        let v = w[2 + usize::from(c & 7)] as i16;
-        Some(if hits != 0 { v } else { UNKNOWN })
+        Some(pick(w, matches::<LANES>(cells, i) & below(len), LANES))
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
         let _ = (words, at, i);
         None
+    }
+}
+
+/// The value of the listed cell whose lane is set in `hits` (of `lanes`, a power
+/// of two), `UNKNOWN` when none is: with no hit the first cell is read and its
+/// value dropped, no branch.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+fn pick(w: &[u16], hits: u64, lanes: usize) -> i16 {
+    let c = w[UNIT + (hits.trailing_zeros() as usize & (lanes - 1))];
+    let v = w[2 + usize::from(c & 7)] as i16;
+    if hits != 0 {
+        v
+    } else {
+        UNKNOWN
     }
 }
 
@@ -61,26 +83,35 @@ fn below(len: usize) -> u64 {
 }
 
 /// Bit `k` set where listed cell `k` is cell `i` (a listed cell is
-/// `index << 3 | value number`).
+/// `index << 3 | value number`), over `N` cells: 8 (one compare) or a multiple of 16.
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
-fn matches(cells: &[u16; LANES], i: usize) -> u64 {
+fn matches<const N: usize>(cells: &[u16; N], i: usize) -> u64 {
     use std::arch::x86_64::{
         __m128i, _mm_and_si128, _mm_cmpeq_epi16, _mm_loadu_si128, _mm_movemask_epi8,
-        _mm_packs_epi16, _mm_set1_epi16,
+        _mm_packs_epi16, _mm_set1_epi16, _mm_setzero_si128,
     };
+    const { assert!(N == 8 || (N % 16 == 0 && N <= 64)) };
     let p = cells.as_ptr().cast::<__m128i>();
-    // SAFETY: SSE2 is part of every x86_64 CPU. Load `k` (k < LANES / 8) reads the
+    // SAFETY: SSE2 is part of every x86_64 CPU. Load `k` (k < N / 8) reads the
     // eight words `cells[8k..8k + 8]`, inside the array; `loadu` needs no alignment.
     unsafe {
         let key = _mm_set1_epi16((i << 3) as i16);
         let index = _mm_set1_epi16(!7);
         let eq = |k: usize| _mm_cmpeq_epi16(_mm_and_si128(_mm_loadu_si128(p.add(k)), index), key);
         let mut bits = 0u64;
-        for q in 0..LANES / 16 {
-            // Two compares' 16 lanes of 0 or −1 packed to bytes: one bit a lane.
-            let m = _mm_movemask_epi8(_mm_packs_epi16(eq(2 * q), eq(2 * q + 1)));
-            bits |= u64::from(m as u16) << (16 * q);
+        let mut k = 0;
+        while k < N / 8 {
+            // Two compares' 16 lanes of 0 or −1 packed to bytes: one bit a lane
+            // (with one compare, its eight lanes and eight of zeros).
+            let hi = if k + 1 < N / 8 {
+                eq(k + 1)
+            } else {
+                _mm_setzero_si128()
+            };
+            let m = _mm_movemask_epi8(_mm_packs_epi16(eq(k), hi));
+            bits |= u64::from(m as u16) << (8 * k);
+            k += 2;
         }
         bits
     }
@@ -129,7 +160,11 @@ mod tests {
                 for &c in &cells {
                     want[(c >> 16) as usize] = c as u16 as i16;
                 }
-                let short = words.len() >= before + UNIT + LANES && len <= LANES;
+                let short = if len <= UNIT {
+                    words.len() >= before + 2 * UNIT
+                } else {
+                    words.len() >= before + UNIT + LANES && len <= LANES
+                };
                 for (i, &w) in want.iter().enumerate() {
                     assert_eq!(sparse_value(&words, before, i), w, "len {len} cell {i}");
                     assert_eq!(sparse_get(&words[before..], i), w, "len {len} cell {i}");
