@@ -31,7 +31,7 @@ pub(crate) fn sparse_value(words: &[u16], at: usize, i: usize) -> i16 {
 /// [`LANES`], when a list longer than [`UNIT`] has fewer than `UNIT + LANES` words
 /// left from `at`, or off x86_64.
 ///
-/// A list of up to [`UNIT`] cells (most sparse surfaces outdoors: 94 % of the
+/// A list of up to [`UNIT`] cells (most sparse surfaces outdoors: 93 % of the
 /// street's sparse lookups) is compared in one load of its own unit of cells.
 /// Longer lists read the words past their end (another block's, or free) and mask
 /// their lanes off; for a short list those were one or two more cache lines that
