@@ -83,7 +83,7 @@ fn below(len: usize) -> u64 {
 }
 
 /// Bit `k` set where listed cell `k` is cell `i` (a listed cell is
-/// `index << 3 | value number`), over `N` cells: 8 (one compare) or a multiple of 16.
+/// `index << 3 | value number`), over `N` cells: [`UNIT`] (one compare) or [`LANES`].
 #[cfg(target_arch = "x86_64")]
 #[inline(always)]
 fn matches<const N: usize>(cells: &[u16; N], i: usize) -> u64 {
@@ -91,7 +91,7 @@ fn matches<const N: usize>(cells: &[u16; N], i: usize) -> u64 {
         __m128i, _mm_and_si128, _mm_cmpeq_epi16, _mm_loadu_si128, _mm_movemask_epi8,
         _mm_packs_epi16, _mm_set1_epi16, _mm_setzero_si128,
     };
-    const { assert!(N == 8 || (N % 16 == 0 && N <= 64)) };
+    const { assert!(N == UNIT || N == LANES) };
     let p = cells.as_ptr().cast::<__m128i>();
     // SAFETY: SSE2 is part of every x86_64 CPU. Load `k` (k < N / 8) reads the
     // eight words `cells[8k..8k + 8]`, inside the array; `loadu` needs no alignment.
